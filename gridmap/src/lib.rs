@@ -1,0 +1,1 @@
+//! Map cloud to 2D occupancy grid, inflation and map files for spot-nav.

@@ -1,0 +1,1 @@
+//! Point cloud registration backends (ICP, point-to-plane ICP, LOAM features) for spot-nav.

@@ -1,0 +1,32 @@
+//! SE(2): exponential and logarithm. Tangent order `[x, y, theta]`.
+
+use nalgebra::{Isometry2, Vector2, Vector3};
+
+/// `(sin t / t, (1 - cos t) / t)` with series near zero.
+fn v_coefficients(theta: f64) -> (f64, f64) {
+    if theta.abs() < 1e-4 {
+        let t2 = theta * theta;
+        (1.0 - t2 / 6.0, theta / 2.0 - theta * t2 / 24.0)
+    } else {
+        (theta.sin() / theta, (1.0 - theta.cos()) / theta)
+    }
+}
+
+/// The planar rigid transform `exp([x, y, theta])`.
+#[must_use]
+pub fn se2_exp(xi: &Vector3<f64>) -> Isometry2<f64> {
+    let (a, b) = v_coefficients(xi.z);
+    let t = Vector2::new(a * xi.x - b * xi.y, b * xi.x + a * xi.y);
+    Isometry2::new(t, xi.z)
+}
+
+/// The twist `[x, y, theta]` with `exp(xi) = t`, `theta` in `(-pi, pi]`.
+#[must_use]
+pub fn se2_log(t: &Isometry2<f64>) -> Vector3<f64> {
+    let theta = t.rotation.angle();
+    let (a, b) = v_coefficients(theta);
+    let det = a * a + b * b;
+    let v = t.translation.vector;
+    // Inverse of [[a, -b], [b, a]].
+    Vector3::new((a * v.x + b * v.y) / det, (-b * v.x + a * v.y) / det, theta)
+}

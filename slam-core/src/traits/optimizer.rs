@@ -1,0 +1,64 @@
+//! The `Optimizer` trait: optimise a [`PoseGraph`] in place.
+
+use crate::error::OptimizeError;
+use crate::pose_graph::{GraphPose, PoseGraph};
+
+/// Why an optimisation stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum StopReason {
+    /// The relative cost decrease fell below its threshold.
+    CostConverged,
+    /// The update step fell below its threshold.
+    StepConverged,
+    /// The iteration cap was reached.
+    MaxIterations,
+    /// Levenberg-Marquardt's damping grew past its cap without finding a better step.
+    DampingExhausted,
+    /// Nothing to optimise (every node fixed, or no edges).
+    NothingToDo,
+}
+
+/// What an optimisation did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct OptimizationReport {
+    /// Iterations run (accepted and rejected steps).
+    pub iterations: usize,
+    /// Cost before, `sum e^T Omega e` over edges (robust kernels applied).
+    pub initial_cost: f64,
+    /// Cost after.
+    pub final_cost: f64,
+    /// Why it stopped.
+    pub stop_reason: StopReason,
+}
+
+/// A pose-graph optimiser.
+///
+/// ```
+/// use slam_core::{OptimizationReport, OptimizeError, Optimizer, PoseGraph, Pose2, StopReason};
+///
+/// /// Does nothing: shows the contract.
+/// struct Idle;
+/// impl Optimizer<Pose2> for Idle {
+///     fn optimize(&mut self, graph: &mut PoseGraph<Pose2>) -> Result<OptimizationReport, OptimizeError> {
+///         let cost = graph.cost();
+///         Ok(OptimizationReport { iterations: 0, initial_cost: cost, final_cost: cost,
+///             stop_reason: StopReason::NothingToDo })
+///     }
+/// }
+///
+/// let mut graph = PoseGraph::<Pose2>::new();
+/// graph.add_node(0, Pose2::identity())?;
+/// assert_eq!(Idle.optimize(&mut graph)?.final_cost, 0.0);
+/// # Ok::<(), OptimizeError>(())
+/// ```
+pub trait Optimizer<P: GraphPose> {
+    /// Move the free nodes of `graph` to minimise its cost, starting from their current poses.
+    ///
+    /// # Errors
+    /// Invalid graphs (no fixed node, disconnected nodes, bad information) or a factorisation that
+    /// cannot be recovered. Stopping at the iteration cap is not an error: see the report.
+    fn optimize(&mut self, graph: &mut PoseGraph<P>) -> Result<OptimizationReport, OptimizeError>;
+}

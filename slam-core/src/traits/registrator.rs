@@ -1,0 +1,97 @@
+//! The `Registrator` trait: align a source cloud to a target cloud.
+
+use nalgebra::Matrix6;
+
+use crate::cloud::PointCloud;
+use crate::error::RegistrationError;
+use crate::geometry::Pose3;
+
+/// The outcome of one alignment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Alignment {
+    /// `target_T_source`: maps source points into the target frame.
+    pub pose: Pose3,
+    /// Whether the update fell below the convergence thresholds before the iteration cap.
+    pub converged: bool,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Source points with an accepted correspondence in the last iteration.
+    pub inliers: usize,
+    /// `inliers` over the number of source points used.
+    pub inlier_ratio: f64,
+    /// Root mean squared residual (metres) of the inliers at the final pose.
+    pub rmse: f64,
+    /// `J^T W J` of the last linearisation (6x6, tangent order `[rho; phi]`, perturbation on the
+    /// left of `pose`): weigh a pose-graph edge with it.
+    pub information: Matrix6<f64>,
+    /// Smallest eigenvalue of `information`, relative to the largest: near zero means a degenerate
+    /// direction (a long featureless corridor, a single plane).
+    pub min_eigenvalue_ratio: f64,
+}
+
+/// A registration backend. Preparing a cloud (k-d tree, normals, features) is separate from
+/// aligning, so that a target can be prepared once and aligned against many times.
+///
+/// ```
+/// use nalgebra::{Matrix6, Point3, Vector3};
+/// use slam_core::{Alignment, PointCloud, Pose3, Registrator, RegistrationError};
+///
+/// /// Aligns centroids only: a toy backend that shows the contract.
+/// struct CentroidAligner;
+///
+/// impl Registrator for CentroidAligner {
+///     type Source = Point3<f64>;
+///     type Target = Point3<f64>;
+///     fn prepare_source(&self, c: &PointCloud) -> Result<Self::Source, RegistrationError> {
+///         c.centroid().ok_or(RegistrationError::TooFewPoints { what: "source", points: 0, required: 1 })
+///     }
+///     fn prepare_target(&self, c: &PointCloud) -> Result<Self::Target, RegistrationError> {
+///         c.centroid().ok_or(RegistrationError::TooFewPoints { what: "target", points: 0, required: 1 })
+///     }
+///     fn align(&self, s: &Self::Source, t: &Self::Target, _initial: &Pose3)
+///         -> Result<Alignment, RegistrationError> {
+///         Ok(Alignment {
+///             pose: Pose3::translation(t.x - s.x, t.y - s.y, t.z - s.z),
+///             converged: true, iterations: 1, inliers: 1, inlier_ratio: 1.0, rmse: 0.0,
+///             information: Matrix6::identity(), min_eigenvalue_ratio: 1.0,
+///         })
+///     }
+/// }
+///
+/// let source = PointCloud::from_points(vec![Point3::new(0.0, 0.0, 0.0)]);
+/// let target = PointCloud::from_points(vec![Point3::new(1.0, 2.0, 3.0)]);
+/// let r = CentroidAligner;
+/// let a = r.align(&r.prepare_source(&source)?, &r.prepare_target(&target)?, &Pose3::identity())?;
+/// assert_eq!(a.pose.translation.vector, Vector3::new(1.0, 2.0, 3.0));
+/// # Ok::<(), RegistrationError>(())
+/// ```
+pub trait Registrator {
+    /// A source cloud made ready for alignment (downsampled, features extracted).
+    type Source;
+    /// A target made ready for queries (k-d tree, normals, features).
+    type Target;
+
+    /// Prepare a cloud to be aligned.
+    ///
+    /// # Errors
+    /// [`RegistrationError::TooFewPoints`] when too little is left after filtering.
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError>;
+
+    /// Prepare a cloud to be aligned against (done once, reused for many sources).
+    ///
+    /// # Errors
+    /// [`RegistrationError::TooFewPoints`] when too little is left after filtering.
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError>;
+
+    /// Find `target_T_source`, starting from `initial`.
+    ///
+    /// # Errors
+    /// A non-finite initial guess, too few correspondences, or a degenerate system. Failing to
+    /// converge within the iteration cap is not an error: see [`Alignment::converged`].
+    fn align(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError>;
+}

@@ -1,0 +1,1 @@
+//! Spot frames, a simulated Spot, recordings and the navigator of spot-nav.
