@@ -24,7 +24,7 @@ impl Aabb {
 
 /// A point cloud in one frame. Positions are f32 metres; the optional channels have one value per
 /// point when present:
-/// - `ring`: laser (beam) index of a spinning LiDAR, 0-based;
+/// - `ring`: laser (beam) index of a spinning LiDAR, zero-based;
 /// - `intensity`: return strength as the sensor reports it;
 /// - `time`: seconds since the start of the sweep (for deskewing).
 ///
@@ -58,14 +58,21 @@ impl PointCloud {
     /// A cloud of the given positions with no channels.
     #[must_use]
     pub fn from_points(points: Vec<Point3<f32>>) -> Self {
-        Self { points, ..Self::default() }
+        Self {
+            points,
+            ..Self::default()
+        }
     }
 
     fn check_len(&self, channel: &'static str, got: usize) -> Result<(), CloudError> {
         if got == self.points.len() {
             Ok(())
         } else {
-            Err(CloudError::ChannelLength { channel, expected: self.points.len(), got })
+            Err(CloudError::ChannelLength {
+                channel,
+                expected: self.points.len(),
+                got,
+            })
         }
     }
 
@@ -145,7 +152,12 @@ impl PointCloud {
     #[allow(clippy::type_complexity)]
     pub fn into_parts(
         self,
-    ) -> (Vec<Point3<f32>>, Option<Vec<u16>>, Option<Vec<f32>>, Option<Vec<f32>>) {
+    ) -> (
+        Vec<Point3<f32>>,
+        Option<Vec<u16>>,
+        Option<Vec<f32>>,
+        Option<Vec<f32>>,
+    ) {
         (self.points, self.ring, self.intensity, self.time)
     }
 
@@ -183,7 +195,9 @@ impl PointCloud {
             return Err(CloudError::ChannelMismatch { channel: "ring" });
         }
         if self.intensity.is_some() != other.intensity.is_some() {
-            return Err(CloudError::ChannelMismatch { channel: "intensity" });
+            return Err(CloudError::ChannelMismatch {
+                channel: "intensity",
+            });
         }
         if self.time.is_some() != other.time.is_some() {
             return Err(CloudError::ChannelMismatch { channel: "time" });
@@ -204,8 +218,13 @@ impl PointCloud {
     /// The points (with their channels) for which `keep(index, point)` is true.
     #[must_use]
     pub fn filtered(&self, mut keep: impl FnMut(usize, &Point3<f32>) -> bool) -> Self {
-        let idx: Vec<usize> =
-            self.points.iter().enumerate().filter(|(i, p)| keep(*i, p)).map(|(i, _)| i).collect();
+        let idx: Vec<usize> = self
+            .points
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| keep(*i, p))
+            .map(|(i, _)| i)
+            .collect();
         self.select(&idx)
     }
 
@@ -217,9 +236,18 @@ impl PointCloud {
     pub fn select(&self, indices: &[usize]) -> Self {
         Self {
             points: indices.iter().map(|&i| self.points[i]).collect(),
-            ring: self.ring.as_ref().map(|v| indices.iter().map(|&i| v[i]).collect()),
-            intensity: self.intensity.as_ref().map(|v| indices.iter().map(|&i| v[i]).collect()),
-            time: self.time.as_ref().map(|v| indices.iter().map(|&i| v[i]).collect()),
+            ring: self
+                .ring
+                .as_ref()
+                .map(|v| indices.iter().map(|&i| v[i]).collect()),
+            intensity: self
+                .intensity
+                .as_ref()
+                .map(|v| indices.iter().map(|&i| v[i]).collect()),
+            time: self
+                .time
+                .as_ref()
+                .map(|v| indices.iter().map(|&i| v[i]).collect()),
         }
     }
 
@@ -236,9 +264,7 @@ impl PointCloud {
     /// Points inside the box (inclusive).
     #[must_use]
     pub fn crop_box(&self, bounds: &Aabb) -> Self {
-        self.filtered(|_, p| {
-            (0..3).all(|k| p[k] >= bounds.min[k] && p[k] <= bounds.max[k])
-        })
+        self.filtered(|_, p| (0..3).all(|k| p[k] >= bounds.min[k] && p[k] <= bounds.max[k]))
     }
 
     /// Drop every point with a non-finite coordinate; returns how many were dropped.
@@ -254,7 +280,10 @@ impl PointCloud {
     /// Axis-aligned bounds of the finite points, `None` when there are none.
     #[must_use]
     pub fn bounds(&self) -> Option<Aabb> {
-        let mut it = self.points.iter().filter(|p| p.iter().all(|v| v.is_finite()));
+        let mut it = self
+            .points
+            .iter()
+            .filter(|p| p.iter().all(|v| v.is_finite()));
         let first = *it.next()?;
         let (mut min, mut max) = (first, first);
         for p in it {
@@ -272,10 +301,9 @@ impl PointCloud {
         if self.is_empty() {
             return None;
         }
-        let sum = self
-            .points
-            .iter()
-            .fold(Vector3::<f64>::zeros(), |acc, p| acc + nalgebra::convert::<_, Vector3<f64>>(p.coords));
+        let sum = self.points.iter().fold(Vector3::<f64>::zeros(), |acc, p| {
+            acc + nalgebra::convert::<_, Vector3<f64>>(p.coords)
+        });
         Some(Point3::from(sum / self.len() as f64))
     }
 }
@@ -314,9 +342,15 @@ mod tests {
     #[test]
     fn channel_length_and_mismatch_are_errors() {
         let c = PointCloud::from_points(vec![Point3::origin(); 3]);
-        assert!(matches!(c.clone().with_ring(vec![1]), Err(CloudError::ChannelLength { .. })));
+        assert!(matches!(
+            c.clone().with_ring(vec![1]),
+            Err(CloudError::ChannelLength { .. })
+        ));
         let mut a = cloud();
-        assert!(matches!(a.extend_from(&c), Err(CloudError::ChannelMismatch { .. })));
+        assert!(matches!(
+            a.extend_from(&c),
+            Err(CloudError::ChannelMismatch { .. })
+        ));
         let n = a.len();
         a.extend_from(&cloud()).unwrap();
         assert_eq!(a.len(), 2 * n);

@@ -42,7 +42,10 @@ pub struct GridGeometry {
 
 impl Default for GridGeometry {
     fn default() -> Self {
-        Self { origin: Vector2::zeros(), resolution: 1.0 }
+        Self {
+            origin: Vector2::zeros(),
+            resolution: 1.0,
+        }
     }
 }
 
@@ -132,7 +135,11 @@ impl BitGrid {
         }
         let cells = u64::from(width) * u64::from(height);
         if cells > MAX_GRID_CELLS {
-            return Err(GridError::TooLarge { width, height, max_cells: MAX_GRID_CELLS });
+            return Err(GridError::TooLarge {
+                width,
+                height,
+                max_cells: MAX_GRID_CELLS,
+            });
         }
         let stride = (width as usize).div_ceil(64);
         let mut words = vec![0u64; stride * height as usize];
@@ -142,7 +149,13 @@ impl BitGrid {
                 row[stride - 1] = pad;
             }
         }
-        Ok(Self { width, height, stride, words, geometry: GeometryBits::default() })
+        Ok(Self {
+            width,
+            height,
+            stride,
+            words,
+            geometry: GeometryBits::default(),
+        })
     }
 
     /// A grid whose cell (x, y) is blocked when `blocked(x, y)` is true.
@@ -398,20 +411,23 @@ impl BitGrid {
     /// Every blocked cell, row by row.
     pub fn blocked_cells(&self) -> impl Iterator<Item = Cell> + '_ {
         (0..self.height).flat_map(move |y| {
-            self.row_words(y).iter().enumerate().flat_map(move |(wi, &w)| {
-                let mut bits = w;
-                std::iter::from_fn(move || {
-                    while bits != 0 {
-                        let b = bits.trailing_zeros();
-                        bits &= bits - 1;
-                        let x = wi as u32 * 64 + b;
-                        if x < self.width {
-                            return Some(Cell::new(x, y));
+            self.row_words(y)
+                .iter()
+                .enumerate()
+                .flat_map(move |(wi, &w)| {
+                    let mut bits = w;
+                    std::iter::from_fn(move || {
+                        while bits != 0 {
+                            let b = bits.trailing_zeros();
+                            bits &= bits - 1;
+                            let x = wi as u32 * 64 + b;
+                            if x < self.width {
+                                return Some(Cell::new(x, y));
+                            }
                         }
-                    }
-                    None
+                        None
+                    })
                 })
-            })
         })
     }
 
@@ -419,7 +435,8 @@ impl BitGrid {
     #[must_use]
     pub fn cell_at(&self, p: Vector2<f64>) -> Option<Cell> {
         let (x, y) = self.geometry.0.cell_coords(p);
-        self.contains_signed(x, y).then(|| Cell::new(x as u32, y as u32))
+        self.contains_signed(x, y)
+            .then(|| Cell::new(x as u32, y as u32))
     }
 
     /// World position (metres) of the centre of `cell`.
@@ -505,8 +522,14 @@ mod tests {
 
     #[test]
     fn rejects_empty_and_huge() {
-        assert!(matches!(BitGrid::new(0, 5), Err(GridError::EmptyGrid { .. })));
-        assert!(matches!(BitGrid::new(u32::MAX, u32::MAX), Err(GridError::TooLarge { .. })));
+        assert!(matches!(
+            BitGrid::new(0, 5),
+            Err(GridError::EmptyGrid { .. })
+        ));
+        assert!(matches!(
+            BitGrid::new(u32::MAX, u32::MAX),
+            Err(GridError::TooLarge { .. })
+        ));
     }
 
     #[test]

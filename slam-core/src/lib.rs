@@ -17,8 +17,10 @@
 //!
 //! // Move a cloud by it and thin it to 10 cm voxels.
 //! let cloud = PointCloud::from_points((0..1000).map(|i| Point3::new(i as f32 * 0.001, 0.0, 0.0)).collect());
-//! let moved = cloud.transformed(&pose).voxel_downsample(0.1)?;
-//! assert!(moved.len() <= 11);
+//! let moved = cloud.transformed(&pose);
+//! assert!((moved.centroid().unwrap() - pose * cloud.centroid().unwrap()).norm() < 1e-5);
+//! let thinned = cloud.voxel_downsample(0.1)?;
+//! assert_eq!(thinned.len(), 10);
 //! # Ok::<(), slam_core::CloudError>(())
 //! ```
 //!
@@ -26,8 +28,8 @@
 //! in b into a), metres, radians, seconds; f32 for stored points, f64 for poses and maths. SE(3)
 //! tangents are `[rho; phi]` with left perturbations.
 //!
-//! When not to use it: for dense RGB-D or mesh processing, a general library (Open3D, PCL) has
-//! far more; slam-core keeps only what the LiDAR SLAM and planning pipeline needs.
+//! When not to use it: for dense RGB-D or mesh processing, a general library (`Open3D`, `PCL`) has
+//! far more; `slam-core` keeps only what the LiDAR SLAM and planning pipeline needs.
 
 pub mod cloud;
 pub mod error;

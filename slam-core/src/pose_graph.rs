@@ -33,9 +33,7 @@ pub trait GraphPose: Copy + Debug + PartialEq + Send + Sync + 'static {
     fn is_finite(&self) -> bool;
 }
 
-fn symmetric_positive_definite<const N: usize>(
-    m: &nalgebra::SMatrix<f64, N, N>,
-) -> bool {
+fn symmetric_positive_definite<const N: usize>(m: &nalgebra::SMatrix<f64, N, N>) -> bool {
     if !m.iter().all(|v| v.is_finite()) {
         return false;
     }
@@ -144,7 +142,11 @@ impl<P: GraphPose> PoseGraph<P> {
     /// An empty graph.
     #[must_use]
     pub fn new() -> Self {
-        Self { nodes: Vec::new(), edges: Vec::new(), index: HashMap::new() }
+        Self {
+            nodes: Vec::new(),
+            edges: Vec::new(),
+            index: HashMap::new(),
+        }
     }
 
     /// Add a free node; returns its index.
@@ -158,7 +160,11 @@ impl<P: GraphPose> PoseGraph<P> {
         if !pose.is_finite() {
             return Err(OptimizeError::NonFinite(format!("pose of node {id}")));
         }
-        self.nodes.push(Node { id, pose, fixed: false });
+        self.nodes.push(Node {
+            id,
+            pose,
+            fixed: false,
+        });
         self.index.insert(id, self.nodes.len() - 1);
         Ok(self.nodes.len() - 1)
     }
@@ -176,23 +182,39 @@ impl<P: GraphPose> PoseGraph<P> {
         information: P::Information,
         kernel: Option<RobustKernel>,
     ) -> Result<usize, OptimizeError> {
-        let a = self.node_index(from).ok_or(OptimizeError::UnknownNode { id: from })?;
-        let b = self.node_index(to).ok_or(OptimizeError::UnknownNode { id: to })?;
+        let a = self
+            .node_index(from)
+            .ok_or(OptimizeError::UnknownNode { id: from })?;
+        let b = self
+            .node_index(to)
+            .ok_or(OptimizeError::UnknownNode { id: to })?;
         if a == b {
             return Err(OptimizeError::SelfLoop { id: from });
         }
         if !measurement.is_finite() {
-            return Err(OptimizeError::NonFinite(format!("measurement of edge {from}-{to}")));
+            return Err(OptimizeError::NonFinite(format!(
+                "measurement of edge {from}-{to}"
+            )));
         }
         if !P::information_is_valid(&information) {
-            return Err(OptimizeError::InformationNotPositiveDefinite { edge: self.edges.len() });
+            return Err(OptimizeError::InformationNotPositiveDefinite {
+                edge: self.edges.len(),
+            });
         }
         if let Some(k) = kernel
             && !k.is_valid()
         {
-            return Err(OptimizeError::NonFinite(format!("robust kernel of edge {from}-{to}")));
+            return Err(OptimizeError::NonFinite(format!(
+                "robust kernel of edge {from}-{to}"
+            )));
         }
-        self.edges.push(Edge { from: a, to: b, measurement, information, kernel });
+        self.edges.push(Edge {
+            from: a,
+            to: b,
+            measurement,
+            information,
+            kernel,
+        });
         Ok(self.edges.len() - 1)
     }
 
@@ -201,7 +223,9 @@ impl<P: GraphPose> PoseGraph<P> {
     /// # Errors
     /// [`OptimizeError::UnknownNode`].
     pub fn fix(&mut self, id: u64) -> Result<(), OptimizeError> {
-        let i = self.node_index(id).ok_or(OptimizeError::UnknownNode { id })?;
+        let i = self
+            .node_index(id)
+            .ok_or(OptimizeError::UnknownNode { id })?;
         self.nodes[i].fixed = true;
         Ok(())
     }
@@ -211,7 +235,9 @@ impl<P: GraphPose> PoseGraph<P> {
     /// # Errors
     /// [`OptimizeError::UnknownNode`].
     pub fn unfix(&mut self, id: u64) -> Result<(), OptimizeError> {
-        let i = self.node_index(id).ok_or(OptimizeError::UnknownNode { id })?;
+        let i = self
+            .node_index(id)
+            .ok_or(OptimizeError::UnknownNode { id })?;
         self.nodes[i].fixed = false;
         Ok(())
     }
@@ -263,7 +289,11 @@ impl<P: GraphPose> PoseGraph<P> {
     /// The squared Mahalanobis error of edge `e` at the current poses (no kernel).
     #[must_use]
     pub fn edge_chi2(&self, e: &Edge<P>) -> f64 {
-        let err = P::edge_error(&e.measurement, &self.nodes[e.from].pose, &self.nodes[e.to].pose);
+        let err = P::edge_error(
+            &e.measurement,
+            &self.nodes[e.from].pose,
+            &self.nodes[e.to].pose,
+        );
         P::mahalanobis_squared(&err, &e.information)
     }
 
@@ -287,11 +317,6 @@ impl<P: GraphPose> PoseGraph<P> {
     /// [`OptimizeError::EmptyGraph`], [`OptimizeError::NoFixedNode`] or
     /// [`OptimizeError::Disconnected`].
     pub fn check_gauge(&self) -> Result<(), OptimizeError> {
-        if self.nodes.is_empty() {
-            return Err(OptimizeError::EmptyGraph);
-        }
-        // Union-find over edges, then every root must hold a fixed node.
-        let mut parent: Vec<usize> = (0..self.nodes.len()).collect();
         fn find(p: &mut [usize], mut i: usize) -> usize {
             while p[i] != i {
                 p[i] = p[p[i]];
@@ -299,6 +324,11 @@ impl<P: GraphPose> PoseGraph<P> {
             }
             i
         }
+        if self.nodes.is_empty() {
+            return Err(OptimizeError::EmptyGraph);
+        }
+        // Union-find over edges, then every root must hold a fixed node.
+        let mut parent: Vec<usize> = (0..self.nodes.len()).collect();
         for e in &self.edges {
             let (a, b) = (find(&mut parent, e.from), find(&mut parent, e.to));
             if a != b {
@@ -344,11 +374,21 @@ mod tests {
     fn edges_validate_their_inputs() {
         let mut g = PoseGraph::<Pose3>::new();
         g.add_node(1, Pose3::identity()).unwrap();
-        g.add_node(2, pose3_from_xyz_rpy(1.0, 0.0, 0.0, 0.0, 0.0, 0.3)).unwrap();
-        assert!(matches!(g.add_node(1, Pose3::identity()), Err(OptimizeError::DuplicateNode { id: 1 })));
+        g.add_node(2, pose3_from_xyz_rpy(1.0, 0.0, 0.0, 0.0, 0.0, 0.3))
+            .unwrap();
+        assert!(matches!(
+            g.add_node(1, Pose3::identity()),
+            Err(OptimizeError::DuplicateNode { id: 1 })
+        ));
         let info = Matrix6::identity();
-        assert!(matches!(g.add_edge(1, 3, Pose3::identity(), info, None), Err(OptimizeError::UnknownNode { id: 3 })));
-        assert!(matches!(g.add_edge(1, 1, Pose3::identity(), info, None), Err(OptimizeError::SelfLoop { .. })));
+        assert!(matches!(
+            g.add_edge(1, 3, Pose3::identity(), info, None),
+            Err(OptimizeError::UnknownNode { id: 3 })
+        ));
+        assert!(matches!(
+            g.add_edge(1, 1, Pose3::identity(), info, None),
+            Err(OptimizeError::SelfLoop { .. })
+        ));
         let mut bad = info;
         bad[(0, 0)] = -1.0;
         assert!(matches!(
@@ -359,7 +399,13 @@ mod tests {
         assert!(g.add_edge(1, 2, Pose3::identity(), bad, None).is_err());
         assert!(matches!(g.check_gauge(), Err(OptimizeError::NoFixedNode)));
         g.fix(1).unwrap();
-        assert!(matches!(g.check_gauge(), Err(OptimizeError::Disconnected { count: 1, first_id: 2 })));
+        assert!(matches!(
+            g.check_gauge(),
+            Err(OptimizeError::Disconnected {
+                count: 1,
+                first_id: 2
+            })
+        ));
         let z = pose3_from_xyz_rpy(1.0, 0.0, 0.0, 0.0, 0.0, 0.3);
         g.add_edge(1, 2, z, info, None).unwrap();
         g.check_gauge().unwrap();

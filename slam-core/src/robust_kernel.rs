@@ -84,7 +84,11 @@ mod tests {
             for s in [0.01, 0.5, 1.0, 3.0, 10.0, 100.0] {
                 let h = 1e-6 * s;
                 let fd = (k.rho(s + h) - k.rho(s - h)) / (2.0 * h);
-                assert!((fd - k.weight(s)).abs() < 1e-5, "{k:?} at {s}: {fd} vs {}", k.weight(s));
+                assert!(
+                    (fd - k.weight(s)).abs() < 1e-5,
+                    "{k:?} at {s}: {fd} vs {}",
+                    k.weight(s)
+                );
                 assert!(k.rho(s) <= s + 1e-12);
             }
             assert!((k.rho(1e-8) - 1e-8).abs() < 1e-12);

@@ -61,7 +61,9 @@ impl PointCloud {
         let intensity = self.intensity();
         let time = self.time();
         for (i, p) in self.points().iter().enumerate() {
-            let Some(key) = voxel_key(p, inv) else { continue };
+            let Some(key) = voxel_key(p, inv) else {
+                continue;
+            };
             let slot = *index.entry(key).or_insert_with(|| {
                 acc.push(Accumulator {
                     sum: Vector3::zeros(),
@@ -95,11 +97,17 @@ impl PointCloud {
         }
         if intensity.is_some() {
             out = out.with_intensity(
-                acc.iter().map(|a| (a.intensity / f64::from(a.count)) as f32).collect(),
+                acc.iter()
+                    .map(|a| (a.intensity / f64::from(a.count)) as f32)
+                    .collect(),
             )?;
         }
         if time.is_some() {
-            out = out.with_time(acc.iter().map(|a| (a.time / f64::from(a.count)) as f32).collect())?;
+            out = out.with_time(
+                acc.iter()
+                    .map(|a| (a.time / f64::from(a.count)) as f32)
+                    .collect(),
+            )?;
         }
         Ok(out)
     }

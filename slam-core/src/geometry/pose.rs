@@ -69,4 +69,3 @@ pub fn interpolate(a: &Pose3, b: &Pose3, t: f64) -> Pose3 {
     let delta = se3_log(&(a.inverse() * b));
     a * se3_exp(&(delta * t))
 }
-

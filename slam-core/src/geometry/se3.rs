@@ -6,7 +6,10 @@ use nalgebra::{Isometry3, Matrix3, Matrix4, Matrix6, Translation3, Vector3, Vect
 use super::so3::{so3_exp, so3_hat, so3_left_jacobian, so3_left_jacobian_inverse, so3_log};
 
 fn split(xi: &Vector6<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    (xi.fixed_rows::<3>(0).into_owned(), xi.fixed_rows::<3>(3).into_owned())
+    (
+        xi.fixed_rows::<3>(0).into_owned(),
+        xi.fixed_rows::<3>(3).into_owned(),
+    )
 }
 
 /// The 4x4 twist matrix of `xi = [rho; phi]`.
@@ -49,7 +52,8 @@ pub fn se3_adjoint(t: &Isometry3<f64>) -> Matrix6<f64> {
     let r = t.rotation.to_rotation_matrix().into_inner();
     let mut ad = Matrix6::zeros();
     ad.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-    ad.fixed_view_mut::<3, 3>(0, 3).copy_from(&(so3_hat(&t.translation.vector) * r));
+    ad.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(so3_hat(&t.translation.vector) * r));
     ad.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
     ad
 }
@@ -60,7 +64,11 @@ fn q_block(rho: &Vector3<f64>, phi: &Vector3<f64>) -> Matrix3<f64> {
     let (p, r) = (so3_hat(phi), so3_hat(rho));
     let t2 = theta * theta;
     let (c1, c2, c3) = if theta < 1e-3 {
-        (1.0 / 6.0 - t2 / 120.0, 1.0 / 24.0 - t2 / 720.0, 1.0 / 120.0 - t2 / 2520.0)
+        (
+            1.0 / 6.0 - t2 / 120.0,
+            1.0 / 24.0 - t2 / 720.0,
+            1.0 / 120.0 - t2 / 2520.0,
+        )
     } else {
         let (s, c) = theta.sin_cos();
         (
@@ -83,6 +91,7 @@ pub fn se3_left_jacobian(xi: &Vector6<f64>) -> Matrix6<f64> {
     let mut out = Matrix6::zeros();
     out.fixed_view_mut::<3, 3>(0, 0).copy_from(&j);
     out.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&q_block(&rho, &phi));
+    out.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&q_block(&rho, &phi));
     out
 }

@@ -15,7 +15,11 @@ pub fn so3_hat(w: &Vector3<f64>) -> Matrix3<f64> {
 /// ignored).
 #[must_use]
 pub fn so3_vee(m: &Matrix3<f64>) -> Vector3<f64> {
-    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+    Vector3::new(
+        m[(2, 1)] - m[(1, 2)],
+        m[(0, 2)] - m[(2, 0)],
+        m[(1, 0)] - m[(0, 1)],
+    ) * 0.5
 }
 
 /// Rotation of angle `|w|` about `w` (Rodrigues).
@@ -47,7 +51,10 @@ fn left_jacobian_coefficients(theta: f64) -> (f64, f64) {
         (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
     } else {
         let t2 = theta * theta;
-        ((1.0 - theta.cos()) / t2, (theta - theta.sin()) / (t2 * theta))
+        (
+            (1.0 - theta.cos()) / t2,
+            (theta - theta.sin()) / (t2 * theta),
+        )
     }
 }
 

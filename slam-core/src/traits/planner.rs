@@ -26,7 +26,9 @@ impl GridPath {
     #[must_use]
     pub fn expand(&self) -> Vec<Cell> {
         let mut out = Vec::with_capacity(self.cells.len());
-        let Some(&first) = self.cells.first() else { return out };
+        let Some(&first) = self.cells.first() else {
+            return out;
+        };
         out.push(first);
         for w in self.cells.windows(2) {
             let (a, b) = (w[0], w[1]);
@@ -101,7 +103,11 @@ pub fn validate_endpoints(grid: &BitGrid, start: Cell, goal: Cell) -> Result<(),
             });
         }
         if grid.is_blocked(c) {
-            return Err(PlanError::BlockedCell { which, x: c.x, y: c.y });
+            return Err(PlanError::BlockedCell {
+                which,
+                x: c.x,
+                y: c.y,
+            });
         }
     }
     Ok(())
