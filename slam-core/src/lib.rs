@@ -38,6 +38,7 @@ pub mod grid;
 pub mod io;
 pub mod pose_graph;
 pub mod robust_kernel;
+pub mod slam;
 pub mod traits;
 mod voxel;
 
@@ -47,6 +48,10 @@ pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};
 pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
+pub use slam::{
+    EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, ScanInput, ScanOutcome, SkipReason,
+    SlamReport,
+};
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
-pub use traits::registrator::{Alignment, Registrator};
+pub use traits::registrator::{Alignment, MapRegistrator, Registrator};

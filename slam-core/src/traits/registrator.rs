@@ -95,3 +95,18 @@ pub trait Registrator {
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError>;
 }
+
+/// A registrator that can build a target from prepared sources placed at poses: the local map of
+/// the last keyframes (LiDAR odometry) or the neighbourhood of a loop-closure candidate. Sources
+/// are prepared once per keyframe and reused, so the map is never re-extracted from raw clouds.
+pub trait MapRegistrator: Registrator {
+    /// A target made of `parts`: each prepared source moved by its pose (`world_T_source`). The
+    /// result is in the world frame.
+    ///
+    /// # Errors
+    /// [`RegistrationError::TooFewPoints`] when the parts hold too little.
+    fn target_from_sources(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError>;
+}

@@ -1,0 +1,89 @@
+//! Settings of the Graph-SLAM engine, with the thesis' values as defaults.
+
+use crate::robust_kernel::RobustKernel;
+
+/// How an edge's information matrix is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum EdgeInformation {
+    /// A diagonal information from standard deviations per edge.
+    Fixed {
+        /// Translation standard deviation, metres.
+        translation_sigma: f64,
+        /// Rotation standard deviation, radians.
+        rotation_sigma: f64,
+    },
+    /// The registration's own `J^T W J`, moved into the edge's frame and multiplied by `scale`
+    /// (registration information is usually over-confident: scale < 1).
+    FromRegistration {
+        /// Multiplier.
+        scale: f64,
+    },
+}
+
+/// Settings of [`GraphSlam`](super::GraphSlam). Distances in metres, angles in radians.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct GraphSlamConfig {
+    /// A new keyframe once the LiDAR moved this far from the last one (thesis: 0.20 m).
+    pub keyframe_distance: f64,
+    /// ... or turned this much (radians; default 10 degrees).
+    pub keyframe_rotation: f64,
+    /// Keyframes in the local map that scans are registered against (thesis: n = 40).
+    pub local_map_keyframes: usize,
+    /// A registration result that moves the predicted pose by more than this (metres) is
+    /// rejected and the odometry prediction kept instead (a diverged alignment).
+    pub max_odometry_correction: f64,
+    /// Loop candidates lie within this distance of the new keyframe (thesis: 0.5 m).
+    pub loop_search_radius: f64,
+    /// The loop target is made of the candidate and this many keyframes on each side (thesis: 20).
+    pub loop_neighbours: usize,
+    /// A coarse loop alignment is accepted when its mean squared error is below this (m^2).
+    pub loop_max_mean_squared_error: f64,
+    /// Keyframes to wait after a loop attempt before trying again (limits optimiser calls).
+    pub loop_min_keyframe_gap: usize,
+    /// A refined loop alignment further than this (metres) from the coarse one is rejected.
+    pub loop_max_refine_shift: f64,
+    /// Robust kernel on loop-closure edges (a wrong loop must not wreck the map).
+    pub loop_kernel: Option<RobustKernel>,
+    /// Information of odometry edges.
+    pub odometry_information: EdgeInformation,
+    /// Information of loop-closure edges.
+    pub loop_information: EdgeInformation,
+    /// Voxel (metres) of the keyframe clouds kept for the map.
+    pub map_voxel_size: f32,
+    /// Scans with fewer finite points are skipped.
+    pub min_scan_points: usize,
+    /// Run one loop-closure step inside [`GraphSlam::process`](super::GraphSlam::process) after
+    /// each new keyframe. When false the caller schedules
+    /// [`GraphSlam::loop_closure_step`](super::GraphSlam::loop_closure_step) itself.
+    pub inline_loop_closure: bool,
+}
+
+impl Default for GraphSlamConfig {
+    fn default() -> Self {
+        Self {
+            keyframe_distance: 0.20,
+            keyframe_rotation: 10f64.to_radians(),
+            local_map_keyframes: 40,
+            max_odometry_correction: 0.5,
+            loop_search_radius: 0.5,
+            loop_neighbours: 20,
+            loop_max_mean_squared_error: 0.01,
+            loop_min_keyframe_gap: 5,
+            loop_max_refine_shift: 0.3,
+            loop_kernel: Some(RobustKernel::Cauchy { c: 1.0 }),
+            odometry_information: EdgeInformation::Fixed {
+                translation_sigma: 0.01,
+                rotation_sigma: 0.2f64.to_radians(),
+            },
+            loop_information: EdgeInformation::Fixed {
+                translation_sigma: 0.02,
+                rotation_sigma: 0.3f64.to_radians(),
+            },
+            map_voxel_size: 0.05,
+            min_scan_points: 100,
+            inline_loop_closure: true,
+        }
+    }
+}

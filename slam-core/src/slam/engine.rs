@@ -1,0 +1,460 @@
+//! `GraphSlam`: keyframes, LiDAR odometry against a local map, loop closure and map assembly.
+
+use std::time::Instant;
+
+use nalgebra::Matrix6;
+
+use super::config::{EdgeInformation, GraphSlamConfig};
+use super::node_index::NodeIndex;
+use super::report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
+use crate::cloud::PointCloud;
+use crate::error::CloudError;
+use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint};
+use crate::pose_graph::PoseGraph;
+use crate::traits::optimizer::Optimizer;
+use crate::traits::registrator::MapRegistrator;
+
+/// One LiDAR scan with the robot's odometry at the same instant (the `spot-adapter` sample).
+#[derive(Clone, Copy, Debug)]
+pub struct ScanInput<'a> {
+    /// Seconds; must increase from scan to scan.
+    pub stamp: f64,
+    /// The robot's odometry: body pose in its odometry frame.
+    pub odom_t_body: Pose3,
+    /// The LiDAR's mounting: LiDAR pose in the body frame.
+    pub body_t_lidar: Pose3,
+    /// Points in the LiDAR frame.
+    pub cloud: &'a PointCloud,
+}
+
+/// A keyframe: a node of the graph with what the engine keeps of its scan.
+struct Keyframe<S, C> {
+    stamp: f64,
+    odom_t_lidar: Pose3,
+    /// Prepared for the odometry/refinement registrator.
+    source: S,
+    /// Prepared for the coarse loop registrator.
+    coarse: C,
+    /// Voxel-filtered scan (LiDAR frame) for the map.
+    cloud: PointCloud,
+}
+
+/// Graph-SLAM over any [`MapRegistrator`] (odometry and loop refinement), a second one for coarse
+/// loop checks (the thesis uses point-to-point ICP), and any [`Optimizer`].
+///
+/// Loop closure runs as a bounded step: each call of [`GraphSlam::loop_closure_step`] tries at
+/// most one queued candidate and optimises at most once. With
+/// [`GraphSlamConfig::inline_loop_closure`] (the default) [`GraphSlam::process`] calls it after
+/// each new keyframe; otherwise the caller schedules it (between scans, or on a timer), so that
+/// odometry is never held up. Either way the result is deterministic for a given input.
+pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> {
+    config: GraphSlamConfig,
+    odometry: R,
+    loop_coarse: C,
+    loop_refine: R,
+    optimizer: O,
+    graph: PoseGraph<Pose3>,
+    keyframes: Vec<Keyframe<R::Source, C::Source>>,
+    local_map: Option<R::Target>,
+    node_index: NodeIndex,
+    pending_loops: Vec<(usize, usize)>,
+    last_loop_attempt: Option<usize>,
+    /// Every accepted scan: stamp, its keyframe, and the LiDAR pose relative to that keyframe.
+    scan_poses: Vec<(f64, usize, Pose3)>,
+    last_stamp: f64,
+    report: SlamReport,
+}
+
+impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, O> {
+    /// An engine with its backends: `odometry` registers scans against the local map,
+    /// `loop_coarse` checks loop candidates, `loop_refine` refines accepted loops (the same
+    /// backend as odometry with a looser outlier threshold, thesis: 0.10 m).
+    pub fn new(
+        config: GraphSlamConfig,
+        odometry: R,
+        loop_coarse: C,
+        loop_refine: R,
+        optimizer: O,
+    ) -> Self {
+        Self {
+            config,
+            odometry,
+            loop_coarse,
+            loop_refine,
+            optimizer,
+            graph: PoseGraph::new(),
+            keyframes: Vec::new(),
+            local_map: None,
+            node_index: NodeIndex::default(),
+            pending_loops: Vec::new(),
+            last_loop_attempt: None,
+            scan_poses: Vec::new(),
+            last_stamp: f64::NEG_INFINITY,
+            report: SlamReport::default(),
+        }
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn config(&self) -> &GraphSlamConfig {
+        &self.config
+    }
+
+    /// The pose graph (keyframe `i` is node id `i`).
+    #[must_use]
+    pub fn graph(&self) -> &PoseGraph<Pose3> {
+        &self.graph
+    }
+
+    /// Counts and timings so far.
+    #[must_use]
+    pub fn report(&self) -> &SlamReport {
+        &self.report
+    }
+
+    /// Number of keyframes.
+    #[must_use]
+    pub fn keyframe_count(&self) -> usize {
+        self.keyframes.len()
+    }
+
+    fn keyframe_pose(&self, i: usize) -> Pose3 {
+        self.graph.nodes()[i].pose
+    }
+
+    /// The latest LiDAR pose in the map frame (`map_T_lidar`), `None` before the first scan.
+    #[must_use]
+    pub fn current_lidar_pose(&self) -> Option<Pose3> {
+        let &(_, k, rel) = self.scan_poses.last()?;
+        Some(self.keyframe_pose(k) * rel)
+    }
+
+    /// Optimised keyframe trajectory: `(stamp, map_T_lidar)` per keyframe.
+    #[must_use]
+    pub fn keyframe_trajectory(&self) -> Vec<(f64, Pose3)> {
+        self.keyframes
+            .iter()
+            .enumerate()
+            .map(|(i, k)| (k.stamp, self.keyframe_pose(i)))
+            .collect()
+    }
+
+    /// Trajectory of every accepted scan, `(stamp, map_T_lidar)`: each scan rides on its keyframe,
+    /// so loop closures correct it too.
+    #[must_use]
+    pub fn scan_trajectory(&self) -> Vec<(f64, Pose3)> {
+        self.scan_poses
+            .iter()
+            .map(|&(s, k, rel)| (s, self.keyframe_pose(k) * rel))
+            .collect()
+    }
+
+    /// The map: every keyframe cloud at its optimised pose, voxel-filtered at `voxel_size`.
+    ///
+    /// # Errors
+    /// [`CloudError::InvalidVoxelSize`] for a bad voxel size.
+    pub fn map(&self, voxel_size: f32) -> Result<PointCloud, CloudError> {
+        let mut all = PointCloud::new();
+        for (i, k) in self.keyframes.iter().enumerate() {
+            let mut c = k.cloud.transformed(&self.keyframe_pose(i));
+            // Channels may differ between sensors' scans; the map keeps positions only.
+            c = PointCloud::from_points(c.into_parts().0);
+            all.extend_from(&c)?;
+        }
+        all.voxel_downsample(voxel_size)
+    }
+
+    fn skip(&mut self, reason: SkipReason, started: Instant) -> ScanOutcome {
+        match reason {
+            SkipReason::OutOfOrderStamp => self.report.skipped_out_of_order += 1,
+            SkipReason::NonFiniteOdometry => self.report.skipped_non_finite_odometry += 1,
+            SkipReason::TooFewPoints => self.report.skipped_too_few_points += 1,
+            SkipReason::PreparationFailed => self.report.skipped_preparation += 1,
+        }
+        self.report
+            .scan_ms
+            .push(started.elapsed().as_secs_f64() * 1e3);
+        ScanOutcome::Skipped(reason)
+    }
+
+    /// Feed one scan. Bad input (out-of-order stamps, non-finite odometry, empty or tiny scans) is
+    /// skipped and counted in the report, never fatal.
+    pub fn process(&mut self, scan: &ScanInput<'_>) -> ScanOutcome {
+        let started = Instant::now();
+        self.report.scans += 1;
+        if !scan.stamp.is_finite() || scan.stamp <= self.last_stamp {
+            return self.skip(SkipReason::OutOfOrderStamp, started);
+        }
+        if !pose3_is_finite(&scan.odom_t_body) || !pose3_is_finite(&scan.body_t_lidar) {
+            return self.skip(SkipReason::NonFiniteOdometry, started);
+        }
+        let odom_t_lidar = scan.odom_t_body * scan.body_t_lidar;
+        let Some(last) = self.keyframes.len().checked_sub(1) else {
+            // The first keyframe defines the map frame: the odometry frame at the first scan.
+            let outcome = self.add_keyframe(scan, odom_t_lidar, odom_t_lidar, started);
+            return outcome;
+        };
+        let kf = &self.keyframes[last];
+        let delta = kf.odom_t_lidar.inverse() * odom_t_lidar;
+        let predicted = self.keyframe_pose(last) * delta;
+        let moved = delta.translation.vector.norm() >= self.config.keyframe_distance
+            || delta.rotation.angle() >= self.config.keyframe_rotation;
+        if !moved {
+            self.last_stamp = scan.stamp;
+            self.scan_poses.push((scan.stamp, last, delta));
+            self.report
+                .scan_ms
+                .push(started.elapsed().as_secs_f64() * 1e3);
+            return ScanOutcome::Tracked;
+        }
+        self.add_keyframe(scan, odom_t_lidar, predicted, started)
+    }
+
+    fn information(
+        kind: EdgeInformation,
+        reg_info: Option<&Matrix6<f64>>,
+        pose: &Pose3,
+    ) -> Matrix6<f64> {
+        match (kind, reg_info) {
+            (EdgeInformation::FromRegistration { scale }, Some(info)) => {
+                // Registration information is for a left perturbation of map_T_lidar; the edge
+                // error perturbs the relative pose on the right: Omega' = Ad(X)^T Omega Ad(X).
+                let ad = se3_adjoint(pose);
+                let m = ad.transpose() * info * ad * scale;
+                let sym = (m + m.transpose()) * 0.5;
+                if sym.cholesky().is_some() {
+                    return sym;
+                }
+                fixed_information(0.05, 1f64.to_radians())
+            }
+            (
+                EdgeInformation::Fixed {
+                    translation_sigma,
+                    rotation_sigma,
+                },
+                _,
+            ) => fixed_information(translation_sigma, rotation_sigma),
+            (EdgeInformation::FromRegistration { .. }, None) => {
+                fixed_information(0.05, 1f64.to_radians())
+            }
+        }
+    }
+
+    fn ensure_local_map(&mut self) -> bool {
+        if self.local_map.is_some() {
+            return true;
+        }
+        let n = self.keyframes.len();
+        let first = n.saturating_sub(self.config.local_map_keyframes);
+        let parts: Vec<(&R::Source, Pose3)> = (first..n)
+            .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
+            .collect();
+        self.local_map = self.odometry.target_from_sources(&parts).ok();
+        self.local_map.is_some()
+    }
+
+    fn add_keyframe(
+        &mut self,
+        scan: &ScanInput<'_>,
+        odom_t_lidar: Pose3,
+        predicted: Pose3,
+        started: Instant,
+    ) -> ScanOutcome {
+        let mut cloud = scan.cloud.clone();
+        let dropped = cloud.remove_non_finite();
+        if cloud.len() < self.config.min_scan_points {
+            return self.skip(SkipReason::TooFewPoints, started);
+        }
+        self.report.dropped_points += dropped;
+        let (Ok(source), Ok(coarse)) = (
+            self.odometry.prepare_source(&cloud),
+            self.loop_coarse.prepare_source(&cloud),
+        ) else {
+            return self.skip(SkipReason::PreparationFailed, started);
+        };
+        let map_cloud = cloud
+            .voxel_downsample(self.config.map_voxel_size)
+            .unwrap_or(cloud);
+
+        let index = self.keyframes.len();
+        let mut pose = predicted;
+        let mut registered = false;
+        let mut reg_info = None;
+        if index > 0 && self.ensure_local_map() {
+            if let Some(target) = &self.local_map
+                && let Ok(a) = self.odometry.align(&source, target, &predicted)
+            {
+                let shift = (a.pose.translation.vector - predicted.translation.vector).norm();
+                if a.converged
+                    && pose3_is_finite(&a.pose)
+                    && shift <= self.config.max_odometry_correction
+                {
+                    pose = a.pose;
+                    registered = true;
+                    reg_info = Some(a.information);
+                }
+            }
+            if !registered {
+                self.report.odometry_fallbacks += 1;
+            }
+        }
+
+        let id = index as u64;
+        if self.graph.add_node(id, pose).is_err() {
+            return self.skip(SkipReason::NonFiniteOdometry, started);
+        }
+        if index == 0 {
+            // The first node is the gauge.
+            let _ = self.graph.fix(id);
+        } else {
+            let prev = self.keyframe_pose(index - 1);
+            let info =
+                Self::information(self.config.odometry_information, reg_info.as_ref(), &pose);
+            // Both nodes exist and the information is positive definite, so this cannot fail.
+            let _ = self
+                .graph
+                .add_edge(id - 1, id, prev.inverse() * pose, info, None);
+        }
+        self.keyframes.push(Keyframe {
+            stamp: scan.stamp,
+            odom_t_lidar,
+            source,
+            coarse,
+            cloud: map_cloud,
+        });
+        self.report.keyframes += 1;
+        self.local_map = None;
+        self.last_stamp = scan.stamp;
+        self.scan_poses.push((scan.stamp, index, Pose3::identity()));
+
+        // Queue a loop candidate: the oldest keyframe near this one outside the local window.
+        let window = self.config.local_map_keyframes;
+        let may_try = self
+            .last_loop_attempt
+            .is_none_or(|l| index >= l + self.config.loop_min_keyframe_gap);
+        if index > window
+            && may_try
+            && let Some(candidate) =
+                self.node_index
+                    .oldest_within(&pose, self.config.loop_search_radius, index - window)
+        {
+            self.pending_loops.push((candidate, index));
+            self.last_loop_attempt = Some(index);
+        }
+        self.node_index.insert(index, &pose);
+        self.report
+            .scan_ms
+            .push(started.elapsed().as_secs_f64() * 1e3);
+        if self.config.inline_loop_closure {
+            self.loop_closure_step();
+        }
+        ScanOutcome::Keyframe { id, registered }
+    }
+
+    /// Try the oldest queued loop candidate: coarse alignment of the new keyframe to the
+    /// candidate's neighbourhood, acceptance on its mean squared error, refinement, a new edge and
+    /// one optimisation. Bounded: at most one candidate per call.
+    pub fn loop_closure_step(&mut self) -> LoopOutcome {
+        if self.pending_loops.is_empty() {
+            return LoopOutcome::Idle;
+        }
+        let started = Instant::now();
+        let (cand, new) = self.pending_loops.remove(0);
+        self.report.loops_attempted += 1;
+        let outcome = self.try_loop(cand, new);
+        self.report
+            .loop_ms
+            .push(started.elapsed().as_secs_f64() * 1e3);
+        outcome
+    }
+
+    fn try_loop(&mut self, cand: usize, new: usize) -> LoopOutcome {
+        let rejected = LoopOutcome::Rejected {
+            from: cand as u64,
+            to: new as u64,
+        };
+        let lo = cand.saturating_sub(self.config.loop_neighbours);
+        // Keep the neighbourhood disjoint from the new keyframe's own recent window.
+        let hi = (cand + self.config.loop_neighbours)
+            .min(new.saturating_sub(self.config.local_map_keyframes));
+        let coarse_parts: Vec<(&C::Source, Pose3)> = (lo..=hi.max(cand))
+            .map(|i| (&self.keyframes[i].coarse, self.keyframe_pose(i)))
+            .collect();
+        let refine_parts: Vec<(&R::Source, Pose3)> = (lo..=hi.max(cand))
+            .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
+            .collect();
+        let initial = self.keyframe_pose(new);
+        let Ok(coarse_target) = self.loop_coarse.target_from_sources(&coarse_parts) else {
+            return rejected;
+        };
+        let Ok(coarse) =
+            self.loop_coarse
+                .align(&self.keyframes[new].coarse, &coarse_target, &initial)
+        else {
+            return rejected;
+        };
+        let mse = coarse.rmse * coarse.rmse;
+        if !coarse.converged
+            || !pose3_is_finite(&coarse.pose)
+            || mse > self.config.loop_max_mean_squared_error
+        {
+            return rejected;
+        }
+        let Ok(refine_target) = self.loop_refine.target_from_sources(&refine_parts) else {
+            return rejected;
+        };
+        let Ok(refined) =
+            self.loop_refine
+                .align(&self.keyframes[new].source, &refine_target, &coarse.pose)
+        else {
+            return rejected;
+        };
+        let shift = (refined.pose.translation.vector - coarse.pose.translation.vector).norm();
+        if !refined.converged
+            || !pose3_is_finite(&refined.pose)
+            || shift > self.config.loop_max_refine_shift
+        {
+            return rejected;
+        }
+        let cand_pose = self.keyframe_pose(cand);
+        let info = Self::information(
+            self.config.loop_information,
+            Some(&refined.information),
+            &refined.pose,
+        );
+        if self
+            .graph
+            .add_edge(
+                cand as u64,
+                new as u64,
+                cand_pose.inverse() * refined.pose,
+                info,
+                self.config.loop_kernel,
+            )
+            .is_err()
+        {
+            return rejected;
+        }
+        if self.optimizer.optimize(&mut self.graph).is_err() {
+            self.report.optimizer_failures += 1;
+        }
+        self.report.loops_closed += 1;
+        self.local_map = None;
+        let poses: Vec<Pose3> = self.graph.nodes().iter().map(|n| n.pose).collect();
+        self.node_index.rebuild(poses.iter());
+        LoopOutcome::Closed {
+            from: cand as u64,
+            to: new as u64,
+            mean_squared_error: mse,
+        }
+    }
+}
+
+/// Diagonal information from standard deviations (tangent order `[rho; phi]`).
+fn fixed_information(translation_sigma: f64, rotation_sigma: f64) -> Matrix6<f64> {
+    let (t, r) = (
+        1.0 / (translation_sigma * translation_sigma),
+        1.0 / (rotation_sigma * rotation_sigma),
+    );
+    Matrix6::from_diagonal(&nalgebra::Vector6::new(t, t, t, r, r, r))
+}

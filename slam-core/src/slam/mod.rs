@@ -1,0 +1,18 @@
+//! The Graph-SLAM engine (thesis chapter 4), generic over the backend traits.
+//!
+//! Per scan: validate the input, predict the LiDAR pose from the robot's odometry
+//! (`X_t = X_k * (odom_T_lidar_k^-1 * odom_T_lidar_t)`, thesis eq. 4.1-4.2), and once the LiDAR
+//! has moved [`GraphSlamConfig::keyframe_distance`] from the last keyframe, register the scan
+//! against a local map of the last [`GraphSlamConfig::local_map_keyframes`] keyframes and add a
+//! node. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
+//! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
+//! optimises the graph.
+
+mod config;
+mod engine;
+mod node_index;
+mod report;
+
+pub use config::{EdgeInformation, GraphSlamConfig};
+pub use engine::{GraphSlam, ScanInput};
+pub use report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};

@@ -1,0 +1,49 @@
+//! Spatial index over keyframe positions for loop-closure candidate search.
+
+use rstar::RTree;
+use rstar::primitives::GeomWithData;
+
+use crate::geometry::Pose3;
+
+type Entry = GeomWithData<[f64; 3], usize>;
+
+/// An R-tree of keyframe positions; rebuilt in bulk after an optimisation moves the nodes.
+#[derive(Default)]
+pub(crate) struct NodeIndex {
+    tree: RTree<Entry>,
+}
+
+impl NodeIndex {
+    /// Index the positions of `poses` (keyframe index = position in the slice).
+    pub(crate) fn rebuild<'a>(&mut self, poses: impl Iterator<Item = &'a Pose3>) {
+        let entries: Vec<Entry> = poses
+            .enumerate()
+            .map(|(i, p)| {
+                let t = p.translation.vector;
+                GeomWithData::new([t.x, t.y, t.z], i)
+            })
+            .collect();
+        self.tree = RTree::bulk_load(entries);
+    }
+
+    /// Add one keyframe.
+    pub(crate) fn insert(&mut self, index: usize, pose: &Pose3) {
+        let t = pose.translation.vector;
+        self.tree.insert(GeomWithData::new([t.x, t.y, t.z], index));
+    }
+
+    /// The smallest keyframe index within `radius` of `pose` and below `max_index`.
+    pub(crate) fn oldest_within(
+        &self,
+        pose: &Pose3,
+        radius: f64,
+        max_index: usize,
+    ) -> Option<usize> {
+        let t = pose.translation.vector;
+        self.tree
+            .locate_within_distance([t.x, t.y, t.z], radius * radius)
+            .map(|e| e.data)
+            .filter(|&i| i < max_index)
+            .min()
+    }
+}
