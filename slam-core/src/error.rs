@@ -47,6 +47,14 @@ pub enum GridError {
     /// The origin must be finite.
     #[error("grid origin is not finite")]
     NonFiniteOrigin,
+    /// Stored grid data has the wrong number of words for its size.
+    #[error("grid data has {got} words, {expected} expected for its size")]
+    WordCount {
+        /// Words a grid of that size has.
+        expected: usize,
+        /// Words given.
+        got: usize,
+    },
 }
 
 /// Errors reading or writing the file formats in [`io`](crate::io).

@@ -97,18 +97,26 @@ impl GridGeometry {
 /// # Ok::<(), slam_core::GridError>(())
 /// ```
 #[derive(Clone, PartialEq, Eq, Debug)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "serde_form::RawBitGrid", into = "serde_form::RawBitGrid")
+)]
 pub struct BitGrid {
     width: u32,
     height: u32,
     stride: usize,
     words: Vec<u64>,
-    #[cfg_attr(feature = "serde", serde(skip))]
     geometry: GeometryBits,
 }
 
 /// `GridGeometry` stored so that `BitGrid` can stay `Eq` (compares the raw bits of the floats).
 #[derive(Clone, Copy, Debug, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(transparent)
+)]
 struct GeometryBits(GridGeometry);
 
 impl PartialEq for GeometryBits {
@@ -443,6 +451,51 @@ impl BitGrid {
     #[must_use]
     pub fn cell_center(&self, cell: Cell) -> Vector2<f64> {
         self.geometry.0.cell_center(cell)
+    }
+}
+
+/// The serialised form of a grid, checked on the way back in so a bad file cannot break the
+/// grid's invariants (row stride, padding bits).
+#[cfg(feature = "serde")]
+mod serde_form {
+    use super::{BitGrid, GeometryBits, GridGeometry};
+    use crate::error::GridError;
+
+    #[derive(serde::Serialize, serde::Deserialize)]
+    pub(super) struct RawBitGrid {
+        width: u32,
+        height: u32,
+        geometry: GridGeometry,
+        words: Vec<u64>,
+    }
+
+    impl From<BitGrid> for RawBitGrid {
+        fn from(g: BitGrid) -> Self {
+            Self {
+                width: g.width,
+                height: g.height,
+                geometry: g.geometry.0,
+                words: g.words,
+            }
+        }
+    }
+
+    impl TryFrom<RawBitGrid> for BitGrid {
+        type Error = GridError;
+        fn try_from(raw: RawBitGrid) -> Result<Self, GridError> {
+            let mut grid = BitGrid::new(raw.width, raw.height)?;
+            if raw.words.len() != grid.words.len() {
+                return Err(GridError::WordCount {
+                    expected: grid.words.len(),
+                    got: raw.words.len(),
+                });
+            }
+            let geometry = GridGeometry::try_new(raw.geometry.origin, raw.geometry.resolution)?;
+            grid.words = raw.words;
+            grid.geometry = GeometryBits(geometry);
+            grid.restore_padding();
+            Ok(grid)
+        }
     }
 }
 
