@@ -1,0 +1,572 @@
+//! PCD (Point Cloud Library) files: `ascii`, `binary` and `binary_compressed` data, fields in any
+//! order, padding fields skipped. Reads x y z plus intensity, ring and time when present.
+//! The `VIEWPOINT` is not applied to the points (as PCL does not); files are read as stored.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
+use crate::cloud::PointCloud;
+use crate::error::FormatError;
+
+/// How [`write_pcd`] stores the data section.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PcdEncoding {
+    /// One text line per point (values printed so that f32 round-trips exactly).
+    Ascii,
+    /// Packed little-endian records.
+    #[default]
+    Binary,
+}
+
+/// One `FIELDS` entry.
+#[derive(Clone, Debug)]
+struct Field {
+    name: String,
+    scalar: Scalar,
+    count: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum DataKind {
+    Ascii,
+    Binary,
+    BinaryCompressed,
+}
+
+struct Header {
+    fields: Vec<Field>,
+    points: usize,
+    data: DataKind,
+    /// Byte offset of the data section.
+    data_offset: usize,
+    /// Line number of the first data line (for ascii errors).
+    data_line: usize,
+}
+
+fn line_err(line: usize, message: impl Into<String>) -> FormatError {
+    FormatError::Line {
+        line,
+        message: message.into(),
+    }
+}
+
+fn byte_err(offset: usize, message: impl Into<String>) -> FormatError {
+    FormatError::Byte {
+        offset,
+        message: message.into(),
+    }
+}
+
+fn scalar_of(ty: &str, size: usize, line: usize) -> Result<Scalar, FormatError> {
+    Ok(match (ty, size) {
+        ("F", 4) => Scalar::F32,
+        ("F", 8) => Scalar::F64,
+        ("U", 1) => Scalar::U8,
+        ("U", 2) => Scalar::U16,
+        ("U", 4) => Scalar::U32,
+        ("U", 8) => Scalar::U64,
+        ("I", 1) => Scalar::I8,
+        ("I", 2) => Scalar::I16,
+        ("I", 4) => Scalar::I32,
+        ("I", 8) => Scalar::I64,
+        _ => {
+            return Err(line_err(
+                line,
+                format!("unsupported TYPE {ty} with SIZE {size}"),
+            ));
+        }
+    })
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
+    let mut names: Option<Vec<String>> = None;
+    let mut sizes: Option<Vec<usize>> = None;
+    let mut types: Option<Vec<String>> = None;
+    let mut counts: Option<Vec<usize>> = None;
+    let (mut width, mut height, mut points) = (None, None, None);
+    let mut pos = 0;
+    let mut line_no = 0;
+    while pos < bytes.len() {
+        line_no += 1;
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |e| pos + e);
+        let raw = &bytes[pos..end];
+        let next = (end + 1).min(bytes.len());
+        let text = std::str::from_utf8(raw)
+            .map_err(|_| line_err(line_no, "header line is not UTF-8"))?
+            .trim();
+        pos = next;
+        if text.is_empty() || text.starts_with('#') {
+            continue;
+        }
+        let mut it = text.split_whitespace();
+        let key = it.next().unwrap_or_default().to_ascii_uppercase();
+        let rest: Vec<&str> = it.collect();
+        let nums = |rest: &[&str]| -> Result<Vec<usize>, FormatError> {
+            rest.iter()
+                .map(|t| {
+                    t.parse::<usize>()
+                        .map_err(|_| line_err(line_no, format!("{key}: {t:?} is not a count")))
+                })
+                .collect()
+        };
+        match key.as_str() {
+            "VERSION" | "VIEWPOINT" => {}
+            "FIELDS" | "COLUMNS" => names = Some(rest.iter().map(|s| (*s).to_string()).collect()),
+            "SIZE" => sizes = Some(nums(&rest)?),
+            "TYPE" => types = Some(rest.iter().map(|s| s.to_ascii_uppercase()).collect()),
+            "COUNT" => counts = Some(nums(&rest)?),
+            "WIDTH" => width = nums(&rest)?.first().copied(),
+            "HEIGHT" => height = nums(&rest)?.first().copied(),
+            "POINTS" => points = nums(&rest)?.first().copied(),
+            "DATA" => {
+                let data = match rest.first().map(|s| s.to_ascii_lowercase()).as_deref() {
+                    Some("ascii") => DataKind::Ascii,
+                    Some("binary") => DataKind::Binary,
+                    Some("binary_compressed") => DataKind::BinaryCompressed,
+                    other => {
+                        return Err(line_err(line_no, format!("unknown DATA kind {other:?}")));
+                    }
+                };
+                let names = names.ok_or_else(|| line_err(line_no, "no FIELDS line before DATA"))?;
+                let sizes = sizes.ok_or_else(|| line_err(line_no, "no SIZE line before DATA"))?;
+                let types = types.ok_or_else(|| line_err(line_no, "no TYPE line before DATA"))?;
+                let counts = counts.unwrap_or_else(|| vec![1; names.len()]);
+                if sizes.len() != names.len()
+                    || types.len() != names.len()
+                    || counts.len() != names.len()
+                {
+                    return Err(line_err(
+                        line_no,
+                        format!(
+                            "FIELDS has {} entries but SIZE {}, TYPE {}, COUNT {}",
+                            names.len(),
+                            sizes.len(),
+                            types.len(),
+                            counts.len()
+                        ),
+                    ));
+                }
+                let mut fields = Vec::with_capacity(names.len());
+                for (((name, size), ty), count) in
+                    names.into_iter().zip(sizes).zip(types).zip(counts)
+                {
+                    if count == 0 {
+                        return Err(line_err(line_no, format!("field {name} has COUNT 0")));
+                    }
+                    fields.push(Field {
+                        scalar: scalar_of(&ty, size, line_no)?,
+                        name,
+                        count,
+                    });
+                }
+                let wh = match (width, height) {
+                    (Some(w), Some(h)) => Some(
+                        w.checked_mul(h)
+                            .ok_or_else(|| line_err(line_no, "WIDTH * HEIGHT overflows"))?,
+                    ),
+                    (Some(w), None) => Some(w),
+                    _ => None,
+                };
+                let points = match (points, wh) {
+                    (Some(p), Some(wh)) if p != wh => {
+                        return Err(line_err(
+                            line_no,
+                            format!("POINTS {p} but WIDTH * HEIGHT = {wh}"),
+                        ));
+                    }
+                    (Some(p), _) => p,
+                    (None, Some(wh)) => wh,
+                    (None, None) => {
+                        return Err(line_err(line_no, "neither POINTS nor WIDTH given"));
+                    }
+                };
+                return Ok(Header {
+                    fields,
+                    points,
+                    data,
+                    data_offset: pos,
+                    data_line: line_no + 1,
+                });
+            }
+            other => return Err(line_err(line_no, format!("unknown header key {other}"))),
+        }
+    }
+    Err(line_err(line_no, "no DATA line: the header is incomplete"))
+}
+
+/// Where each channel lives in a record: (channel, byte offset in record, scalar, index of the
+/// value among all values of a record for ascii).
+struct Layout {
+    record_size: usize,
+    slots: Vec<(Channel, usize, Scalar, usize, usize)>,
+}
+
+fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
+    let mut offset = 0usize;
+    let mut value_index = 0usize;
+    let mut slots = Vec::new();
+    for (fi, f) in fields.iter().enumerate() {
+        if let Some(ch) = Channel::from_name(&f.name)
+            && !slots
+                .iter()
+                .any(|s: &(Channel, usize, Scalar, usize, usize)| s.0 == ch)
+        {
+            if ch == Channel::Ring && !f.scalar.is_integer() {
+                return Err(FormatError::Unsupported(format!(
+                    "ring field {} is not an integer type",
+                    f.name
+                )));
+            }
+            slots.push((ch, offset, f.scalar, value_index, fi));
+        }
+        offset = f
+            .scalar
+            .size()
+            .checked_mul(f.count)
+            .and_then(|s| s.checked_add(offset))
+            .ok_or_else(|| FormatError::Unsupported("record size overflows".into()))?;
+        value_index += f.count;
+    }
+    for ch in [Channel::X, Channel::Y, Channel::Z] {
+        if !slots.iter().any(|s| s.0 == ch) {
+            return Err(FormatError::Unsupported(
+                format!("no {ch:?} field").to_lowercase(),
+            ));
+        }
+    }
+    Ok(Layout {
+        record_size: offset,
+        slots,
+    })
+}
+
+fn sink_for(layout: &Layout, n: usize) -> ChannelSink {
+    let has = |c| layout.slots.iter().any(|s| s.0 == c);
+    ChannelSink::new(
+        n,
+        has(Channel::Ring),
+        has(Channel::Intensity),
+        has(Channel::Time),
+    )
+}
+
+/// Push one decoded point; `value(slot)` yields the slot's number.
+fn push_point(
+    sink: &mut ChannelSink,
+    layout: &Layout,
+    mut value: impl FnMut(&(Channel, usize, Scalar, usize, usize)) -> Result<f64, FormatError>,
+    at: impl Fn() -> FormatError,
+) -> Result<(), FormatError> {
+    let mut p = [0f32; 3];
+    for s in &layout.slots {
+        let v = value(s)?;
+        match s.0 {
+            Channel::X => p[0] = v as f32,
+            Channel::Y => p[1] = v as f32,
+            Channel::Z => p[2] = v as f32,
+            Channel::Intensity => {
+                if let Some(c) = &mut sink.intensity {
+                    c.push(v as f32);
+                }
+            }
+            Channel::Time => {
+                if let Some(c) = &mut sink.time {
+                    c.push(v as f32);
+                }
+            }
+            Channel::Ring => {
+                let r = ring_value(v).ok_or_else(&at)?;
+                if let Some(c) = &mut sink.ring {
+                    c.push(r);
+                }
+            }
+        }
+    }
+    sink.xyz.push(nalgebra::Point3::new(p[0], p[1], p[2]));
+    Ok(())
+}
+
+/// Decompress PCL's LZF blocks (`binary_compressed`).
+fn lzf_decompress(input: &[u8], out_len: usize, base: usize) -> Result<Vec<u8>, FormatError> {
+    let mut out = Vec::with_capacity(out_len);
+    let mut ip = 0;
+    while ip < input.len() {
+        let ctrl = usize::from(input[ip]);
+        ip += 1;
+        if ctrl < 32 {
+            let n = ctrl + 1;
+            let lit = input
+                .get(ip..ip + n)
+                .ok_or_else(|| byte_err(base + ip, "LZF literal runs past the data"))?;
+            out.extend_from_slice(lit);
+            ip += n;
+        } else {
+            let mut len = ctrl >> 5;
+            if len == 7 {
+                len += usize::from(
+                    *input
+                        .get(ip)
+                        .ok_or_else(|| byte_err(base + ip, "LZF data truncated"))?,
+                );
+                ip += 1;
+            }
+            let lo = usize::from(
+                *input
+                    .get(ip)
+                    .ok_or_else(|| byte_err(base + ip, "LZF data truncated"))?,
+            );
+            ip += 1;
+            let back = ((ctrl & 0x1f) << 8) + lo + 1;
+            let start = out
+                .len()
+                .checked_sub(back)
+                .ok_or_else(|| byte_err(base + ip, "LZF back reference before the start"))?;
+            for k in 0..len + 2 {
+                let b = out[start + k];
+                out.push(b);
+            }
+        }
+        if out.len() > out_len {
+            return Err(byte_err(
+                base + ip,
+                "LZF data decompresses past its stated size",
+            ));
+        }
+    }
+    if out.len() != out_len {
+        return Err(byte_err(
+            base + ip,
+            format!("LZF data gave {} bytes, {} stated", out.len(), out_len),
+        ));
+    }
+    Ok(out)
+}
+
+/// Parse a PCD file held in memory.
+///
+/// # Errors
+/// [`FormatError::Line`] for header and ascii errors, [`FormatError::Byte`] for binary data that
+/// is truncated or malformed, [`FormatError::Unsupported`] for files without x, y, z.
+pub fn parse_pcd(bytes: &[u8]) -> Result<PointCloud, FormatError> {
+    let header = parse_header(bytes)?;
+    let layout = layout(&header.fields)?;
+    let data = &bytes[header.data_offset..];
+    let n = header.points;
+    match header.data {
+        DataKind::Binary => {
+            let need = n.saturating_mul(layout.record_size);
+            if data.len() < need {
+                return Err(byte_err(
+                    header.data_offset + data.len(),
+                    format!(
+                        "binary data holds {} bytes, {n} points need {need}",
+                        data.len()
+                    ),
+                ));
+            }
+            let mut sink = sink_for(&layout, n);
+            for (i, rec) in data.chunks_exact(layout.record_size).take(n).enumerate() {
+                let at = || {
+                    byte_err(
+                        header.data_offset + i * layout.record_size,
+                        "ring value is not a u16",
+                    )
+                };
+                push_point(&mut sink, &layout, |s| Ok(s.2.read(&rec[s.1..], true)), at)?;
+            }
+            sink.finish()
+        }
+        DataKind::BinaryCompressed => {
+            let word = |k: usize| -> Result<usize, FormatError> {
+                let b = data
+                    .get(4 * k..4 * k + 4)
+                    .ok_or_else(|| byte_err(header.data_offset, "compressed header truncated"))?;
+                Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+            };
+            let (csize, usize_) = (word(0)?, word(1)?);
+            let need = n.saturating_mul(layout.record_size);
+            if usize_ != need {
+                return Err(byte_err(
+                    header.data_offset + 4,
+                    format!("uncompressed size {usize_}, {need} expected"),
+                ));
+            }
+            let comp = data
+                .get(8..8 + csize)
+                .ok_or_else(|| byte_err(header.data_offset + 8, "compressed data truncated"))?;
+            let raw = lzf_decompress(comp, usize_, header.data_offset + 8)?;
+            // Column layout: every point's value of field 0, then field 1, ...
+            let mut field_start = Vec::with_capacity(header.fields.len());
+            let mut acc = 0;
+            for f in &header.fields {
+                field_start.push(acc);
+                acc += f.scalar.size() * f.count * n;
+            }
+            let mut sink = sink_for(&layout, n);
+            for i in 0..n {
+                let at = || byte_err(header.data_offset, "ring value is not a u16");
+                push_point(
+                    &mut sink,
+                    &layout,
+                    |s| {
+                        let f = &header.fields[s.4];
+                        let off = field_start[s.4] + i * f.scalar.size() * f.count;
+                        Ok(s.2.read(&raw[off..], true))
+                    },
+                    at,
+                )?;
+            }
+            sink.finish()
+        }
+        DataKind::Ascii => {
+            let text = std::str::from_utf8(data)
+                .map_err(|_| byte_err(header.data_offset, "ascii data is not UTF-8"))?;
+            let values_per_point: usize = header.fields.iter().map(|f| f.count).sum();
+            let mut sink = sink_for(&layout, n.min(data.len() / 2 + 1));
+            let mut tokens: Vec<&str> = Vec::with_capacity(values_per_point);
+            for (k, line) in text.lines().enumerate() {
+                let line_no = header.data_line + k;
+                if sink.xyz.len() == n {
+                    if line.trim().is_empty() {
+                        continue;
+                    }
+                    return Err(line_err(
+                        line_no,
+                        format!("more than the {n} points the header states"),
+                    ));
+                }
+                if line.trim().is_empty() {
+                    continue;
+                }
+                tokens.clear();
+                tokens.extend(line.split_whitespace());
+                if tokens.len() != values_per_point {
+                    return Err(line_err(
+                        line_no,
+                        format!("{} values, {values_per_point} expected", tokens.len()),
+                    ));
+                }
+                let at = || line_err(line_no, "ring value is not a whole number in 0..=65535");
+                push_point(
+                    &mut sink,
+                    &layout,
+                    |s| parse_f64(tokens[s.3], line_no, "value"),
+                    at,
+                )?;
+            }
+            if sink.xyz.len() != n {
+                return Err(line_err(
+                    header.data_line + text.lines().count(),
+                    format!("{} points, the header states {n}", sink.xyz.len()),
+                ));
+            }
+            sink.finish()
+        }
+    }
+}
+
+/// Read a PCD file.
+///
+/// # Errors
+/// [`FormatError::Io`] when the file cannot be read, otherwise as [`parse_pcd`].
+pub fn read_pcd(path: impl AsRef<Path>) -> Result<PointCloud, FormatError> {
+    parse_pcd(&read_file(path.as_ref())?)
+}
+
+/// Write `cloud` as PCD to any writer: x y z as F4, then intensity (F4), ring (U2) and t (F4)
+/// when the cloud has them.
+///
+/// # Errors
+/// [`FormatError::Stream`] when writing fails.
+pub fn write_pcd_to(
+    mut w: impl Write,
+    cloud: &PointCloud,
+    encoding: PcdEncoding,
+) -> Result<(), FormatError> {
+    let mut names = vec!["x", "y", "z"];
+    let mut sizes = vec!["4", "4", "4"];
+    let mut types = vec!["F", "F", "F"];
+    if cloud.intensity().is_some() {
+        names.push("intensity");
+        sizes.push("4");
+        types.push("F");
+    }
+    if cloud.ring().is_some() {
+        names.push("ring");
+        sizes.push("2");
+        types.push("U");
+    }
+    if cloud.time().is_some() {
+        names.push("t");
+        sizes.push("4");
+        types.push("F");
+    }
+    let n = cloud.len();
+    writeln!(w, "# .PCD v0.7 - Point Cloud Data file format")?;
+    writeln!(w, "VERSION 0.7")?;
+    writeln!(w, "FIELDS {}", names.join(" "))?;
+    writeln!(w, "SIZE {}", sizes.join(" "))?;
+    writeln!(w, "TYPE {}", types.join(" "))?;
+    writeln!(w, "COUNT {}", vec!["1"; names.len()].join(" "))?;
+    writeln!(w, "WIDTH {n}")?;
+    writeln!(w, "HEIGHT 1")?;
+    writeln!(w, "VIEWPOINT 0 0 0 1 0 0 0")?;
+    writeln!(w, "POINTS {n}")?;
+    match encoding {
+        PcdEncoding::Binary => {
+            writeln!(w, "DATA binary")?;
+            let mut rec = Vec::with_capacity(22);
+            for (i, p) in cloud.points().iter().enumerate() {
+                rec.clear();
+                for v in [p.x, p.y, p.z] {
+                    rec.extend_from_slice(&v.to_le_bytes());
+                }
+                if let Some(c) = cloud.intensity() {
+                    rec.extend_from_slice(&c[i].to_le_bytes());
+                }
+                if let Some(c) = cloud.ring() {
+                    rec.extend_from_slice(&c[i].to_le_bytes());
+                }
+                if let Some(c) = cloud.time() {
+                    rec.extend_from_slice(&c[i].to_le_bytes());
+                }
+                w.write_all(&rec)?;
+            }
+        }
+        PcdEncoding::Ascii => {
+            writeln!(w, "DATA ascii")?;
+            for (i, p) in cloud.points().iter().enumerate() {
+                // `{}` prints the shortest text that reads back to the same f32.
+                write!(w, "{} {} {}", p.x, p.y, p.z)?;
+                if let Some(c) = cloud.intensity() {
+                    write!(w, " {}", c[i])?;
+                }
+                if let Some(c) = cloud.ring() {
+                    write!(w, " {}", c[i])?;
+                }
+                if let Some(c) = cloud.time() {
+                    write!(w, " {}", c[i])?;
+                }
+                writeln!(w)?;
+            }
+        }
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// Write `cloud` to a PCD file.
+///
+/// # Errors
+/// [`FormatError::Io`] when the file cannot be created, [`FormatError::Stream`] on write errors.
+pub fn write_pcd(
+    path: impl AsRef<Path>,
+    cloud: &PointCloud,
+    encoding: PcdEncoding,
+) -> Result<(), FormatError> {
+    write_pcd_to(create_file(path.as_ref())?, cloud, encoding)
+}

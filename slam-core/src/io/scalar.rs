@@ -1,0 +1,159 @@
+//! Numeric field types shared by the PCD and PLY readers.
+
+use crate::error::FormatError;
+
+/// A scalar type of a binary record field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    /// Size in bytes.
+    pub(crate) fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::I64 | Self::U64 | Self::F64 => 8,
+        }
+    }
+
+    /// Whether the type is an integer type.
+    pub(crate) fn is_integer(self) -> bool {
+        !matches!(self, Self::F32 | Self::F64)
+    }
+
+    /// Decode one value at the start of `b` (at least `size()` bytes) as f64.
+    #[inline]
+    pub(crate) fn read(self, b: &[u8], little_endian: bool) -> f64 {
+        macro_rules! get {
+            ($t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                if little_endian {
+                    <$t>::from_le_bytes(a)
+                } else {
+                    <$t>::from_be_bytes(a)
+                }
+            }};
+        }
+        match self {
+            Self::I8 => f64::from(b[0] as i8),
+            Self::U8 => f64::from(b[0]),
+            Self::I16 => f64::from(get!(i16, 2)),
+            Self::U16 => f64::from(get!(u16, 2)),
+            Self::I32 => f64::from(get!(i32, 4)),
+            Self::U32 => f64::from(get!(u32, 4)),
+            Self::I64 => get!(i64, 8) as f64,
+            Self::U64 => get!(u64, 8) as f64,
+            Self::F32 => f64::from(get!(f32, 4)),
+            Self::F64 => get!(f64, 8),
+        }
+    }
+}
+
+/// Parse a decimal token of a text format, with the line number for errors.
+pub(crate) fn parse_f64(token: &str, line: usize, what: &str) -> Result<f64, FormatError> {
+    token.parse::<f64>().map_err(|_| FormatError::Line {
+        line,
+        message: format!("{what}: {token:?} is not a number"),
+    })
+}
+
+/// A ring value from a decoded number: a whole number in `0..=u16::MAX`.
+pub(crate) fn ring_value(v: f64) -> Option<u16> {
+    (v.fract() == 0.0 && (0.0..=f64::from(u16::MAX)).contains(&v)).then_some(v as u16)
+}
+
+/// Which cloud channel a field name feeds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Channel {
+    X,
+    Y,
+    Z,
+    Intensity,
+    Ring,
+    Time,
+}
+
+impl Channel {
+    /// The channel a field or property of this name holds, if any.
+    pub(crate) fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "x" => Self::X,
+            "y" => Self::Y,
+            "z" => Self::Z,
+            "intensity" | "scalar_intensity" | "reflectance" => Self::Intensity,
+            "ring" | "laser_id" | "channel" => Self::Ring,
+            "t" | "time" | "timestamp" => Self::Time,
+            _ => return None,
+        })
+    }
+}
+
+/// Collects decoded values per channel and builds the cloud.
+#[derive(Default)]
+pub(crate) struct ChannelSink {
+    pub(crate) xyz: Vec<nalgebra::Point3<f32>>,
+    pub(crate) ring: Option<Vec<u16>>,
+    pub(crate) intensity: Option<Vec<f32>>,
+    pub(crate) time: Option<Vec<f32>>,
+}
+
+impl ChannelSink {
+    /// A sink for `n` points with the given optional channels.
+    pub(crate) fn new(n: usize, ring: bool, intensity: bool, time: bool) -> Self {
+        Self {
+            xyz: Vec::with_capacity(n),
+            ring: ring.then(|| Vec::with_capacity(n)),
+            intensity: intensity.then(|| Vec::with_capacity(n)),
+            time: time.then(|| Vec::with_capacity(n)),
+        }
+    }
+
+    /// The finished cloud.
+    pub(crate) fn finish(self) -> Result<crate::PointCloud, FormatError> {
+        let mut c = crate::PointCloud::from_points(self.xyz);
+        let wrap = |e: crate::CloudError| FormatError::Unsupported(e.to_string());
+        if let Some(r) = self.ring {
+            c = c.with_ring(r).map_err(wrap)?;
+        }
+        if let Some(i) = self.intensity {
+            c = c.with_intensity(i).map_err(wrap)?;
+        }
+        if let Some(t) = self.time {
+            c = c.with_time(t).map_err(wrap)?;
+        }
+        Ok(c)
+    }
+}
+
+/// Read a whole file, naming it in the error.
+pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, FormatError> {
+    std::fs::read(path).map_err(|source| FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Create a file for writing, naming it in the error.
+pub(crate) fn create_file(
+    path: &std::path::Path,
+) -> Result<std::io::BufWriter<std::fs::File>, FormatError> {
+    std::fs::File::create(path)
+        .map(std::io::BufWriter::new)
+        .map_err(|source| FormatError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+}
