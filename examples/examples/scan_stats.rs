@@ -18,7 +18,11 @@ fn default_scan() -> PathBuf {
 }
 
 fn read_any(path: &Path) -> Result<PointCloud> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     let cloud = match ext.as_str() {
         "pcd" => read_pcd(path)?,
         "ply" => read_ply(path)?,
@@ -29,7 +33,9 @@ fn read_any(path: &Path) -> Result<PointCloud> {
 }
 
 fn main() -> Result<()> {
-    let path = std::env::args_os().nth(1).map_or_else(default_scan, PathBuf::from);
+    let path = std::env::args_os()
+        .nth(1)
+        .map_or_else(default_scan, PathBuf::from);
     let started = Instant::now();
     let mut cloud = read_any(&path).with_context(|| format!("reading {}", path.display()))?;
     let read_ms = started.elapsed().as_secs_f64() * 1e3;
