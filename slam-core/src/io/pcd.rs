@@ -79,12 +79,85 @@ fn scalar_of(ty: &str, size: usize, line: usize) -> Result<Scalar, FormatError> 
     })
 }
 
+/// Header values as read, before they are checked against each other.
+#[derive(Default)]
+struct RawHeader {
+    names: Option<Vec<String>>,
+    sizes: Option<Vec<usize>>,
+    types: Option<Vec<String>>,
+    counts: Option<Vec<usize>>,
+    width: Option<usize>,
+    height: Option<usize>,
+    points: Option<usize>,
+}
+
+impl RawHeader {
+    /// Check the header at its `DATA` line (`line_no`); the data starts at byte `pos`.
+    fn finish(self, data: DataKind, pos: usize, line_no: usize) -> Result<Header, FormatError> {
+        let names = self
+            .names
+            .ok_or_else(|| line_err(line_no, "no FIELDS line before DATA"))?;
+        let sizes = self
+            .sizes
+            .ok_or_else(|| line_err(line_no, "no SIZE line before DATA"))?;
+        let types = self
+            .types
+            .ok_or_else(|| line_err(line_no, "no TYPE line before DATA"))?;
+        let counts = self.counts.unwrap_or_else(|| vec![1; names.len()]);
+        if sizes.len() != names.len() || types.len() != names.len() || counts.len() != names.len() {
+            return Err(line_err(
+                line_no,
+                format!(
+                    "FIELDS has {} entries but SIZE {}, TYPE {}, COUNT {}",
+                    names.len(),
+                    sizes.len(),
+                    types.len(),
+                    counts.len()
+                ),
+            ));
+        }
+        let mut fields = Vec::with_capacity(names.len());
+        for (((name, size), ty), count) in names.into_iter().zip(sizes).zip(types).zip(counts) {
+            if count == 0 {
+                return Err(line_err(line_no, format!("field {name} has COUNT 0")));
+            }
+            fields.push(Field {
+                scalar: scalar_of(&ty, size, line_no)?,
+                name,
+                count,
+            });
+        }
+        let wh = match (self.width, self.height) {
+            (Some(w), Some(h)) => Some(
+                w.checked_mul(h)
+                    .ok_or_else(|| line_err(line_no, "WIDTH * HEIGHT overflows"))?,
+            ),
+            (Some(w), None) => Some(w),
+            _ => None,
+        };
+        let points = match (self.points, wh) {
+            (Some(p), Some(wh)) if p != wh => {
+                return Err(line_err(
+                    line_no,
+                    format!("POINTS {p} but WIDTH * HEIGHT = {wh}"),
+                ));
+            }
+            (Some(p), _) => p,
+            (None, Some(wh)) => wh,
+            (None, None) => return Err(line_err(line_no, "neither POINTS nor WIDTH given")),
+        };
+        Ok(Header {
+            fields,
+            points,
+            data,
+            data_offset: pos,
+            data_line: line_no + 1,
+        })
+    }
+}
+
 fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
-    let mut names: Option<Vec<String>> = None;
-    let mut sizes: Option<Vec<usize>> = None;
-    let mut types: Option<Vec<String>> = None;
-    let mut counts: Option<Vec<usize>> = None;
-    let (mut width, mut height, mut points) = (None, None, None);
+    let mut raw = RawHeader::default();
     let mut pos = 0;
     let mut line_no = 0;
     while pos < bytes.len() {
@@ -93,12 +166,10 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
             .iter()
             .position(|&b| b == b'\n')
             .map_or(bytes.len(), |e| pos + e);
-        let raw = &bytes[pos..end];
-        let next = (end + 1).min(bytes.len());
-        let text = std::str::from_utf8(raw)
+        let text = std::str::from_utf8(&bytes[pos..end])
             .map_err(|_| line_err(line_no, "header line is not UTF-8"))?
             .trim();
-        pos = next;
+        pos = (end + 1).min(bytes.len());
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
@@ -115,82 +186,23 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
         };
         match key.as_str() {
             "VERSION" | "VIEWPOINT" => {}
-            "FIELDS" | "COLUMNS" => names = Some(rest.iter().map(|s| (*s).to_string()).collect()),
-            "SIZE" => sizes = Some(nums(&rest)?),
-            "TYPE" => types = Some(rest.iter().map(|s| s.to_ascii_uppercase()).collect()),
-            "COUNT" => counts = Some(nums(&rest)?),
-            "WIDTH" => width = nums(&rest)?.first().copied(),
-            "HEIGHT" => height = nums(&rest)?.first().copied(),
-            "POINTS" => points = nums(&rest)?.first().copied(),
+            "FIELDS" | "COLUMNS" => {
+                raw.names = Some(rest.iter().map(|s| (*s).to_string()).collect());
+            }
+            "SIZE" => raw.sizes = Some(nums(&rest)?),
+            "TYPE" => raw.types = Some(rest.iter().map(|s| s.to_ascii_uppercase()).collect()),
+            "COUNT" => raw.counts = Some(nums(&rest)?),
+            "WIDTH" => raw.width = nums(&rest)?.first().copied(),
+            "HEIGHT" => raw.height = nums(&rest)?.first().copied(),
+            "POINTS" => raw.points = nums(&rest)?.first().copied(),
             "DATA" => {
                 let data = match rest.first().map(|s| s.to_ascii_lowercase()).as_deref() {
                     Some("ascii") => DataKind::Ascii,
                     Some("binary") => DataKind::Binary,
                     Some("binary_compressed") => DataKind::BinaryCompressed,
-                    other => {
-                        return Err(line_err(line_no, format!("unknown DATA kind {other:?}")));
-                    }
+                    other => return Err(line_err(line_no, format!("unknown DATA kind {other:?}"))),
                 };
-                let names = names.ok_or_else(|| line_err(line_no, "no FIELDS line before DATA"))?;
-                let sizes = sizes.ok_or_else(|| line_err(line_no, "no SIZE line before DATA"))?;
-                let types = types.ok_or_else(|| line_err(line_no, "no TYPE line before DATA"))?;
-                let counts = counts.unwrap_or_else(|| vec![1; names.len()]);
-                if sizes.len() != names.len()
-                    || types.len() != names.len()
-                    || counts.len() != names.len()
-                {
-                    return Err(line_err(
-                        line_no,
-                        format!(
-                            "FIELDS has {} entries but SIZE {}, TYPE {}, COUNT {}",
-                            names.len(),
-                            sizes.len(),
-                            types.len(),
-                            counts.len()
-                        ),
-                    ));
-                }
-                let mut fields = Vec::with_capacity(names.len());
-                for (((name, size), ty), count) in
-                    names.into_iter().zip(sizes).zip(types).zip(counts)
-                {
-                    if count == 0 {
-                        return Err(line_err(line_no, format!("field {name} has COUNT 0")));
-                    }
-                    fields.push(Field {
-                        scalar: scalar_of(&ty, size, line_no)?,
-                        name,
-                        count,
-                    });
-                }
-                let wh = match (width, height) {
-                    (Some(w), Some(h)) => Some(
-                        w.checked_mul(h)
-                            .ok_or_else(|| line_err(line_no, "WIDTH * HEIGHT overflows"))?,
-                    ),
-                    (Some(w), None) => Some(w),
-                    _ => None,
-                };
-                let points = match (points, wh) {
-                    (Some(p), Some(wh)) if p != wh => {
-                        return Err(line_err(
-                            line_no,
-                            format!("POINTS {p} but WIDTH * HEIGHT = {wh}"),
-                        ));
-                    }
-                    (Some(p), _) => p,
-                    (None, Some(wh)) => wh,
-                    (None, None) => {
-                        return Err(line_err(line_no, "neither POINTS nor WIDTH given"));
-                    }
-                };
-                return Ok(Header {
-                    fields,
-                    points,
-                    data,
-                    data_offset: pos,
-                    data_line: line_no + 1,
-                });
+                return raw.finish(data, pos, line_no);
             }
             other => return Err(line_err(line_no, format!("unknown header key {other}"))),
         }
@@ -355,118 +367,130 @@ pub fn parse_pcd(bytes: &[u8]) -> Result<PointCloud, FormatError> {
     let header = parse_header(bytes)?;
     let layout = layout(&header.fields)?;
     let data = &bytes[header.data_offset..];
-    let n = header.points;
     match header.data {
-        DataKind::Binary => {
-            let need = n.saturating_mul(layout.record_size);
-            if data.len() < need {
-                return Err(byte_err(
-                    header.data_offset + data.len(),
-                    format!(
-                        "binary data holds {} bytes, {n} points need {need}",
-                        data.len()
-                    ),
-                ));
-            }
-            let mut sink = sink_for(&layout, n);
-            for (i, rec) in data.chunks_exact(layout.record_size).take(n).enumerate() {
-                let at = || {
-                    byte_err(
-                        header.data_offset + i * layout.record_size,
-                        "ring value is not a u16",
-                    )
-                };
-                push_point(&mut sink, &layout, |s| Ok(s.2.read(&rec[s.1..], true)), at)?;
-            }
-            sink.finish()
-        }
-        DataKind::BinaryCompressed => {
-            let word = |k: usize| -> Result<usize, FormatError> {
-                let b = data
-                    .get(4 * k..4 * k + 4)
-                    .ok_or_else(|| byte_err(header.data_offset, "compressed header truncated"))?;
-                Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
-            };
-            let (csize, usize_) = (word(0)?, word(1)?);
-            let need = n.saturating_mul(layout.record_size);
-            if usize_ != need {
-                return Err(byte_err(
-                    header.data_offset + 4,
-                    format!("uncompressed size {usize_}, {need} expected"),
-                ));
-            }
-            let comp = data
-                .get(8..8 + csize)
-                .ok_or_else(|| byte_err(header.data_offset + 8, "compressed data truncated"))?;
-            let raw = lzf_decompress(comp, usize_, header.data_offset + 8)?;
-            // Column layout: every point's value of field 0, then field 1, ...
-            let mut field_start = Vec::with_capacity(header.fields.len());
-            let mut acc = 0;
-            for f in &header.fields {
-                field_start.push(acc);
-                acc += f.scalar.size() * f.count * n;
-            }
-            let mut sink = sink_for(&layout, n);
-            for i in 0..n {
-                let at = || byte_err(header.data_offset, "ring value is not a u16");
-                push_point(
-                    &mut sink,
-                    &layout,
-                    |s| {
-                        let f = &header.fields[s.4];
-                        let off = field_start[s.4] + i * f.scalar.size() * f.count;
-                        Ok(s.2.read(&raw[off..], true))
-                    },
-                    at,
-                )?;
-            }
-            sink.finish()
-        }
-        DataKind::Ascii => {
-            let text = std::str::from_utf8(data)
-                .map_err(|_| byte_err(header.data_offset, "ascii data is not UTF-8"))?;
-            let values_per_point: usize = header.fields.iter().map(|f| f.count).sum();
-            let mut sink = sink_for(&layout, n.min(data.len() / 2 + 1));
-            let mut tokens: Vec<&str> = Vec::with_capacity(values_per_point);
-            for (k, line) in text.lines().enumerate() {
-                let line_no = header.data_line + k;
-                if sink.xyz.len() == n {
-                    if line.trim().is_empty() {
-                        continue;
-                    }
-                    return Err(line_err(
-                        line_no,
-                        format!("more than the {n} points the header states"),
-                    ));
-                }
-                if line.trim().is_empty() {
-                    continue;
-                }
-                tokens.clear();
-                tokens.extend(line.split_whitespace());
-                if tokens.len() != values_per_point {
-                    return Err(line_err(
-                        line_no,
-                        format!("{} values, {values_per_point} expected", tokens.len()),
-                    ));
-                }
-                let at = || line_err(line_no, "ring value is not a whole number in 0..=65535");
-                push_point(
-                    &mut sink,
-                    &layout,
-                    |s| parse_f64(tokens[s.3], line_no, "value"),
-                    at,
-                )?;
-            }
-            if sink.xyz.len() != n {
-                return Err(line_err(
-                    header.data_line + text.lines().count(),
-                    format!("{} points, the header states {n}", sink.xyz.len()),
-                ));
-            }
-            sink.finish()
-        }
+        DataKind::Binary => parse_binary(&header, &layout, data),
+        DataKind::BinaryCompressed => parse_compressed(&header, &layout, data),
+        DataKind::Ascii => parse_ascii(&header, &layout, data),
     }
+}
+
+fn parse_binary(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointCloud, FormatError> {
+    let n = header.points;
+    let need = n.saturating_mul(layout.record_size);
+    if data.len() < need {
+        return Err(byte_err(
+            header.data_offset + data.len(),
+            format!(
+                "binary data holds {} bytes, {n} points need {need}",
+                data.len()
+            ),
+        ));
+    }
+    let mut sink = sink_for(layout, n);
+    for (i, rec) in data.chunks_exact(layout.record_size).take(n).enumerate() {
+        let at = || {
+            byte_err(
+                header.data_offset + i * layout.record_size,
+                "ring value is not a u16",
+            )
+        };
+        push_point(&mut sink, layout, |s| Ok(s.2.read(&rec[s.1..], true)), at)?;
+    }
+    sink.finish()
+}
+
+fn parse_compressed(
+    header: &Header,
+    layout: &Layout,
+    data: &[u8],
+) -> Result<PointCloud, FormatError> {
+    let n = header.points;
+    let word = |k: usize| -> Result<usize, FormatError> {
+        let b = data
+            .get(4 * k..4 * k + 4)
+            .ok_or_else(|| byte_err(header.data_offset, "compressed header truncated"))?;
+        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    let (csize, usize_) = (word(0)?, word(1)?);
+    let need = n.saturating_mul(layout.record_size);
+    if usize_ != need {
+        return Err(byte_err(
+            header.data_offset + 4,
+            format!("uncompressed size {usize_}, {need} expected"),
+        ));
+    }
+    let comp = data
+        .get(8..8 + csize)
+        .ok_or_else(|| byte_err(header.data_offset + 8, "compressed data truncated"))?;
+    let raw = lzf_decompress(comp, usize_, header.data_offset + 8)?;
+    // Column layout: every point's value of field 0, then field 1, ...
+    let mut field_start = Vec::with_capacity(header.fields.len());
+    let mut acc = 0;
+    for f in &header.fields {
+        field_start.push(acc);
+        acc += f.scalar.size() * f.count * n;
+    }
+    let mut sink = sink_for(layout, n);
+    for i in 0..n {
+        let at = || byte_err(header.data_offset, "ring value is not a u16");
+        push_point(
+            &mut sink,
+            layout,
+            |s| {
+                let f = &header.fields[s.4];
+                let off = field_start[s.4] + i * f.scalar.size() * f.count;
+                Ok(s.2.read(&raw[off..], true))
+            },
+            at,
+        )?;
+    }
+    sink.finish()
+}
+
+fn parse_ascii(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointCloud, FormatError> {
+    let n = header.points;
+    let text = std::str::from_utf8(data)
+        .map_err(|_| byte_err(header.data_offset, "ascii data is not UTF-8"))?;
+    let values_per_point: usize = header.fields.iter().map(|f| f.count).sum();
+    let mut sink = sink_for(layout, n.min(data.len() / 2 + 1));
+    let mut tokens: Vec<&str> = Vec::with_capacity(values_per_point);
+    for (k, line) in text.lines().enumerate() {
+        let line_no = header.data_line + k;
+        if sink.xyz.len() == n {
+            if line.trim().is_empty() {
+                continue;
+            }
+            return Err(line_err(
+                line_no,
+                format!("more than the {n} points the header states"),
+            ));
+        }
+        if line.trim().is_empty() {
+            continue;
+        }
+        tokens.clear();
+        tokens.extend(line.split_whitespace());
+        if tokens.len() != values_per_point {
+            return Err(line_err(
+                line_no,
+                format!("{} values, {values_per_point} expected", tokens.len()),
+            ));
+        }
+        let at = || line_err(line_no, "ring value is not a whole number in 0..=65535");
+        push_point(
+            &mut sink,
+            layout,
+            |s| parse_f64(tokens[s.3], line_no, "value"),
+            at,
+        )?;
+    }
+    if sink.xyz.len() != n {
+        return Err(line_err(
+            header.data_line + text.lines().count(),
+            format!("{} points, the header states {n}", sink.xyz.len()),
+        ));
+    }
+    sink.finish()
 }
 
 /// Read a PCD file.

@@ -309,7 +309,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
                         };
                         match p {
                             Property::Scalar { .. } => {
-                                values.push(parse_f64(next()?, line_no, "value")?)
+                                values.push(parse_f64(next()?, line_no, "value")?);
                             }
                             Property::List { .. } => {
                                 let n = parse_f64(next()?, line_no, "list length")?;
