@@ -1,1 +1,62 @@
-//! Grid path planners (Dijkstra, A*, JPS, JPS+) and Moving AI benchmark IO for spot-nav.
+//! # pathfind
+//!
+//! Shortest paths on spot-nav's bit-packed occupancy grid ([`slam_core::BitGrid`]) under the
+//! Moving AI movement model: 8-connected, diagonal cost sqrt(2), no corner cutting.
+//!
+//! - [`Dijkstra`] and [`AStar`] (octile heuristic): the references.
+//! - [`JumpPointSearch`]: online JPS (Harabor & Grastien, AAAI 2011) with pruning rules derived
+//!   for no corner cutting.
+//! - [`JumpPointSearchPlus`]: JPS with 64-cell word scans (Harabor & Grastien, ICAPS 2014), or
+//!   with JPS+ jump tables precomputed per grid.
+//! - [`filter_path`]: the thesis' path filter, keeping only the waypoints a straight
+//!   collision-free segment cannot skip ([`line_of_sight`] walks every touched cell).
+//! - [`movingai`]: readers for the Moving AI `.map` and `.scen` benchmark files.
+//!
+//! Every planner labels the grid's connected components at construction, so an unreachable goal
+//! is answered without a search; [`PlanError::NoPath`](slam_core::PlanError::NoPath) is an answer,
+//! not a failure.
+//!
+//! ```
+//! use pathfind::{AStar, JumpPointSearchPlus, filter_path};
+//! use slam_core::{BitGrid, Cell, Planner};
+//!
+//! // A 20 x 10 room with a wall that has a gap at the top.
+//! let grid = BitGrid::from_fn(20, 10, |x, y| x == 10 && y < 8)?;
+//! let (start, goal) = (Cell::new(2, 2), Cell::new(17, 2));
+//! let mut jps = JumpPointSearchPlus::with_jump_tables(&grid)?;
+//! let path = jps.plan(start, goal)?;
+//! let reference = AStar::new(&grid).plan(start, goal)?;
+//! assert!((path.length - reference.length).abs() < 1e-9);
+//! let filtered = filter_path(&grid, &path);
+//! assert!(filtered.waypoints.len() <= 4);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! When not to use it: for any-angle optimal paths (Theta*, Anya) or weighted terrain costs, these
+//! planners give grid-optimal paths on a binary grid only; the filter shortens them but does not
+//! make them any-angle optimal.
+
+mod astar;
+mod best_first;
+mod block_scan;
+mod components;
+mod dijkstra;
+mod error;
+mod jps;
+mod jps_plus;
+mod jump_search;
+mod jump_tables;
+mod line_of_sight;
+pub mod movement;
+pub mod movingai;
+mod path_filter;
+mod search_space;
+
+pub use astar::AStar;
+pub use components::Components;
+pub use dijkstra::Dijkstra;
+pub use error::PathfindError;
+pub use jps::JumpPointSearch;
+pub use jps_plus::JumpPointSearchPlus;
+pub use line_of_sight::{line_of_sight, supercover_cells};
+pub use path_filter::{FilteredPath, filter_path};

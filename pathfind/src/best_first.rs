@@ -1,0 +1,46 @@
+//! The cell-by-cell best-first search behind [`Dijkstra`](crate::Dijkstra) and
+//! [`AStar`](crate::AStar).
+
+use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
+
+use crate::components::Components;
+use crate::movement::{DIRECTIONS, SQRT_2, can_step};
+use crate::search_space::{NO_DIRECTION, SearchSpace};
+
+/// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
+/// `g + heuristic(cell)`.
+pub(crate) fn best_first(
+    grid: &BitGrid,
+    components: &Components,
+    space: &mut SearchSpace,
+    start: Cell,
+    goal: Cell,
+    heuristic: impl Fn(Cell) -> f64,
+) -> Result<GridPath, PlanError> {
+    validate_endpoints(grid, start, goal)?;
+    if !components.connected(start, goal) {
+        return Err(PlanError::NoPath);
+    }
+    space.reset();
+    let (s, t) = (space.index(start), space.index(goal));
+    space.relax(s, 0.0, heuristic(start), s, NO_DIRECTION);
+    let mut expanded = 0;
+    while let Some((i, g, _)) = space.pop() {
+        expanded += 1;
+        if i == t {
+            return Ok(space.path(s, t, expanded));
+        }
+        let c = space.cell(i);
+        let (x, y) = (i64::from(c.x), i64::from(c.y));
+        for (d, &(dx, dy)) in DIRECTIONS.iter().enumerate() {
+            let (dx, dy) = (i64::from(dx), i64::from(dy));
+            if !can_step(grid, x, y, dx, dy) {
+                continue;
+            }
+            let n = Cell::new((x + dx) as u32, (y + dy) as u32);
+            let cost = if dx != 0 && dy != 0 { SQRT_2 } else { 1.0 };
+            space.relax(space.index(n), g + cost, heuristic(n), i, d as u8);
+        }
+    }
+    Err(PlanError::NoPath)
+}

@@ -1,0 +1,38 @@
+//! Errors of the pathfind crate (planning itself reports [`slam_core::PlanError`]).
+
+use thiserror::Error;
+
+/// Errors building planners and reading Moving AI files.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum PathfindError {
+    /// JPS+ tables store distances as `i16`.
+    #[error("a {width}x{height} grid is too large for jump tables (at most {max_side} per side)")]
+    GridTooLargeForTables {
+        /// Grid width.
+        width: u32,
+        /// Grid height.
+        height: u32,
+        /// The limit.
+        max_side: u32,
+    },
+    /// A Moving AI file could not be parsed.
+    #[error("line {line}: {message}")]
+    Parse {
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The grid could not be built.
+    #[error(transparent)]
+    Grid(#[from] slam_core::GridError),
+}

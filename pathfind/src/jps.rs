@@ -1,0 +1,98 @@
+//! Online Jump Point Search (Harabor & Grastien 2011), adapted to no corner cutting, stepping one
+//! cell at a time.
+
+use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
+
+use crate::components::Components;
+use crate::jump_search::{Jumper, jump_search};
+use crate::movement::{DIRECTIONS, can_step, free};
+use crate::search_space::SearchSpace;
+
+/// Jump Point Search: A* over jump points, found by scanning the grid one cell at a time. No
+/// preprocessing beyond connected components; see
+/// [`JumpPointSearchPlus`](crate::JumpPointSearchPlus) for word-at-a-time scans and jump tables.
+pub struct JumpPointSearch<'g> {
+    grid: &'g BitGrid,
+    components: Components,
+    space: SearchSpace,
+}
+
+impl<'g> JumpPointSearch<'g> {
+    /// A planner for `grid` (labels its connected components once).
+    #[must_use]
+    pub fn new(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            components: Components::new(grid),
+            space: SearchSpace::new(grid.width(), grid.height()),
+        }
+    }
+}
+
+struct CellJumper<'g>(&'g BitGrid);
+
+impl CellJumper<'_> {
+    /// Straight jump: the first cell with a forced side, the goal, or `None` at a wall.
+    fn straight(&self, mut x: i64, mut y: i64, dx: i64, dy: i64, goal: Cell) -> Option<(i64, i64)> {
+        let g = self.0;
+        loop {
+            x += dx;
+            y += dy;
+            if !free(g, x, y) {
+                return None;
+            }
+            if x == i64::from(goal.x) && y == i64::from(goal.y) {
+                return Some((x, y));
+            }
+            let forced = if dx != 0 {
+                (free(g, x, y + 1) && !free(g, x - dx, y + 1))
+                    || (free(g, x, y - 1) && !free(g, x - dx, y - 1))
+            } else {
+                (free(g, x + 1, y) && !free(g, x + 1, y - dy))
+                    || (free(g, x - 1, y) && !free(g, x - 1, y - dy))
+            };
+            if forced {
+                return Some((x, y));
+            }
+        }
+    }
+}
+
+impl Jumper for CellJumper<'_> {
+    fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell> {
+        let (dx, dy) = DIRECTIONS[d as usize];
+        let (dx, dy) = (i64::from(dx), i64::from(dy));
+        let (mut x, mut y) = (i64::from(c.x), i64::from(c.y));
+        if dx == 0 || dy == 0 {
+            return self
+                .straight(x, y, dx, dy, goal)
+                .map(|(x, y)| Cell::new(x as u32, y as u32));
+        }
+        loop {
+            if !can_step(self.0, x, y, dx, dy) {
+                return None;
+            }
+            x += dx;
+            y += dy;
+            if (x == i64::from(goal.x) && y == i64::from(goal.y))
+                || self.straight(x, y, dx, 0, goal).is_some()
+                || self.straight(x, y, 0, dy, goal).is_some()
+            {
+                return Some(Cell::new(x as u32, y as u32));
+            }
+        }
+    }
+}
+
+impl Planner for JumpPointSearch<'_> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+        jump_search(
+            self.grid,
+            &self.components,
+            &mut self.space,
+            &CellJumper(self.grid),
+            start,
+            goal,
+        )
+    }
+}

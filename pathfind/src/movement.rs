@@ -1,0 +1,93 @@
+//! The movement model shared by every planner: 8-connected, straight cost 1, diagonal cost
+//! sqrt(2), no corner cutting (a diagonal step needs both orthogonal neighbours free).
+
+use slam_core::{BitGrid, Cell};
+
+/// sqrt(2), the cost of a diagonal step.
+pub const SQRT_2: f64 = std::f64::consts::SQRT_2;
+
+/// The eight step directions `(dx, dy)`: four straight, then four diagonal.
+pub const DIRECTIONS: [(i32, i32); 8] = [
+    (1, 0),
+    (-1, 0),
+    (0, 1),
+    (0, -1),
+    (1, 1),
+    (1, -1),
+    (-1, 1),
+    (-1, -1),
+];
+
+/// Octile distance: the exact cost between two cells on an empty grid (an admissible and
+/// consistent A* heuristic).
+#[inline]
+#[must_use]
+pub fn octile(a: Cell, b: Cell) -> f64 {
+    let dx = a.x.abs_diff(b.x);
+    let dy = a.y.abs_diff(b.y);
+    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+    f64::from(hi - lo) + SQRT_2 * f64::from(lo)
+}
+
+/// Whether `(x, y)` is a free cell of `grid` (signed coordinates; off-grid is not free).
+#[inline]
+#[must_use]
+pub fn free(grid: &BitGrid, x: i64, y: i64) -> bool {
+    grid.is_free_signed(x, y)
+}
+
+/// Whether a single step from free cell `(x, y)` by `(dx, dy)` is legal.
+#[inline]
+#[must_use]
+pub fn can_step(grid: &BitGrid, x: i64, y: i64, dx: i64, dy: i64) -> bool {
+    if dx != 0 && dy != 0 {
+        free(grid, x + dx, y) && free(grid, x, y + dy) && free(grid, x + dx, y + dy)
+    } else {
+        free(grid, x + dx, y + dy)
+    }
+}
+
+/// Cost of the cell path `cells` (consecutive cells joined by straight or diagonal runs).
+#[must_use]
+pub fn path_cost(cells: &[Cell]) -> f64 {
+    cells.windows(2).map(|w| octile(w[0], w[1])).sum()
+}
+
+/// Why a path is not valid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathViolation {
+    /// The path is empty.
+    Empty,
+    /// A cell is off the grid or blocked.
+    BlockedCell(Cell),
+    /// Two consecutive cells are not neighbours.
+    NotAdjacent(Cell, Cell),
+    /// A diagonal step cuts a blocked corner.
+    CutsCorner(Cell, Cell),
+}
+
+/// Check a dense path (every cell listed): free cells, 8-connected steps, no corner cutting.
+///
+/// # Errors
+/// The first [`PathViolation`] found.
+pub fn validate_dense_path(grid: &BitGrid, cells: &[Cell]) -> Result<(), PathViolation> {
+    if cells.is_empty() {
+        return Err(PathViolation::Empty);
+    }
+    for &c in cells {
+        if grid.is_blocked(c) {
+            return Err(PathViolation::BlockedCell(c));
+        }
+    }
+    for w in cells.windows(2) {
+        let dx = i64::from(w[1].x) - i64::from(w[0].x);
+        let dy = i64::from(w[1].y) - i64::from(w[0].y);
+        if dx.abs() > 1 || dy.abs() > 1 || (dx == 0 && dy == 0) {
+            return Err(PathViolation::NotAdjacent(w[0], w[1]));
+        }
+        if !can_step(grid, i64::from(w[0].x), i64::from(w[0].y), dx, dy) {
+            return Err(PathViolation::CutsCorner(w[0], w[1]));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,174 @@
+//! Every planner against Dijkstra on random grids, and every returned path checked cell by cell.
+#![allow(clippy::unwrap_used)]
+
+use pathfind::movement::{path_cost, validate_dense_path};
+use pathfind::{
+    AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus, filter_path, line_of_sight,
+    supercover_cells,
+};
+use proptest::prelude::*;
+use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
+
+/// A random grid: `density` percent blocked, from a seeded xorshift.
+fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
+    let mut s = seed | 1;
+    BitGrid::from_fn(w, h, |_, _| {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s % 100) < u64::from(density)
+    })
+    .unwrap()
+}
+
+fn free_cell(grid: &BitGrid, pick: u64) -> Option<Cell> {
+    let n = u64::from(grid.width()) * u64::from(grid.height());
+    (0..n)
+        .map(|k| (pick + k * 7919) % n)
+        .map(|i| {
+            Cell::new(
+                (i % u64::from(grid.width())) as u32,
+                (i / u64::from(grid.width())) as u32,
+            )
+        })
+        .find(|&c| !grid.is_blocked(c))
+}
+
+fn check(
+    grid: &BitGrid,
+    got: &Result<GridPath, PlanError>,
+    want: &Result<GridPath, PlanError>,
+    start: Cell,
+    goal: Cell,
+    name: &str,
+) {
+    match (got, want) {
+        (Ok(p), Ok(r)) => {
+            assert!(
+                (p.length - r.length).abs() < 1e-9,
+                "{name}: {} vs Dijkstra {} from {start:?} to {goal:?}",
+                p.length,
+                r.length
+            );
+            let dense = p.expand();
+            assert_eq!(dense.first(), Some(&start));
+            assert_eq!(dense.last(), Some(&goal));
+            validate_dense_path(grid, &dense)
+                .unwrap_or_else(|e| panic!("{name}: invalid path {e:?}"));
+            assert!(
+                (path_cost(&dense) - p.length).abs() < 1e-9,
+                "{name}: reported length differs from the path's"
+            );
+            let f = filter_path(grid, p);
+            assert_eq!(f.waypoints.first(), Some(&start));
+            assert_eq!(f.waypoints.last(), Some(&goal));
+            assert!(f.length <= p.length + 1e-9);
+            for w in f.waypoints.windows(2) {
+                assert!(line_of_sight(grid, w[0], w[1]));
+                for (x, y) in supercover_cells(w[0], w[1]) {
+                    assert!(
+                        grid.is_free_signed(x, y),
+                        "{name}: filtered segment crosses ({x}, {y})"
+                    );
+                }
+            }
+        }
+        (Err(PlanError::NoPath), Err(PlanError::NoPath)) => {}
+        _ => panic!("{name}: {got:?} but Dijkstra says {want:?}"),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn planners_match_dijkstra(
+        w in 1u32..200, h in 1u32..200, density in 0u32..=45, seed in any::<u64>(),
+        picks in proptest::collection::vec((any::<u64>(), any::<u64>()), 1..6),
+    ) {
+        let grid = random_grid(w, h, density, seed);
+        let mut dijkstra = Dijkstra::new(&grid);
+        let mut astar = AStar::new(&grid);
+        let mut jps = JumpPointSearch::new(&grid);
+        let mut blocks = JumpPointSearchPlus::new(&grid);
+        let mut tables = JumpPointSearchPlus::with_jump_tables(&grid).unwrap();
+        for (a, b) in picks {
+            let (Some(start), Some(goal)) = (free_cell(&grid, a), free_cell(&grid, b)) else { continue };
+            for goal in [goal, start] {
+                let want = dijkstra.plan(start, goal);
+                check(&grid, &astar.plan(start, goal), &want, start, goal, "A*");
+                check(&grid, &jps.plan(start, goal), &want, start, goal, "JPS");
+                check(&grid, &blocks.plan(start, goal), &want, start, goal, "JPS blocks");
+                check(&grid, &tables.plan(start, goal), &want, start, goal, "JPS+ tables");
+                if let Ok(p) = &want {
+                    validate_dense_path(&grid, &p.cells).unwrap();
+                }
+            }
+        }
+    }
+}
+
+/// Thin diagonal walls: the classic case where corner cutting or Bresenham would leak.
+#[test]
+fn diagonal_wall_blocks_everything() {
+    // Cells with x == y are blocked: the two triangles touch only at corners.
+    let grid = BitGrid::from_fn(40, 40, |x, y| x == y).unwrap();
+    let (a, b) = (Cell::new(5, 0), Cell::new(0, 5));
+    for r in [
+        Dijkstra::new(&grid).plan(a, b),
+        AStar::new(&grid).plan(a, b),
+        JumpPointSearch::new(&grid).plan(a, b),
+        JumpPointSearchPlus::new(&grid).plan(a, b),
+        JumpPointSearchPlus::with_jump_tables(&grid)
+            .unwrap()
+            .plan(a, b),
+    ] {
+        assert_eq!(r, Err(PlanError::NoPath));
+    }
+    // A blocked anti-diagonal pair: the segment between (0, 0) and (2, 2) passes the corner
+    // between (1, 0)/(0, 1)-style blocks and must be refused.
+    let pinch = BitGrid::from_fn(3, 3, |x, y| (x, y) == (2, 1) || (x, y) == (1, 2)).unwrap();
+    assert!(!line_of_sight(&pinch, Cell::new(1, 1), Cell::new(2, 2)));
+    assert!(line_of_sight(&pinch, Cell::new(0, 0), Cell::new(1, 1)));
+}
+
+#[test]
+fn bad_endpoints_are_errors() {
+    let grid = BitGrid::from_fn(10, 10, |x, _| x == 5).unwrap();
+    let mut p = JumpPointSearchPlus::new(&grid);
+    assert!(matches!(
+        p.plan(Cell::new(5, 0), Cell::new(0, 0)),
+        Err(PlanError::BlockedCell { which: "start", .. })
+    ));
+    assert!(matches!(
+        p.plan(Cell::new(0, 0), Cell::new(10, 0)),
+        Err(PlanError::OutOfBounds { which: "goal", .. })
+    ));
+    assert_eq!(
+        p.plan(Cell::new(0, 0), Cell::new(9, 9)),
+        Err(PlanError::NoPath)
+    );
+    let same = p.plan(Cell::new(1, 1), Cell::new(1, 1)).unwrap();
+    assert_eq!(same.cells, vec![Cell::new(1, 1)]);
+    assert!(same.length.abs() < f64::EPSILON);
+}
+
+/// Long straight runs exercise the 64-cell scans across word boundaries, with the goal inside a
+/// scanned stretch.
+#[test]
+fn word_scans_stop_at_the_goal() {
+    for w in [63u32, 64, 65, 127, 128, 129, 300] {
+        let grid = BitGrid::from_fn(w, 3, |x, y| y == 0 && x % 50 == 25).unwrap();
+        let mut p = JumpPointSearchPlus::new(&grid);
+        let mut t = JumpPointSearchPlus::with_jump_tables(&grid).unwrap();
+        let mut d = Dijkstra::new(&grid);
+        for (sx, gx) in [(0, w - 1), (w - 1, 0), (1, w / 2), (w / 2, 1)] {
+            for y in 1..3 {
+                let (s, g) = (Cell::new(sx, y), Cell::new(gx, y));
+                let want = d.plan(s, g).unwrap().length;
+                assert!((p.plan(s, g).unwrap().length - want).abs() < 1e-9);
+                assert!((t.plan(s, g).unwrap().length - want).abs() < 1e-9);
+            }
+        }
+    }
+}
