@@ -1,5 +1,5 @@
 //! Every planner against Dijkstra on random grids, and every returned path checked cell by cell.
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::panic)]
 
 use pathfind::movement::{path_cost, validate_dense_path};
 use pathfind::{
