@@ -1,1 +1,90 @@
-//! Shared helpers for the benches (data paths).
+//! Shared helpers for the benches: where the benchmark data lives, and the peers measured in the
+//! same run.
+
+use std::path::PathBuf;
+
+use slam_core::{BitGrid, Cell};
+
+/// Root of the public benchmark data: `$SPOT_NAV_DATA`, or `../shared/data` beside the workspace.
+#[must_use]
+pub fn data_root() -> PathBuf {
+    std::env::var_os("SPOT_NAV_DATA").map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
+        PathBuf::from,
+    )
+}
+
+/// The data root when it exists; otherwise prints a notice naming the variable and returns `None`.
+#[must_use]
+pub fn data_root_or_notice(what: &str) -> Option<PathBuf> {
+    let root = data_root();
+    if root.is_dir() {
+        Some(root)
+    } else {
+        eprintln!(
+            "{what}: benchmark data not found at {} (set SPOT_NAV_DATA to the shared data folder); skipping",
+            root.display()
+        );
+        None
+    }
+}
+
+/// The peer planner: the `pathfinding` crate's generic `astar`, the common Rust choice, with a
+/// successor closure that follows the same movement rule (8-connected, no corner cutting) and an
+/// octile heuristic. Costs are integers (`pathfinding` needs `Ord`): 1 = 1e-6 cells, so lengths
+/// are exact to about 1e-6 per step.
+pub mod pathfinding_peer {
+    use super::{BitGrid, Cell};
+
+    /// Cost of a straight step.
+    pub const STRAIGHT: u64 = 1_000_000;
+    /// Cost of a diagonal step (sqrt(2) rounded).
+    pub const DIAGONAL: u64 = 1_414_214;
+
+    fn octile(a: (u32, u32), b: (u32, u32)) -> u64 {
+        let dx = u64::from(a.0.abs_diff(b.0));
+        let dy = u64::from(a.1.abs_diff(b.1));
+        let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+        (hi - lo) * STRAIGHT + lo * DIAGONAL
+    }
+
+    /// Shortest path length (in cells) from `start` to `goal`, or `None`.
+    #[must_use]
+    pub fn astar_length(grid: &BitGrid, start: Cell, goal: Cell) -> Option<f64> {
+        let free = |x: i64, y: i64| grid.is_free_signed(x, y);
+        let goal_t = (goal.x, goal.y);
+        let (_, cost) = pathfinding::directed::astar::astar(
+            &(start.x, start.y),
+            |&(x, y)| {
+                let (x, y) = (i64::from(x), i64::from(y));
+                let mut out: Vec<((u32, u32), u64)> = Vec::with_capacity(8);
+                for (dx, dy) in [
+                    (1, 0),
+                    (-1, 0),
+                    (0, 1),
+                    (0, -1),
+                    (1, 1),
+                    (1, -1),
+                    (-1, 1),
+                    (-1, -1),
+                ] {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if !free(nx, ny) {
+                        continue;
+                    }
+                    if dx != 0 && dy != 0 {
+                        if free(x + dx, y) && free(x, y + dy) {
+                            out.push(((nx as u32, ny as u32), DIAGONAL));
+                        }
+                    } else {
+                        out.push(((nx as u32, ny as u32), STRAIGHT));
+                    }
+                }
+                out
+            },
+            |&p| octile(p, goal_t),
+            |&p| p == goal_t,
+        )?;
+        Some(cost as f64 / STRAIGHT as f64)
+    }
+}
