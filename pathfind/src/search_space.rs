@@ -1,5 +1,6 @@
-//! Per-cell search state reused across queries: costs, parents and arrival directions in flat
-//! arrays, reset in O(1) by a generation counter, and a binary-heap open list with lazy deletion.
+//! Per-cell search state reused across queries: one packed record per cell (cost, parent,
+//! arrival direction, generation stamps), reset in O(1) by a generation counter, and a binary-heap
+//! open list of 64-bit keys with lazy deletion.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -9,21 +10,16 @@ use slam_core::{Cell, GridPath};
 /// No arrival direction (the start).
 pub(crate) const NO_DIRECTION: u8 = 8;
 
-/// An open-list entry. Ordered so that the max-heap pops the smallest `f`, and among equal `f`
-/// the largest `g` (deeper nodes first: fewer expansions on ties).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Open {
-    f: f64,
-    g: f64,
+/// Path costs below 2^22 cells get quantised keys with a tie-break; see [`SearchSpace::key`].
+const QUANTISED_LIMIT: f64 = (1u64 << 22) as f64;
+
+/// An open-list entry: the smallest key pops first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Open {
+    key: u64,
     index: u32,
 }
 
-impl PartialEq for Open {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Open {}
 impl PartialOrd for Open {
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
@@ -31,39 +27,60 @@ impl PartialOrd for Open {
 }
 impl Ord for Open {
     fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .f
-            .total_cmp(&self.f)
-            .then_with(|| self.g.total_cmp(&other.g))
+        other.key.cmp(&self.key)
     }
+}
+
+/// One cell's search record, packed so a visit touches one cache line.
+#[derive(Clone, Copy, Debug)]
+struct NodeState {
+    g: f64,
+    parent: u32,
+    /// Generation in which `g`, `parent` and `direction` were written.
+    seen: u32,
+    /// Generation in which the cell was expanded.
+    closed: u32,
+    direction: u8,
 }
 
 /// Search state for one grid size.
 pub(crate) struct SearchSpace {
     width: u32,
-    g: Vec<f64>,
-    parent: Vec<u32>,
-    direction: Vec<u8>,
-    /// Generation in which `g`, `parent` and `direction` were last written.
-    seen: Vec<u32>,
-    /// Generation in which the cell was expanded.
-    closed: Vec<u32>,
+    nodes: Vec<NodeState>,
     generation: u32,
     heap: BinaryHeap<Open>,
+    /// Whether every path cost on this grid stays below [`QUANTISED_LIMIT`].
+    quantised: bool,
 }
 
 impl SearchSpace {
     pub(crate) fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
+        let empty = NodeState { g: 0.0, parent: 0, seen: 0, closed: 0, direction: NO_DIRECTION };
         Self {
             width,
-            g: vec![0.0; n],
-            parent: vec![0; n],
-            direction: vec![NO_DIRECTION; n],
-            seen: vec![0; n],
-            closed: vec![0; n],
+            nodes: vec![empty; n],
             generation: 0,
             heap: BinaryHeap::new(),
+            // No shortest path visits a cell twice, so costs stay below cells * sqrt(2).
+            quantised: (n as f64) * std::f64::consts::SQRT_2 < QUANTISED_LIMIT,
+        }
+    }
+
+    /// The heap key of priority `f` for a node of cost `g`: smaller pops first.
+    ///
+    /// On grids whose costs stay below 2^22, `f` is fixed point with 26 fractional bits in the top
+    /// 48 bits, and the low 16 bits prefer the larger `g` among equal `f`. Distinct costs
+    /// `a + b sqrt(2)` below 2^22 differ by far more than 2^-26, so the order of `f` is exact.
+    /// On larger grids the key is the bit pattern of `f` (monotone for non-negative floats).
+    #[inline]
+    fn key(&self, f: f64, g: f64) -> u64 {
+        if self.quantised {
+            let fq = (f * (1u64 << 26) as f64).round() as u64;
+            let tie = 0xFFFF - (g as u64).min(0xFFFF);
+            (fq << 16) | tie
+        } else {
+            f.to_bits()
         }
     }
 
@@ -83,8 +100,10 @@ impl SearchSpace {
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             // Wrapped after 4 billion queries: clear the stamps once.
-            self.seen.fill(0);
-            self.closed.fill(0);
+            for n in &mut self.nodes {
+                n.seen = 0;
+                n.closed = 0;
+            }
             self.generation = 1;
         }
     }
@@ -93,34 +112,26 @@ impl SearchSpace {
     /// with priority `g + h` when it improves.
     #[inline]
     pub(crate) fn relax(&mut self, i: u32, g: f64, h: f64, parent: u32, direction: u8) {
-        let k = i as usize;
-        if self.seen[k] == self.generation && self.g[k] <= g {
+        let generation = self.generation;
+        let n = &mut self.nodes[i as usize];
+        if n.seen == generation && (n.g <= g || n.closed == generation) {
             return;
         }
-        if self.closed[k] == self.generation {
-            return;
-        }
-        self.seen[k] = self.generation;
-        self.g[k] = g;
-        self.parent[k] = parent;
-        self.direction[k] = direction;
-        self.heap.push(Open {
-            f: g + h,
-            g,
-            index: i,
-        });
+        *n = NodeState { g, parent, seen: generation, closed: n.closed, direction };
+        let key = self.key(g + h, g);
+        self.heap.push(Open { key, index: i });
     }
 
     /// Pop the best open cell that is not yet expanded, and mark it expanded.
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<(u32, f64, u8)> {
         while let Some(o) = self.heap.pop() {
-            let k = o.index as usize;
-            if self.closed[k] == self.generation || o.g > self.g[k] {
+            let n = &mut self.nodes[o.index as usize];
+            if n.closed == self.generation {
                 continue;
             }
-            self.closed[k] = self.generation;
-            return Some((o.index, o.g, self.direction[k]));
+            n.closed = self.generation;
+            return Some((o.index, n.g, n.direction));
         }
         None
     }
@@ -130,14 +141,10 @@ impl SearchSpace {
         let mut cells = vec![self.cell(goal)];
         let mut i = goal;
         while i != start {
-            i = self.parent[i as usize];
+            i = self.nodes[i as usize].parent;
             cells.push(self.cell(i));
         }
         cells.reverse();
-        GridPath {
-            length: self.g[goal as usize],
-            cells,
-            expanded,
-        }
+        GridPath { length: self.nodes[goal as usize].g, cells, expanded }
     }
 }
