@@ -4,7 +4,7 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
 use crate::components::Components;
-use crate::movement::{DIRECTIONS, SQRT_2, can_step};
+use crate::movement::{DIRECTIONS, SQRT_2, legal_steps};
 use crate::search_space::{NO_DIRECTION, SearchSpace};
 
 /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
@@ -31,14 +31,13 @@ pub(crate) fn best_first(
             return Ok(space.path(s, t, expanded));
         }
         let c = space.cell(i);
-        let (x, y) = (i64::from(c.x), i64::from(c.y));
-        for (d, &(dx, dy)) in DIRECTIONS.iter().enumerate() {
-            let (dx, dy) = (i64::from(dx), i64::from(dy));
-            if !can_step(grid, x, y, dx, dy) {
-                continue;
-            }
-            let n = Cell::new((x + dx) as u32, (y + dy) as u32);
-            let cost = if dx != 0 && dy != 0 { SQRT_2 } else { 1.0 };
+        let mut steps = legal_steps(grid, c);
+        while steps != 0 {
+            let d = steps.trailing_zeros() as usize;
+            steps &= steps - 1;
+            let (dx, dy) = DIRECTIONS[d];
+            let n = Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
+            let cost = if d >= 4 { SQRT_2 } else { 1.0 };
             space.relax(space.index(n), g + cost, heuristic(n), i, d as u8);
         }
     }

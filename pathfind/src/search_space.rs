@@ -56,7 +56,13 @@ pub(crate) struct SearchSpace {
 impl SearchSpace {
     pub(crate) fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        let empty = NodeState { g: 0.0, parent: 0, seen: 0, closed: 0, direction: NO_DIRECTION };
+        let empty = NodeState {
+            g: 0.0,
+            parent: 0,
+            seen: 0,
+            closed: 0,
+            direction: NO_DIRECTION,
+        };
         Self {
             width,
             nodes: vec![empty; n],
@@ -117,7 +123,13 @@ impl SearchSpace {
         if n.seen == generation && (n.g <= g || n.closed == generation) {
             return;
         }
-        *n = NodeState { g, parent, seen: generation, closed: n.closed, direction };
+        *n = NodeState {
+            g,
+            parent,
+            seen: generation,
+            closed: n.closed,
+            direction,
+        };
         let key = self.key(g + h, g);
         self.heap.push(Open { key, index: i });
     }
@@ -145,6 +157,10 @@ impl SearchSpace {
             cells.push(self.cell(i));
         }
         cells.reverse();
-        GridPath { length: self.nodes[goal as usize].g, cells, expanded }
+        GridPath {
+            length: self.nodes[goal as usize].g,
+            cells,
+            expanded,
+        }
     }
 }

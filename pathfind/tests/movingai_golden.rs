@@ -9,7 +9,9 @@ use pathfind::{AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus};
 use slam_core::{BitGrid, Planner};
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
 
 /// Run every scenario of `map` with `planner`; returns the number checked.
@@ -17,7 +19,9 @@ fn run(name: &str, planner: &mut dyn Planner, grid: &BitGrid, map: &str) -> usiz
     let scenarios = read_scenarios(data(&format!("{map}.map.scen"))).unwrap();
     for (k, s) in scenarios.iter().enumerate() {
         assert_eq!((s.map_width, s.map_height), (grid.width(), grid.height()));
-        let p = planner.plan(s.start, s.goal).unwrap_or_else(|e| panic!("{name} {map} #{k}: {e}"));
+        let p = planner
+            .plan(s.start, s.goal)
+            .unwrap_or_else(|e| panic!("{name} {map} #{k}: {e}"));
         assert!(
             (p.length - s.optimal_length).abs() <= s.tolerance,
             "{name} on {map} scenario {k}: {} but the optimum is {} (tolerance {})",
@@ -34,7 +38,12 @@ fn all_planners(map: &str, with_slow: bool) {
     let g = &m.grid;
     let n = run("JPS", &mut JumpPointSearch::new(g), g, map);
     run("JPS blocks", &mut JumpPointSearchPlus::new(g), g, map);
-    run("JPS+ tables", &mut JumpPointSearchPlus::with_jump_tables(g).unwrap(), g, map);
+    run(
+        "JPS+ tables",
+        &mut JumpPointSearchPlus::with_jump_tables(g).unwrap(),
+        g,
+        map,
+    );
     if with_slow {
         run("A*", &mut AStar::new(g), g, map);
         run("Dijkstra", &mut Dijkstra::new(g), g, map);

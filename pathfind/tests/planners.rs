@@ -172,3 +172,25 @@ fn word_scans_stop_at_the_goal() {
         }
     }
 }
+
+proptest! {
+    /// The word-based 3 x 3 neighbourhood agrees with cell-by-cell step checks.
+    #[test]
+    fn legal_steps_match_can_step(w in 1u32..140, h in 1u32..6, density in 0u32..60, seed in any::<u64>()) {
+        use pathfind::movement::{DIRECTIONS, can_step, legal_steps};
+        let grid = random_grid(w, h, density, seed);
+        for y in 0..h {
+            for x in 0..w {
+                let c = Cell::new(x, y);
+                if grid.is_blocked(c) {
+                    continue;
+                }
+                let m = legal_steps(&grid, c);
+                for (d, &(dx, dy)) in DIRECTIONS.iter().enumerate() {
+                    let want = can_step(&grid, i64::from(x), i64::from(y), i64::from(dx), i64::from(dy));
+                    prop_assert_eq!((m >> d) & 1 == 1, want, "cell {:?} direction {:?}", c, (dx, dy));
+                }
+            }
+        }
+    }
+}
