@@ -55,11 +55,11 @@ fn planners(c: &mut Criterion) {
         });
         let mut astar = AStar::new(grid);
         group.bench_function(BenchmarkId::new("AStar", name), |b| {
-            b.iter(|| run(&mut astar, &sample))
+            b.iter(|| run(&mut astar, &sample));
         });
         let mut jps = JumpPointSearch::new(grid);
         group.bench_function(BenchmarkId::new("JumpPointSearch", name), |b| {
-            b.iter(|| run(&mut jps, &sample))
+            b.iter(|| run(&mut jps, &sample));
         });
         let mut blocks = JumpPointSearchPlus::new(grid);
         group.bench_function(BenchmarkId::new("JumpPointSearchPlus_blocks", name), |b| {

@@ -6,6 +6,9 @@
 //! (`SPOT_NAV_DATA` names the shared data folder; `PLANNERS_TABLE_STRIDE=k` runs every k-th
 //! scenario for a quick look.)
 
+// A wrong or missing path must stop the bench: its figures would be meaningless.
+#![allow(clippy::panic)]
+
 use std::time::Instant;
 
 use pathfind::movingai::{Scenario, read_map, read_scenarios};

@@ -24,7 +24,7 @@ fn main() -> Result<()> {
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
-            "--planner" => which = it.next().context(USAGE)?.clone(),
+            "--planner" => which.clone_from(it.next().context(USAGE)?),
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
