@@ -1,0 +1,73 @@
+//! Errors of the gridmap crate.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// Errors building, transforming or storing occupancy grids.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum GridMapError {
+    /// The input cloud has no points.
+    #[error("the map cloud is empty")]
+    EmptyCloud,
+    /// The cloud has non-finite points (drop them first with `PointCloud::remove_non_finite`).
+    #[error("the map cloud has {count} non-finite points")]
+    NonFinitePoints {
+        /// How many.
+        count: usize,
+    },
+    /// No point lies in the height slice.
+    #[error("no point lies between {min_z} m and {max_z} m")]
+    EmptySlice {
+        /// Lower bound of the slice.
+        min_z: f64,
+        /// Upper bound of the slice.
+        max_z: f64,
+    },
+    /// A setting is out of range.
+    #[error("invalid setting: {0}")]
+    InvalidConfig(String),
+    /// The grid would have more cells than the configured budget.
+    #[error("a {width}x{height} grid exceeds the budget of {max_cells} cells")]
+    TooManyCells {
+        /// Width the grid would have.
+        width: u64,
+        /// Height the grid would have.
+        height: u64,
+        /// The budget.
+        max_cells: u64,
+    },
+    /// The two grids do not have the same size and placement.
+    #[error("grids differ in size or placement")]
+    GeometryMismatch,
+    /// A map file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A map YAML line could not be parsed.
+    #[error("{path} line {line}: {message}")]
+    Yaml {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The image codec failed.
+    #[error("image {path}: {message}")]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// What the codec said.
+        message: String,
+    },
+    /// A grid operation failed.
+    #[error(transparent)]
+    Grid(#[from] slam_core::GridError),
+}

@@ -1,0 +1,132 @@
+//! `OccupancyGrid`: free, occupied or unknown per cell, over two bit grids.
+
+use slam_core::{BitGrid, Cell, GridGeometry};
+
+use crate::error::GridMapError;
+
+/// What is known of a cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CellState {
+    /// Seen empty (a ray passed through), or assumed free when no ray casting was done.
+    Free,
+    /// An obstacle was observed in the height slice.
+    Occupied,
+    /// Never observed.
+    Unknown,
+}
+
+/// How a planner should treat unknown cells.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum UnknownCells {
+    /// Unknown cells are obstacles (safe: the robot stays in mapped space).
+    #[default]
+    Blocked,
+    /// Unknown cells are free (exploration).
+    Free,
+}
+
+/// A 2D occupancy grid. Cell (0, 0) is the lower-left corner at `geometry().origin`, row `y` grows
+/// along world +y, each cell is `geometry().resolution` metres wide.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OccupancyGrid {
+    occupied: BitGrid,
+    free: BitGrid,
+}
+
+impl OccupancyGrid {
+    /// A grid of `width` x `height` cells, all in state `fill`.
+    ///
+    /// # Errors
+    /// [`GridMapError::Grid`] for an empty or oversized grid.
+    pub fn new(
+        width: u32,
+        height: u32,
+        geometry: GridGeometry,
+        fill: CellState,
+    ) -> Result<Self, GridMapError> {
+        let occupied = BitGrid::from_fn(width, height, |_, _| fill == CellState::Occupied)?
+            .with_geometry(geometry);
+        let free = BitGrid::from_fn(width, height, |_, _| fill == CellState::Free)?
+            .with_geometry(geometry);
+        Ok(Self { occupied, free })
+    }
+
+    /// Columns.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.occupied.width()
+    }
+
+    /// Rows.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.occupied.height()
+    }
+
+    /// Placement in the world.
+    #[must_use]
+    pub fn geometry(&self) -> &GridGeometry {
+        self.occupied.geometry()
+    }
+
+    /// The state of `cell` (`Unknown` off the grid).
+    #[must_use]
+    pub fn state(&self, cell: Cell) -> CellState {
+        if !self.occupied.contains(cell) {
+            CellState::Unknown
+        } else if self.occupied.is_blocked(cell) {
+            CellState::Occupied
+        } else if self.free.is_blocked(cell) {
+            CellState::Free
+        } else {
+            CellState::Unknown
+        }
+    }
+
+    /// Set the state of `cell`.
+    ///
+    /// # Errors
+    /// [`GridMapError::Grid`] when `cell` is off the grid.
+    pub fn set(&mut self, cell: Cell, state: CellState) -> Result<(), GridMapError> {
+        self.occupied.set(cell, state == CellState::Occupied)?;
+        self.free.set(cell, state == CellState::Free)?;
+        Ok(())
+    }
+
+    /// Occupied cells as a bit grid (1 = occupied).
+    #[must_use]
+    pub fn occupied(&self) -> &BitGrid {
+        &self.occupied
+    }
+
+    /// Known-free cells as a bit grid (1 = free).
+    #[must_use]
+    pub fn known_free(&self) -> &BitGrid {
+        &self.free
+    }
+
+    /// The grid a planner searches: occupied cells blocked, unknown cells as `unknown` says.
+    #[must_use]
+    pub fn to_planning_grid(&self, unknown: UnknownCells) -> BitGrid {
+        let mut out = self.occupied.clone();
+        if unknown == UnknownCells::Blocked {
+            for y in 0..self.height() {
+                let free = self.free.row_words(y).to_vec();
+                for (o, f) in out.row_words_mut(y).iter_mut().zip(free) {
+                    // Blocked unless known free; occupied stays blocked.
+                    *o |= !f;
+                }
+            }
+            out.restore_padding();
+        }
+        out
+    }
+
+    /// Number of cells in each state: (free, occupied, unknown).
+    #[must_use]
+    pub fn counts(&self) -> (usize, usize, usize) {
+        let occupied = self.occupied.count_blocked();
+        let free = self.free.count_blocked();
+        (free, occupied, self.occupied.len() - free - occupied)
+    }
+}
