@@ -1,13 +1,19 @@
 //! Word-at-a-time straight jumps (Harabor & Grastien 2014, "Improving Jump Point Search"): 64
-//! cells of a row and of its two neighbouring rows are read as words, and `trailing_zeros` finds
-//! the first blocked cell and the first forced cell at once. Columns are scanned as rows of the
-//! transposed grid.
+//! cells of a row and of its two neighbouring rows are read as aligned words, and
+//! `trailing_zeros` / `leading_zeros` find the first blocked cell and the first forced cell at
+//! once. Columns are scanned as rows of the transposed grid.
 
 use slam_core::BitGrid;
 
+/// Word `i` of a row, or all blocked for a row off the grid.
+#[inline]
+fn word(row: Option<&[u64]>, i: usize) -> u64 {
+    row.map_or(u64::MAX, |r| r[i])
+}
+
 /// Scan row `y` from column `x` east (`east`) or west. Returns the column of the first jump point
-/// (a cell with a forced side) or of the goal column `goal` when it comes first; `None` when a
-/// wall comes first.
+/// (a cell whose side is free while the side cell behind it is blocked) or of the goal column
+/// `goal` when it comes first; `None` when a wall comes first.
 #[inline]
 pub(crate) fn scan_row(
     grid: &BitGrid,
@@ -16,51 +22,112 @@ pub(crate) fn scan_row(
     east: bool,
     goal: Option<u32>,
 ) -> Option<u32> {
-    let h = grid.height();
-    // Bit i of each word is the cell i steps from `s` in the travel direction.
-    let word = |s: u32, r: u32| {
-        if east {
-            grid.word_at(s, r)
-        } else {
-            grid.word_ending_at(s, r).reverse_bits()
-        }
+    let here = grid.row_words(y);
+    let above = (y + 1 < grid.height()).then(|| grid.row_words(y + 1));
+    let below = (y > 0).then(|| grid.row_words(y - 1));
+    let stop = if east {
+        scan_east(here, above, below, x)
+    } else {
+        scan_west(here, above, below, x)
     };
-    let mut s = x;
-    loop {
-        let here = word(s, y);
-        let above = if y + 1 < h { word(s, y + 1) } else { u64::MAX };
-        let below = if y > 0 { word(s, y - 1) } else { u64::MAX };
-        // A side is forced at step i when the side cell is free but the side cell of step i - 1
-        // (the one behind in the travel direction) is blocked.
-        let forced = ((!above & (above << 1)) | (!below & (below << 1))) & !1;
-        let blocked = here & !1;
-        let first_forced = forced.trailing_zeros();
-        let first_blocked = blocked.trailing_zeros();
-        if let Some(g) = goal {
-            let steps = if east {
-                g.checked_sub(s)
-            } else {
-                s.checked_sub(g)
-            };
-            if let Some(i) = steps
-                && (1..64).contains(&i)
-                && i < first_blocked
-                && i <= first_forced
-            {
-                return Some(g);
+    if let Some(g) = goal {
+        // The goal lies ahead, before the wall and not after the jump point.
+        let ahead = if east { g > x } else { g < x };
+        let g64 = i64::from(g);
+        let before_stop = match stop {
+            Stop::Jump(j) => {
+                if east {
+                    g <= j
+                } else {
+                    g >= j
+                }
             }
+            Stop::Wall(w) => {
+                if east {
+                    g64 < w
+                } else {
+                    g64 > w
+                }
+            }
+        };
+        if ahead && before_stop {
+            return Some(g);
         }
-        if first_forced < first_blocked {
-            return Some(if east {
-                s + first_forced
+    }
+    match stop {
+        Stop::Jump(j) => Some(j),
+        Stop::Wall(_) => None,
+    }
+}
+
+/// Where a straight scan ends.
+#[derive(Clone, Copy)]
+enum Stop {
+    /// At a jump point (this column).
+    Jump(u32),
+    /// At a blocked column, or one past the grid's edge (-1 to the west, the width to the east).
+    Wall(i64),
+}
+
+#[inline]
+fn scan_east(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32) -> Stop {
+    let mut i = (x / 64) as usize;
+    // Only cells after x count.
+    let mut mask = (u64::MAX << (x % 64)) << 1;
+    let (mut carry_up, mut carry_down) = (0u64, 0u64);
+    loop {
+        let (h, u, d) = (here[i], word(above, i), word(below, i));
+        // Forced at bit b: side free at b, side blocked at b - 1 (bit 0 looks at the word before).
+        let forced = ((!u & ((u << 1) | carry_up)) | (!d & ((d << 1) | carry_down))) & mask;
+        let blocked = h & mask;
+        let base = i as u32 * 64;
+        if forced != 0 || blocked != 0 {
+            let (f, b) = (forced.trailing_zeros(), blocked.trailing_zeros());
+            return if f < b {
+                Stop::Jump(base + f)
             } else {
-                s - first_forced
-            });
+                Stop::Wall(i64::from(base + b))
+            };
         }
-        if first_blocked < 64 {
-            return None;
+        // Padding bits past the width are blocked; a width that fills its last word has none.
+        if i + 1 == here.len() {
+            return Stop::Wall(i64::from(base) + 64);
         }
-        // Steps 1..=63 are free and unforced: continue from the last one.
-        s = if east { s + 63 } else { s - 63 };
+        carry_up = u >> 63;
+        carry_down = d >> 63;
+        mask = u64::MAX;
+        i += 1;
+    }
+}
+
+#[inline]
+fn scan_west(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32) -> Stop {
+    let mut i = (x / 64) as usize;
+    // Only cells before x count.
+    let mut mask = (1u64 << (x % 64)) - 1;
+    let (mut carry_up, mut carry_down) = (0u64, 0u64);
+    loop {
+        let (h, u, d) = (here[i], word(above, i), word(below, i));
+        // Travelling west, the cell behind b is b + 1 (bit 63 looks at the word after).
+        let forced = ((!u & ((u >> 1) | carry_up)) | (!d & ((d >> 1) | carry_down))) & mask;
+        let blocked = h & mask;
+        let base = i as u32 * 64;
+        if forced != 0 || blocked != 0 {
+            // The highest set bit is the first stop going west; an empty mask never wins.
+            let top = |m: u64| (m != 0).then(|| m.ilog2());
+            return match (top(forced), top(blocked)) {
+                (Some(f), Some(b)) if f > b => Stop::Jump(base + f),
+                (Some(f), None) => Stop::Jump(base + f),
+                (_, Some(b)) => Stop::Wall(i64::from(base + b)),
+                (None, None) => Stop::Wall(-1),
+            };
+        }
+        if i == 0 {
+            return Stop::Wall(-1);
+        }
+        carry_up = u << 63;
+        carry_down = d << 63;
+        mask = u64::MAX;
+        i -= 1;
     }
 }
