@@ -4,7 +4,7 @@
 //!
 //! `cargo bench -p spot-nav-benches --bench planners_table`
 //! (`SPOT_NAV_DATA` names the shared data folder; `PLANNERS_TABLE_STRIDE=k` runs every k-th
-//! scenario for a quick look.)
+//! scenario for a quick look; `PLANNERS_TABLE_MAPS=den520d,maze512-8-0` picks maps.)
 
 // A wrong or missing path must stop the bench: its figures would be meaningless.
 #![allow(clippy::panic)]
@@ -79,7 +79,14 @@ fn main() {
         "| map | planner | mean µs/query | p99 µs | speed-up vs peer | mean expansions | preprocessing ms | extra bytes/cell |"
     );
     println!("|---|---|---|---|---|---|---|---|");
+    let picked = std::env::var("PLANNERS_TABLE_MAPS").ok();
     for (set, name) in MAPS {
+        if picked
+            .as_deref()
+            .is_some_and(|p| !p.split(',').any(|m| m == name))
+        {
+            continue;
+        }
         let dir = root.join("movingai");
         let map = match read_map(dir.join(format!("maps/{set}/{name}.map"))) {
             Ok(m) => m,

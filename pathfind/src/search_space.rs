@@ -1,6 +1,12 @@
 //! Per-cell search state reused across queries: one packed record per cell (cost, parent,
-//! arrival direction, generation stamps), reset in O(1) by a generation counter, and a binary-heap
-//! open list of 64-bit keys with lazy deletion.
+//! arrival direction, generation stamps), reset in O(1) by a generation counter, and an open list
+//! of 64-bit keys with lazy deletion: a binary heap, plus a stack for cells whose `f` equals the
+//! `f` being expanded.
+//!
+//! The stack is sound because the heuristics used here are consistent: `f` never decreases along
+//! an expansion order, so any open cell with the current minimum `f` may be expanded next, and a
+//! successor with that same `f` has the larger `g` (the preferred tie-break). On open maps most
+//! successors are such cells (walking straight at the goal), and they skip the heap entirely.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -49,6 +55,10 @@ pub(crate) struct SearchSpace {
     nodes: Vec<NodeState>,
     generation: u32,
     heap: BinaryHeap<Open>,
+    /// Cells queued with `f` equal to `current_f`; expanded before anything on the heap.
+    same_f: Vec<u32>,
+    /// Quantised `f` (the key without its tie-break bits) of the last cell taken off the heap.
+    current_f: u64,
     /// Whether every path cost on this grid stays below [`QUANTISED_LIMIT`].
     quantised: bool,
 }
@@ -68,6 +78,8 @@ impl SearchSpace {
             nodes: vec![empty; n],
             generation: 0,
             heap: BinaryHeap::new(),
+            same_f: Vec::new(),
+            current_f: u64::MAX,
             // No shortest path visits a cell twice, so costs stay below cells * sqrt(2).
             quantised: (n as f64) * std::f64::consts::SQRT_2 < QUANTISED_LIMIT,
         }
@@ -103,6 +115,8 @@ impl SearchSpace {
     /// Start a new query.
     pub(crate) fn reset(&mut self) {
         self.heap.clear();
+        self.same_f.clear();
+        self.current_f = u64::MAX;
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             // Wrapped after 4 billion queries: clear the stamps once.
@@ -131,18 +145,31 @@ impl SearchSpace {
             direction,
         };
         let key = self.key(g + h, g);
-        self.heap.push(Open { key, index: i });
+        if self.quantised && key >> 16 == self.current_f {
+            self.same_f.push(i);
+        } else {
+            self.heap.push(Open { key, index: i });
+        }
     }
 
     /// Pop the best open cell that is not yet expanded, and mark it expanded.
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<(u32, f64, u8)> {
+        while let Some(i) = self.same_f.pop() {
+            let n = &mut self.nodes[i as usize];
+            if n.closed == self.generation {
+                continue;
+            }
+            n.closed = self.generation;
+            return Some((i, n.g, n.direction));
+        }
         while let Some(o) = self.heap.pop() {
             let n = &mut self.nodes[o.index as usize];
             if n.closed == self.generation {
                 continue;
             }
             n.closed = self.generation;
+            self.current_f = o.key >> 16;
             return Some((o.index, n.g, n.direction));
         }
         None
