@@ -1,0 +1,594 @@
+//! A procedurally generated office building: a ring corridor with rooms on both sides, doors,
+//! corridor pilasters, pillars and furniture, as axis-aligned boxes between a floor and a ceiling.
+//!
+//! Layout (plan view, x east, y north, origin at the outer south-west corner):
+//!
+//! ```text
+//! +------+--------+------+-----+   outer band: rooms between the outer wall and the corridor
+//! |      |        |      |     |
+//! +--D---+---D----+--D---+--D--+
+//! |  ring corridor (loop)      |
+//! |  +---D---+---D----+---+    |
+//! |  | core rooms (two rows) | |
+//! |  +---D---+---D----+---+    |
+//! +--D---+---D----+--D---+--D--+
+//! |      |        |      |     |
+//! +------+--------+------+-----+
+//! ```
+//!
+//! Every room has one door onto the corridor, so the free space is connected. Pillars and
+//! furniture never stand in the corridor or in front of a door.
+
+use nalgebra::{Point3, Vector2};
+
+use crate::error::AdapterError;
+use crate::ray_cast::BoxGrid;
+use crate::rng::SimRng;
+
+/// What a box of the building is (for statistics and pictures; ray casting treats all alike).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum BoxKind {
+    /// A wall segment, floor to ceiling.
+    Wall,
+    /// The wall above a door, from the door's top to the ceiling.
+    Lintel,
+    /// A free-standing pillar or a pilaster against a corridor wall, floor to ceiling.
+    Pillar,
+    /// A desk, table, cabinet or crate standing on the floor.
+    Furniture,
+}
+
+/// An axis-aligned solid box (metres, world frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolidBox {
+    /// Smallest corner.
+    pub min: Point3<f64>,
+    /// Largest corner.
+    pub max: Point3<f64>,
+    /// What it is.
+    pub kind: BoxKind,
+}
+
+impl SolidBox {
+    /// Whether the plan-view point `p` lies inside the box's footprint (borders included).
+    #[must_use]
+    pub fn contains_xy(&self, p: Vector2<f64>) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+}
+
+/// A room: its rectangle between wall centre lines and its door onto the corridor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Room {
+    /// South-west corner (wall centre lines, metres).
+    pub min: Vector2<f64>,
+    /// North-east corner (wall centre lines, metres).
+    pub max: Vector2<f64>,
+    /// Centre of the door opening, on the wall shared with the corridor.
+    pub door: Vector2<f64>,
+    /// Unit vector from the door into the room.
+    pub inward: Vector2<f64>,
+}
+
+impl Room {
+    /// A point 1 m inside the room straight through the door; it is always free floor.
+    #[must_use]
+    pub fn entry_point(&self) -> Vector2<f64> {
+        self.door + self.inward
+    }
+}
+
+/// Ranges the generator draws from (metres). Defaults give realistic office scales.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct BuildingConfig {
+    /// Corridor width between wall centre lines, e.g. 1.8..2.6 m (1.6..2.4 m free).
+    pub corridor_width: (f64, f64),
+    /// Depth of the rooms between the outer wall and the corridor, e.g. 4..6 m.
+    pub outer_room_depth: (f64, f64),
+    /// Length of the corridor loop's centre line along x, e.g. 34..44 m.
+    pub loop_length_x: (f64, f64),
+    /// Length of the corridor loop's centre line along y, e.g. 16..20 m.
+    pub loop_length_y: (f64, f64),
+    /// Room widths along a corridor, e.g. 3..8 m.
+    pub room_width: (f64, f64),
+    /// Ceiling height, e.g. 2.5..3.0 m.
+    pub ceiling_height: (f64, f64),
+    /// Wall thickness, usually 0.2 m.
+    pub wall_thickness: f64,
+    /// Door width, e.g. 1.0..1.2 m.
+    pub door_width: (f64, f64),
+    /// Door height, usually 2.1 m.
+    pub door_height: f64,
+    /// Spacing of the pilasters along the corridor's inner wall, e.g. 4..8 m; they break up the
+    /// long featureless corridor walls as real buildings do.
+    pub pilaster_spacing: (f64, f64),
+    /// Furniture pieces per room, e.g. 1..=3.
+    pub furniture_per_room: (usize, usize),
+}
+
+impl Default for BuildingConfig {
+    fn default() -> Self {
+        Self {
+            corridor_width: (1.8, 2.6),
+            outer_room_depth: (4.0, 6.0),
+            loop_length_x: (34.0, 44.0),
+            loop_length_y: (16.0, 20.0),
+            room_width: (3.0, 8.0),
+            ceiling_height: (2.5, 3.0),
+            wall_thickness: 0.2,
+            door_width: (1.0, 1.2),
+            door_height: 2.1,
+            pilaster_spacing: (4.0, 8.0),
+            furniture_per_room: (1, 3),
+        }
+    }
+}
+
+impl BuildingConfig {
+    fn validate(&self) -> Result<(), AdapterError> {
+        let ranges = [
+            ("corridor_width", self.corridor_width, 1.0),
+            ("outer_room_depth", self.outer_room_depth, 2.5),
+            ("loop_length_x", self.loop_length_x, 10.0),
+            ("loop_length_y", self.loop_length_y, 10.0),
+            ("room_width", self.room_width, 2.5),
+            ("ceiling_height", self.ceiling_height, 2.2),
+            ("door_width", self.door_width, 0.6),
+            ("pilaster_spacing", self.pilaster_spacing, 1.0),
+        ];
+        for (name, (lo, hi), floor) in ranges {
+            if !(lo.is_finite() && hi.is_finite() && lo >= floor && hi >= lo) {
+                return Err(AdapterError::InvalidConfig(format!(
+                    "{name} = ({lo}, {hi}) must be finite, ordered and at least {floor} m"
+                )));
+            }
+        }
+        let t = self.wall_thickness;
+        if !(t.is_finite() && t > 0.0 && t < 0.5 * self.corridor_width.0) {
+            return Err(AdapterError::InvalidConfig(format!(
+                "wall_thickness = {t} m must be positive and below half the corridor width"
+            )));
+        }
+        if !(self.door_height.is_finite()
+            && self.door_height > 1.0
+            && self.door_height < self.ceiling_height.0)
+        {
+            return Err(AdapterError::InvalidConfig(format!(
+                "door_height = {} m must lie between 1 m and the ceiling",
+                self.door_height
+            )));
+        }
+        if self.door_width.1 + 1.2 > self.room_width.0 {
+            return Err(AdapterError::InvalidConfig(
+                "doors must be at least 1.2 m narrower than the narrowest room".into(),
+            ));
+        }
+        if self.furniture_per_room.0 > self.furniture_per_room.1 {
+            return Err(AdapterError::InvalidConfig(
+                "furniture_per_room must be ordered".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The generated building: boxes, rooms, the corridor loop and a ray-casting index.
+#[derive(Clone, Debug)]
+pub struct Building {
+    pub(crate) boxes: Vec<SolidBox>,
+    pub(crate) rooms: Vec<Room>,
+    pub(crate) size: Vector2<f64>,
+    pub(crate) ceiling_height: f64,
+    pub(crate) corridor_loop: [Vector2<f64>; 4],
+    pub(crate) corridor_width: f64,
+    pub(crate) index: BoxGrid,
+}
+
+/// Accumulates boxes while the generator runs.
+struct Draft<'a> {
+    cfg: &'a BuildingConfig,
+    boxes: Vec<SolidBox>,
+    ceiling: f64,
+}
+
+impl Draft<'_> {
+    fn push(&mut self, min: [f64; 3], max: [f64; 3], kind: BoxKind) {
+        self.boxes.push(SolidBox {
+            min: Point3::from(min),
+            max: Point3::from(max),
+            kind,
+        });
+    }
+
+    /// A wall along x (`horizontal`) at y = `c` from x = `a` to `b`, or along y at x = `c`, with
+    /// door openings given as (centre, width) along the wall. Walls overrun their ends by half
+    /// a thickness so that corners close.
+    fn wall(&mut self, horizontal: bool, c: f64, a: f64, b: f64, doors: &[(f64, f64)]) {
+        let h = 0.5 * self.cfg.wall_thickness;
+        let top = self.ceiling;
+        let mut doors = doors.to_vec();
+        doors.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let mut start = a - h;
+        let mut spans = Vec::new();
+        for &(centre, width) in &doors {
+            spans.push((start, centre - 0.5 * width, 0.0, top, BoxKind::Wall));
+            spans.push((
+                centre - 0.5 * width,
+                centre + 0.5 * width,
+                self.cfg.door_height,
+                top,
+                BoxKind::Lintel,
+            ));
+            start = centre + 0.5 * width;
+        }
+        spans.push((start, b + h, 0.0, top, BoxKind::Wall));
+        for (s0, s1, z0, z1, kind) in spans {
+            if s1 - s0 < 1e-6 {
+                continue;
+            }
+            if horizontal {
+                self.push([s0, c - h, z0], [s1, c + h, z1], kind);
+            } else {
+                self.push([c - h, s0, z0], [c + h, s1, z1], kind);
+            }
+        }
+    }
+}
+
+/// Split `[lo, hi]` into rooms about `width` wide: returns the inner cut positions.
+fn cuts(rng: &mut SimRng, lo: f64, hi: f64, width: (f64, f64)) -> Vec<f64> {
+    let len = hi - lo;
+    let mean = 0.5 * (width.0 + width.1);
+    let n = ((len / mean).round() as usize).max(1);
+    let sizes: Vec<f64> = (0..n).map(|_| rng.range(0.75, 1.25)).collect();
+    let total: f64 = sizes.iter().sum();
+    let mut at = lo;
+    let mut out = Vec::with_capacity(n.saturating_sub(1));
+    for s in &sizes[..n - 1] {
+        at += len * s / total;
+        out.push(at);
+    }
+    out
+}
+
+/// A door centre on `[a, b]` of a wall, clear of the side walls (thickness `t`) by 0.3 m.
+fn door_on(rng: &mut SimRng, t: f64, a: f64, b: f64, width: f64) -> f64 {
+    let m = 0.5 * width + 0.5 * t + 0.3;
+    rng.range(a + m, (b - m).max(a + m))
+}
+
+/// Axis-aligned rectangles overlap (with a margin added to the first).
+fn overlaps(a: (Vector2<f64>, Vector2<f64>), b: (Vector2<f64>, Vector2<f64>), margin: f64) -> bool {
+    a.0.x - margin < b.1.x
+        && b.0.x < a.1.x + margin
+        && a.0.y - margin < b.1.y
+        && b.0.y < a.1.y + margin
+}
+
+impl Building {
+    /// Generate the building for `seed`.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] when a range in `config` is not usable.
+    pub fn generate(seed: u64, config: &BuildingConfig) -> Result<Self, AdapterError> {
+        config.validate()?;
+        let mut rng = SimRng::new(seed, 0xb111_d146);
+        let draw = |rng: &mut SimRng, r: (f64, f64)| rng.range(r.0, r.1);
+        let cw = draw(&mut rng, config.corridor_width);
+        let band = draw(&mut rng, config.outer_room_depth);
+        let lx = draw(&mut rng, config.loop_length_x);
+        let ly = draw(&mut rng, config.loop_length_y);
+        let ceiling = draw(&mut rng, config.ceiling_height);
+        let (w, h) = (lx + cw + 2.0 * band, ly + cw + 2.0 * band);
+        let t = config.wall_thickness;
+        let mut d = Draft {
+            cfg: config,
+            boxes: Vec::new(),
+            ceiling,
+        };
+        let mut rooms = Vec::new();
+        let door_w = |rng: &mut SimRng| draw(rng, config.door_width);
+
+        // Outer walls.
+        d.wall(true, 0.0, 0.0, w, &[]);
+        d.wall(true, h, 0.0, w, &[]);
+        d.wall(false, 0.0, 0.0, h, &[]);
+        d.wall(false, w, 0.0, h, &[]);
+
+        // The corridor's outer walls with the doors of the outer-band rooms.
+        let (cx0, cx1, cy0, cy1) = (band, w - band, band, h - band);
+        for south in [true, false] {
+            // South/north bands span the full width; the end rooms must reach the corridor by
+            // at least 2.5 m so that their door fits.
+            let first = cx0 + rng.range(2.5, 3.5);
+            let last = cx1 - rng.range(2.5, 3.5);
+            let mut xs = vec![0.0, first];
+            xs.extend(cuts(&mut rng, first, last, config.room_width));
+            xs.extend([last, w]);
+            let (y_wall, y_out) = if south { (cy0, 0.0) } else { (cy1, h) };
+            let mut doors = Vec::new();
+            for pair in xs.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let width = door_w(&mut rng);
+                let c = door_on(&mut rng, t, a.max(cx0), b.min(cx1), width);
+                doors.push((c, width));
+                let inward = Vector2::new(0.0, if south { -1.0 } else { 1.0 });
+                rooms.push(Room {
+                    min: Vector2::new(a, y_out.min(y_wall)),
+                    max: Vector2::new(b, y_out.max(y_wall)),
+                    door: Vector2::new(c, y_wall),
+                    inward,
+                });
+                if b < w {
+                    d.wall(false, b, y_out.min(y_wall), y_out.max(y_wall), &[]);
+                }
+            }
+            d.wall(true, y_wall, 0.0, w, &doors);
+        }
+        for west in [true, false] {
+            let mut ys = vec![cy0];
+            ys.extend(cuts(&mut rng, cy0, cy1, config.room_width));
+            ys.push(cy1);
+            let (x_wall, x_out) = if west { (cx0, 0.0) } else { (cx1, w) };
+            let mut doors = Vec::new();
+            for pair in ys.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let width = door_w(&mut rng);
+                let c = door_on(&mut rng, t, a, b, width);
+                doors.push((c, width));
+                rooms.push(Room {
+                    min: Vector2::new(x_out.min(x_wall), a),
+                    max: Vector2::new(x_out.max(x_wall), b),
+                    door: Vector2::new(x_wall, c),
+                    inward: Vector2::new(if west { -1.0 } else { 1.0 }, 0.0),
+                });
+                if b < cy1 {
+                    d.wall(true, b, x_out.min(x_wall), x_out.max(x_wall), &[]);
+                }
+            }
+            d.wall(false, x_wall, cy0, cy1, &doors);
+        }
+
+        // The core inside the loop: two rows of rooms, doors onto the corridor's inner walls.
+        let core = [cx0 + cw, cx1 - cw, cy0 + cw, cy1 - cw];
+        let (south_doors, north_doors) = core_rooms(&mut d, &mut rng, core, &mut rooms);
+        pilasters(&mut d, &mut rng, core, &south_doors, &north_doors);
+
+        // Pillars in large rooms, furniture against room walls; nothing in front of a door.
+        for room in &rooms {
+            furnish(&mut d, &mut rng, room);
+        }
+
+        let boxes = d.boxes;
+        let index = BoxGrid::new(&boxes, 1.0);
+        Ok(Self {
+            boxes,
+            rooms,
+            size: Vector2::new(w, h),
+            ceiling_height: ceiling,
+            corridor_loop: [
+                Vector2::new(cx0 + 0.5 * cw, cy0 + 0.5 * cw),
+                Vector2::new(cx1 - 0.5 * cw, cy0 + 0.5 * cw),
+                Vector2::new(cx1 - 0.5 * cw, cy1 - 0.5 * cw),
+                Vector2::new(cx0 + 0.5 * cw, cy1 - 0.5 * cw),
+            ],
+            corridor_width: cw,
+            index,
+        })
+    }
+
+    /// Every box (walls, lintels, pillars, furniture).
+    #[must_use]
+    pub fn boxes(&self) -> &[SolidBox] {
+        &self.boxes
+    }
+
+    /// The rooms, each with its door onto the corridor.
+    #[must_use]
+    pub fn rooms(&self) -> &[Room] {
+        &self.rooms
+    }
+
+    /// Outer size (x, y) in metres; the building spans `[0, size.x] x [0, size.y]`.
+    #[must_use]
+    pub fn size(&self) -> Vector2<f64> {
+        self.size
+    }
+
+    /// Ceiling height (metres); the floor is at z = 0.
+    #[must_use]
+    pub fn ceiling_height(&self) -> f64 {
+        self.ceiling_height
+    }
+
+    /// Corners of the corridor loop's centre line, counter-clockwise from the south-west.
+    #[must_use]
+    pub fn corridor_loop(&self) -> &[Vector2<f64>; 4] {
+        &self.corridor_loop
+    }
+
+    /// Corridor width between wall centre lines (metres).
+    #[must_use]
+    pub fn corridor_width(&self) -> f64 {
+        self.corridor_width
+    }
+}
+
+/// The core's two rows of rooms inside `[x0, x1, y0, y1]`; returns the doors of the south and
+/// north walls as (centre, width).
+#[allow(clippy::type_complexity)]
+fn core_rooms(
+    d: &mut Draft<'_>,
+    rng: &mut SimRng,
+    [kx0, kx1, ky0, ky1]: [f64; 4],
+    rooms: &mut Vec<Room>,
+) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+    let config = d.cfg;
+    let ymid = 0.5 * (ky0 + ky1);
+    d.wall(true, ymid, kx0, kx1, &[]);
+    d.wall(false, kx0, ky0, ky1, &[]);
+    d.wall(false, kx1, ky0, ky1, &[]);
+    let mut inner_doors = [Vec::new(), Vec::new()];
+    for (row, south) in [true, false].into_iter().enumerate() {
+        let mut xs = vec![kx0];
+        xs.extend(cuts(rng, kx0, kx1, config.room_width));
+        xs.push(kx1);
+        let (y_wall, y_far) = if south { (ky0, ymid) } else { (ky1, ymid) };
+        for pair in xs.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let width = rng.range(config.door_width.0, config.door_width.1);
+            let c = door_on(rng, config.wall_thickness, a, b, width);
+            inner_doors[row].push((c, width));
+            rooms.push(Room {
+                min: Vector2::new(a, y_wall.min(y_far)),
+                max: Vector2::new(b, y_wall.max(y_far)),
+                door: Vector2::new(c, y_wall),
+                inward: Vector2::new(0.0, if south { 1.0 } else { -1.0 }),
+            });
+            if b < kx1 {
+                d.wall(false, b, y_wall.min(y_far), y_wall.max(y_far), &[]);
+            }
+        }
+    }
+    let [south_doors, north_doors] = inner_doors;
+    d.wall(true, ky0, kx0, kx1, &south_doors);
+    d.wall(true, ky1, kx0, kx1, &north_doors);
+    (south_doors, north_doors)
+}
+
+/// Pilasters on the corridor side of the core's walls (`[x0, x1, y0, y1]`), clear of doors.
+fn pilasters(
+    d: &mut Draft<'_>,
+    rng: &mut SimRng,
+    [kx0, kx1, ky0, ky1]: [f64; 4],
+    south_doors: &[(f64, f64)],
+    north_doors: &[(f64, f64)],
+) {
+    let config = d.cfg;
+    let (t, ceiling) = (config.wall_thickness, d.ceiling);
+    let draw = |rng: &mut SimRng, r: (f64, f64)| rng.range(r.0, r.1);
+    // Pilasters on the corridor side of the core's walls, clear of doors and corners.
+    let depth = 0.25;
+    let half = 0.2;
+    for (horizontal, c, a, b, sign, doors) in [
+        (true, ky0, kx0, kx1, -1.0, south_doors),
+        (true, ky1, kx0, kx1, 1.0, north_doors),
+        (false, kx0, ky0, ky1, -1.0, &[][..]),
+        (false, kx1, ky0, ky1, 1.0, &[][..]),
+    ] {
+        let mut s = a + draw(rng, config.pilaster_spacing) * 0.5;
+        while s < b - 1.0 {
+            let clear = doors
+                .iter()
+                .all(|&(dc, dw)| (s - dc).abs() > 0.5 * dw + half + 0.3);
+            if clear {
+                let face = c + sign * 0.5 * t;
+                let (f0, f1) = if sign < 0.0 {
+                    (face - depth, face)
+                } else {
+                    (face, face + depth)
+                };
+                if horizontal {
+                    d.push(
+                        [s - half, f0, 0.0],
+                        [s + half, f1, ceiling],
+                        BoxKind::Pillar,
+                    );
+                } else {
+                    d.push(
+                        [f0, s - half, 0.0],
+                        [f1, s + half, ceiling],
+                        BoxKind::Pillar,
+                    );
+                }
+            }
+            s += draw(rng, config.pilaster_spacing);
+        }
+    }
+}
+
+/// Put furniture (and in large rooms a pillar) into `room`.
+fn furnish(d: &mut Draft<'_>, rng: &mut SimRng, room: &Room) {
+    let t = d.cfg.wall_thickness;
+    let inner = (
+        room.min + Vector2::repeat(0.5 * t),
+        room.max - Vector2::repeat(0.5 * t),
+    );
+    // Keep a 1.6 m deep, door-wide-plus-margin zone in front of the door free.
+    let across = Vector2::new(room.inward.y.abs(), room.inward.x.abs());
+    let door_a = room.door - across * 1.0;
+    let door_b = room.door + across * 1.0 + room.inward * 1.6;
+    let door_zone = (
+        Vector2::new(door_a.x.min(door_b.x), door_a.y.min(door_b.y)),
+        Vector2::new(door_a.x.max(door_b.x), door_a.y.max(door_b.y)),
+    );
+    let mut placed: Vec<(Vector2<f64>, Vector2<f64>)> = vec![door_zone];
+    let size = inner.1 - inner.0;
+    if size.x * size.y > 35.0 && size.x > 4.0 && size.y > 4.0 {
+        for _ in 0..10 {
+            let c = Vector2::new(
+                rng.range(inner.0.x + 1.5, inner.1.x - 1.5),
+                rng.range(inner.0.y + 1.5, inner.1.y - 1.5),
+            );
+            let fp = (c - Vector2::repeat(0.2), c + Vector2::repeat(0.2));
+            if placed.iter().all(|&p| !overlaps(fp, p, 0.8)) {
+                d.push(
+                    [fp.0.x, fp.0.y, 0.0],
+                    [fp.1.x, fp.1.y, d.ceiling],
+                    BoxKind::Pillar,
+                );
+                placed.push(fp);
+                break;
+            }
+        }
+    }
+    let (lo, hi) = d.cfg.furniture_per_room;
+    let count = lo + rng.index(hi - lo + 1);
+    for _ in 0..count {
+        // Desk, cabinet or crate: (length along the wall, depth, height) ranges.
+        let (len, depth, height) = match rng.index(3) {
+            0 => (
+                rng.range(1.2, 1.6),
+                rng.range(0.6, 0.8),
+                rng.range(0.72, 0.76),
+            ),
+            1 => (
+                rng.range(0.8, 1.2),
+                rng.range(0.4, 0.6),
+                rng.range(1.8, 2.0),
+            ),
+            _ => (
+                rng.range(0.5, 0.8),
+                rng.range(0.5, 0.8),
+                rng.range(0.5, 1.0),
+            ),
+        };
+        for _ in 0..20 {
+            let side = rng.index(4);
+            let along_x = side < 2;
+            let (sx, sy) = if along_x { (len, depth) } else { (depth, len) };
+            if sx > size.x - 0.2 || sy > size.y - 0.2 {
+                continue;
+            }
+            let gap = 0.05;
+            let (x0, y0) = match side {
+                0 => (rng.range(inner.0.x, inner.1.x - sx), inner.0.y + gap),
+                1 => (rng.range(inner.0.x, inner.1.x - sx), inner.1.y - gap - sy),
+                2 => (inner.0.x + gap, rng.range(inner.0.y, inner.1.y - sy)),
+                _ => (inner.1.x - gap - sx, rng.range(inner.0.y, inner.1.y - sy)),
+            };
+            let fp = (Vector2::new(x0, y0), Vector2::new(x0 + sx, y0 + sy));
+            if placed.iter().all(|&p| !overlaps(fp, p, 0.3)) {
+                d.push(
+                    [fp.0.x, fp.0.y, 0.0],
+                    [fp.1.x, fp.1.y, height],
+                    BoxKind::Furniture,
+                );
+                placed.push(fp);
+                break;
+            }
+        }
+    }
+}

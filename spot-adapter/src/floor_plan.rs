@@ -1,0 +1,95 @@
+//! The building's ground-truth floor plan: which plan-view points a walking robot cannot occupy,
+//! as a predicate and as a [`BitGrid`].
+
+use nalgebra::Vector2;
+use slam_core::{BitGrid, GridGeometry};
+
+use crate::building::Building;
+use crate::error::AdapterError;
+
+/// Boxes whose bottom lies at or below this height (metres) block a walking robot; lintels above
+/// doors (2.1 m) do not. Spot is 0.84 m tall with its LiDAR, so anything lower than this
+/// obstructs it.
+pub const OBSTACLE_HEIGHT: f64 = 1.0;
+
+impl Building {
+    /// Whether the plan-view point `p` (metres) lies inside a wall, pillar or piece of furniture,
+    /// or outside the building.
+    #[must_use]
+    pub fn is_obstacle(&self, p: Vector2<f64>) -> bool {
+        if !(p.x > 0.0 && p.y > 0.0 && p.x < self.size.x && p.y < self.size.y) {
+            return true;
+        }
+        self.boxes
+            .iter()
+            .any(|b| b.min.z < OBSTACLE_HEIGHT && b.contains_xy(p))
+    }
+
+    /// Distance (metres) from `p` to the nearest obstacle footprint or the building's outline;
+    /// zero inside an obstacle.
+    #[must_use]
+    pub fn clearance(&self, p: Vector2<f64>) -> f64 {
+        let outline =
+            p.x.min(p.y)
+                .min(self.size.x - p.x)
+                .min(self.size.y - p.y)
+                .max(0.0);
+        self.boxes
+            .iter()
+            .filter(|b| b.min.z < OBSTACLE_HEIGHT)
+            .map(|b| {
+                let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
+                let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
+                dx.hypot(dy)
+            })
+            .fold(outline, f64::min)
+    }
+
+    /// The ground-truth occupancy grid at `resolution` metres per cell, covering the building
+    /// with its corner at the world origin. A cell is blocked when any obstacle footprint
+    /// overlaps it (conservative, so thin walls are never lost) or it lies outside the building.
+    ///
+    /// # Errors
+    /// [`AdapterError::Grid`] for a resolution that is not finite and positive or a grid too
+    /// large.
+    pub fn occupancy_grid(&self, resolution: f64) -> Result<BitGrid, AdapterError> {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), resolution)?;
+        let width = (self.size.x / resolution).ceil().max(1.0);
+        let height = (self.size.y / resolution).ceil().max(1.0);
+        if width > f64::from(u32::MAX) || height > f64::from(u32::MAX) {
+            return Err(slam_core::GridError::TooLarge {
+                width: u32::MAX,
+                height: u32::MAX,
+                max_cells: slam_core::MAX_GRID_CELLS,
+            }
+            .into());
+        }
+        let (w, h) = (width as u32, height as u32);
+        let mut grid = BitGrid::new(w, h)?.with_geometry(geometry);
+        let cells = |lo: f64, hi: f64, n: u32| {
+            let a = (lo / resolution).floor().max(0.0) as u32;
+            let b = ((hi / resolution).ceil() as i64 - 1).clamp(0, i64::from(n) - 1) as u32;
+            (a.min(n - 1), b)
+        };
+        for b in self.boxes.iter().filter(|b| b.min.z < OBSTACLE_HEIGHT) {
+            let (x0, x1) = cells(b.min.x, b.max.x, w);
+            let (y0, y1) = cells(b.min.y, b.max.y, h);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    grid.set(slam_core::Cell::new(x, y), true)?;
+                }
+            }
+        }
+        // Cells reaching past the building's outline (the last row and column when the size is
+        // not a multiple of the resolution) are outside.
+        for y in 0..h {
+            for x in 0..w {
+                let far = Vector2::new(f64::from(x + 1), f64::from(y + 1)) * resolution;
+                if far.x > self.size.x + 1e-9 || far.y > self.size.y + 1e-9 {
+                    grid.set(slam_core::Cell::new(x, y), true)?;
+                }
+            }
+        }
+        Ok(grid)
+    }
+}

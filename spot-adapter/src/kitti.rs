@@ -1,0 +1,196 @@
+//! KITTI-style sequence folders, so the pipeline runs on public data:
+//!
+//! ```text
+//! DIR/velodyne/000000.bin   scans (float32 x y z reflectance), sorted by name
+//! DIR/poses.txt             optional: ground truth, one 3x4 [R|t] per scan (world_T_cam0)
+//! DIR/times.txt             optional: one stamp (seconds) per scan; else 10 Hz from 0
+//! DIR/calib.txt             optional: a "Tr:" line, the LiDAR pose in the camera frame
+//! ```
+//!
+//! KITTI's poses are those of the left camera, so the camera is the "body" here and `Tr` its
+//! `body_T_lidar` (identity without `calib.txt`). KITTI has no robot odometry: `odom_T_body` is
+//! either the identity for every scan (the engine then predicts no motion) or, on request, the
+//! ground truth itself (for checking the mapping half alone).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use slam_core::Pose3;
+use slam_core::io::{parse_kitti_poses, read_kitti_bin, read_kitti_poses};
+
+use crate::error::AdapterError;
+use crate::sample::Sample;
+
+/// Where a KITTI sequence's odometry comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum KittiOdometry {
+    /// The identity for every scan: no odometry.
+    #[default]
+    None,
+    /// The ground-truth poses (requires `poses.txt`).
+    GroundTruth,
+}
+
+/// A KITTI-style sequence folder.
+#[derive(Clone, Debug)]
+pub struct KittiSequence {
+    scans: Vec<PathBuf>,
+    stamps: Vec<f64>,
+    poses: Option<Vec<Pose3>>,
+    body_t_lidar: Pose3,
+    odometry: KittiOdometry,
+}
+
+fn read_text(path: &Path) -> Result<String, AdapterError> {
+    fs::read_to_string(path).map_err(|e| AdapterError::io(path, e))
+}
+
+/// The `Tr:` line of a KITTI `calib.txt` as a pose.
+fn parse_calib(path: &Path, text: &str) -> Result<Option<Pose3>, AdapterError> {
+    let Some(line) = text.lines().find_map(|l| l.trim().strip_prefix("Tr:")) else {
+        return Ok(None);
+    };
+    // The pose reader checks and re-orthonormalises the rotation.
+    let pose = parse_kitti_poses(line)?
+        .pop()
+        .ok_or_else(|| AdapterError::Recording {
+            path: path.to_path_buf(),
+            message: "empty Tr line".into(),
+        })?;
+    Ok(Some(pose))
+}
+
+impl KittiSequence {
+    /// Open the sequence in `dir`.
+    ///
+    /// # Errors
+    /// [`AdapterError::Io`] without a readable `velodyne` folder, [`AdapterError::Format`] for
+    /// malformed pose, time or calibration files, [`AdapterError::Recording`] when the counts of
+    /// scans, poses and times differ or `GroundTruth` odometry is asked for without poses.
+    pub fn open(dir: impl AsRef<Path>, odometry: KittiOdometry) -> Result<Self, AdapterError> {
+        let dir = dir.as_ref();
+        let velodyne = dir.join("velodyne");
+        let mut scans: Vec<PathBuf> = fs::read_dir(&velodyne)
+            .map_err(|e| AdapterError::io(&velodyne, e))?
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "bin"))
+            .collect();
+        scans.sort();
+        let bad = |path: PathBuf, message: String| AdapterError::Recording { path, message };
+        let poses_path = dir.join("poses.txt");
+        let poses = if poses_path.exists() {
+            let p = read_kitti_poses(&poses_path)?;
+            if p.len() != scans.len() {
+                return Err(bad(
+                    poses_path,
+                    format!("{} poses for {} scans", p.len(), scans.len()),
+                ));
+            }
+            Some(p)
+        } else {
+            None
+        };
+        let times_path = dir.join("times.txt");
+        let stamps = if times_path.exists() {
+            let text = read_text(&times_path)?;
+            let t: Vec<f64> = text
+                .split_whitespace()
+                .map(|v| v.parse::<f64>().ok().filter(|x| x.is_finite()))
+                .collect::<Option<_>>()
+                .ok_or_else(|| bad(times_path.clone(), "a time is not a finite number".into()))?;
+            if t.len() != scans.len() {
+                return Err(bad(
+                    times_path,
+                    format!("{} times for {} scans", t.len(), scans.len()),
+                ));
+            }
+            t
+        } else {
+            (0..scans.len()).map(|i| i as f64 * 0.1).collect()
+        };
+        let calib_path = dir.join("calib.txt");
+        let body_t_lidar = if calib_path.exists() {
+            parse_calib(&calib_path, &read_text(&calib_path)?)?.unwrap_or_else(Pose3::identity)
+        } else {
+            Pose3::identity()
+        };
+        if odometry == KittiOdometry::GroundTruth && poses.is_none() {
+            return Err(bad(
+                poses_path,
+                "ground-truth odometry needs poses.txt".into(),
+            ));
+        }
+        Ok(Self {
+            scans,
+            stamps,
+            poses,
+            body_t_lidar,
+            odometry,
+        })
+    }
+
+    /// Number of scans.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.scans.len()
+    }
+
+    /// Whether the sequence has no scan.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.scans.is_empty()
+    }
+
+    /// The LiDAR pose in the camera ("body") frame.
+    #[must_use]
+    pub fn body_t_lidar(&self) -> Pose3 {
+        self.body_t_lidar
+    }
+
+    /// Ground-truth poses (`world_T_cam0`), when the folder has them.
+    #[must_use]
+    pub fn poses(&self) -> Option<&[Pose3]> {
+        self.poses.as_deref()
+    }
+
+    /// Scan stamps (seconds).
+    #[must_use]
+    pub fn stamps(&self) -> &[f64] {
+        &self.stamps
+    }
+
+    /// Sample `i` (its scan read from disk), `None` past the end.
+    ///
+    /// # Errors
+    /// [`AdapterError::Format`] when the scan cannot be read.
+    pub fn sample(&self, i: usize) -> Option<Result<Sample, AdapterError>> {
+        let path = self.scans.get(i)?;
+        let gt = self.poses.as_ref().map(|p| p[i]);
+        let odom_t_body = match self.odometry {
+            KittiOdometry::GroundTruth => gt.unwrap_or_else(Pose3::identity),
+            KittiOdometry::None => Pose3::identity(),
+        };
+        Some(
+            read_kitti_bin(path)
+                .map_err(AdapterError::from)
+                .map(|cloud| Sample {
+                    stamp: self.stamps[i],
+                    odom_t_body,
+                    body_t_lidar: self.body_t_lidar,
+                    cloud,
+                    ground_truth: gt,
+                }),
+        )
+    }
+
+    /// Every sample in order, each scan read when reached.
+    #[must_use]
+    pub fn samples(&self) -> impl ExactSizeIterator<Item = Result<Sample, AdapterError>> + '_ {
+        (0..self.len()).map(|i| {
+            self.sample(i)
+                .unwrap_or_else(|| Err(AdapterError::InvalidConfig("index out of range".into())))
+        })
+    }
+}

@@ -1,0 +1,192 @@
+//! The simulated Spot: walks a route through a [`Building`], scanning with a VLP-16 and
+//! reporting drifting odometry, one [`Sample`] per LiDAR turn.
+
+use slam_core::Pose3;
+use slam_core::io::StampedPose;
+
+use crate::building::{Building, BuildingConfig};
+use crate::error::AdapterError;
+use crate::frames::SpotGeometry;
+use crate::lidar::{Vlp16, Vlp16Config};
+use crate::odometry::{OdometryDriftConfig, OdometryModel};
+use crate::recording::{Recording, RecordingWriter};
+use crate::rng::SimRng;
+use crate::route::Route;
+use crate::sample::Sample;
+
+/// Settings of a simulated run.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SimulationConfig {
+    /// Seeds the sensor noise and the odometry drift (the building has its own seed).
+    pub seed: u64,
+    /// Walking speed, 0.6 m/s (the thesis' runs).
+    pub speed: f64,
+    /// The LiDAR; one sample per turn, so its `rotation_rate` (5 Hz) is the sample rate.
+    pub lidar: Vlp16Config,
+    /// The odometry's drift.
+    pub odometry: OdometryDriftConfig,
+    /// Body height and LiDAR mounting.
+    pub spot: SpotGeometry,
+}
+
+impl Default for SimulationConfig {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            speed: 0.6,
+            lidar: Vlp16Config::default(),
+            odometry: OdometryDriftConfig::default(),
+            spot: SpotGeometry::default(),
+        }
+    }
+}
+
+/// A simulated run: an iterator of [`Sample`]s with ground truth attached.
+///
+/// ```
+/// use spot_adapter::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
+///
+/// let building = Building::generate(3, &BuildingConfig::default())?;
+/// let route = Route::corridor_loop(&building);
+/// let sim = SimulatedSpot::new(building, &route, &SimulationConfig::default())?;
+/// // 0.6 m/s at 5 Hz: a sample every 0.12 m.
+/// assert_eq!(sim.len(), (route.length() / 0.12).ceil() as usize + 1);
+/// for sample in sim.take(2) {
+///     assert!(sample.cloud.len() > 20_000);
+///     assert!(sample.ground_truth.is_some());
+/// }
+/// # Ok::<(), spot_adapter::AdapterError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SimulatedSpot {
+    building: Building,
+    lidar: Vlp16,
+    odometry: OdometryModel,
+    noise: SimRng,
+    body_t_lidar: Pose3,
+    truth: Vec<(f64, Pose3)>,
+    next: usize,
+}
+
+impl SimulatedSpot {
+    /// A run along `route` through `building`.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry, speed or rate settings.
+    pub fn new(
+        building: Building,
+        route: &Route,
+        config: &SimulationConfig,
+    ) -> Result<Self, AdapterError> {
+        let lidar = Vlp16::new(config.lidar.clone())?;
+        let truth = route.walk(
+            config.speed,
+            config.lidar.rotation_rate,
+            config.spot.body_height,
+        )?;
+        Ok(Self {
+            building,
+            lidar,
+            odometry: OdometryModel::new(config.odometry.clone(), config.seed)?,
+            noise: SimRng::new(config.seed, 0x11da_4000),
+            body_t_lidar: config.spot.body_t_lidar,
+            truth,
+            next: 0,
+        })
+    }
+
+    /// The default building for `building_seed` and one lap of its corridor loop, with
+    /// `config` for the rest.
+    ///
+    /// # Errors
+    /// As [`Building::generate`] and [`SimulatedSpot::new`].
+    pub fn corridor_loop(
+        building_seed: u64,
+        config: &SimulationConfig,
+    ) -> Result<Self, AdapterError> {
+        let building = Building::generate(building_seed, &BuildingConfig::default())?;
+        let route = Route::corridor_loop(&building);
+        Self::new(building, &route, config)
+    }
+
+    /// The building walked through.
+    #[must_use]
+    pub fn building(&self) -> &Building {
+        &self.building
+    }
+
+    /// The LiDAR model.
+    #[must_use]
+    pub fn lidar(&self) -> &Vlp16 {
+        &self.lidar
+    }
+
+    /// The LiDAR mounting (`body_T_lidar`).
+    #[must_use]
+    pub fn body_t_lidar(&self) -> Pose3 {
+        self.body_t_lidar
+    }
+
+    /// The whole ground-truth trajectory `world_T_body`, one pose per sample.
+    #[must_use]
+    pub fn ground_truth(&self) -> Vec<StampedPose> {
+        self.truth
+            .iter()
+            .map(|&(stamp, pose)| StampedPose { stamp, pose })
+            .collect()
+    }
+
+    /// Number of samples the whole run yields.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.truth.len()
+    }
+
+    /// Run the remaining samples into a recording in `dir` and open it.
+    ///
+    /// # Errors
+    /// As [`RecordingWriter::write`], [`RecordingWriter::finish`] and [`Recording::open`].
+    pub fn record(self, dir: impl AsRef<std::path::Path>) -> Result<Recording, AdapterError> {
+        let mut writer = RecordingWriter::create(dir, self.body_t_lidar)?;
+        for sample in self {
+            writer.write(&sample)?;
+        }
+        Recording::open(writer.finish()?)
+    }
+
+    /// Whether the run yields no sample (never, for a valid route).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.truth.is_empty()
+    }
+}
+
+impl Iterator for SimulatedSpot {
+    type Item = Sample;
+
+    fn next(&mut self) -> Option<Sample> {
+        let &(stamp, world_t_body) = self.truth.get(self.next)?;
+        self.next += 1;
+        let odom_t_body = self.odometry.step(&world_t_body);
+        let cloud = self.lidar.scan(
+            &self.building,
+            &(world_t_body * self.body_t_lidar),
+            &mut self.noise,
+        );
+        Some(Sample {
+            stamp,
+            odom_t_body,
+            body_t_lidar: self.body_t_lidar,
+            cloud,
+            ground_truth: Some(world_t_body),
+        })
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.truth.len() - self.next;
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for SimulatedSpot {}

@@ -1,0 +1,169 @@
+//! The generated building: determinism, scale, floor plan and ray casting against a brute-force
+//! oracle.
+
+use nalgebra::{Point3, Vector2, Vector3};
+use spot_adapter::{Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox};
+
+fn building(seed: u64) -> Building {
+    Building::generate(seed, &BuildingConfig::default()).unwrap()
+}
+
+/// Brute force: every box, the floor and the ceiling.
+fn brute_force(b: &Building, o: &Point3<f64>, d: &Vector3<f64>, max: f64) -> Option<f64> {
+    let slab = |bx: &SolidBox| {
+        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+        for k in 0..3 {
+            if d[k].abs() < 1e-300 {
+                if o[k] < bx.min[k] || o[k] > bx.max[k] {
+                    return None;
+                }
+                continue;
+            }
+            let a = (bx.min[k] - o[k]) / d[k];
+            let c = (bx.max[k] - o[k]) / d[k];
+            t0 = t0.max(a.min(c));
+            t1 = t1.min(a.max(c));
+        }
+        (t0 <= t1).then_some(t0)
+    };
+    let mut best = f64::INFINITY;
+    for bx in b.boxes() {
+        if let Some(t) = slab(bx) {
+            best = best.min(t);
+        }
+    }
+    if d.z < 0.0 {
+        best = best.min(-o.z / d.z);
+    }
+    if d.z > 0.0 {
+        best = best.min((b.ceiling_height() - o.z) / d.z);
+    }
+    (best < max).then_some(best)
+}
+
+#[test]
+fn same_seed_same_building_and_realistic_scale() {
+    for seed in 0..6 {
+        let a = building(seed);
+        assert_eq!(a.boxes(), building(seed).boxes());
+        assert_ne!(a.boxes(), building(seed + 100).boxes());
+        let loop_len = Route::corridor_loop(&a).length();
+        assert!(loop_len >= 100.0, "seed {seed}: loop {loop_len} m");
+        assert!((2.5..=3.0).contains(&a.ceiling_height()));
+        let free = a.corridor_width() - 0.2;
+        assert!((1.5..=2.5).contains(&free), "corridor {free} m");
+        for r in a.rooms() {
+            let size = r.max - r.min;
+            assert!(
+                size.x.min(size.y) >= 3.0 && size.x.max(size.y) <= 10.5,
+                "room {size:?}"
+            );
+            assert!(
+                a.clearance(r.entry_point()) > 0.4,
+                "entry of {r:?} is not free"
+            );
+        }
+        let kinds = |k| a.boxes().iter().filter(|b| b.kind == k).count();
+        assert!(kinds(spot_adapter::BoxKind::Furniture) >= a.rooms().len());
+        assert!(kinds(spot_adapter::BoxKind::Pillar) > 10);
+        assert!(kinds(spot_adapter::BoxKind::Lintel) == a.rooms().len());
+    }
+}
+
+#[test]
+fn ray_cast_matches_brute_force() {
+    let b = building(11);
+    let route = Route::corridor_loop(&b);
+    let mut rng = SimRng::new(5, 5);
+    let mut hits = [0usize; 3];
+    for i in 0..4000 {
+        let p = route.point_at(route.length() * f64::from(i) / 4000.0);
+        let o = Point3::new(
+            p.x + rng.range(-0.3, 0.3),
+            p.y + rng.range(-0.3, 0.3),
+            rng.range(0.2, 2.4),
+        );
+        let d = Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(0.4)).normalize();
+        // Axis-parallel rays too (zero direction components).
+        let d = if i % 7 == 0 {
+            Vector3::new(d.x.signum(), 0.0, 0.0)
+        } else {
+            d
+        };
+        let fast = b.cast_ray(&o, &d, 100.0);
+        let slow = brute_force(&b, &o, &d, 100.0);
+        match (fast, slow) {
+            (Some(f), Some(s)) => {
+                assert!((f.range - s).abs() < 1e-9, "ray {i}: {} vs {s}", f.range);
+                hits[match f.target {
+                    HitTarget::Box(_) => 0,
+                    HitTarget::Floor => 1,
+                    HitTarget::Ceiling => 2,
+                }] += 1;
+            }
+            (None, None) => {}
+            other => panic!("ray {i}: {other:?}"),
+        }
+    }
+    assert!(
+        hits.iter().all(|&h| h > 100),
+        "every kind of surface is hit: {hits:?}"
+    );
+}
+
+#[test]
+fn occupancy_grid_agrees_with_obstacle_test() {
+    let b = building(2);
+    let grid = b.occupancy_grid(0.1).unwrap();
+    let geo = *grid.geometry();
+    assert!((f64::from(grid.width()) * 0.1 - b.size().x).abs() < 0.1 + 1e-9);
+    let mut rng = SimRng::new(1, 1);
+    let (mut blocked, mut free) = (0, 0);
+    for _ in 0..20_000 {
+        let p = Vector2::new(rng.range(0.0, b.size().x), rng.range(0.0, b.size().y));
+        let (x, y) = geo.cell_coords(p);
+        let cell = slam_core::Cell::new(x as u32, y as u32);
+        if b.is_obstacle(p) {
+            // Conservative rasterisation: a point inside an obstacle is never in a free cell.
+            assert!(grid.is_blocked(cell), "{p:?}");
+            blocked += 1;
+        } else if b.clearance(p) > 0.1 * std::f64::consts::SQRT_2 {
+            // A point farther than a cell diagonal from every obstacle is in a free cell.
+            assert!(!grid.is_blocked(cell), "{p:?}");
+            free += 1;
+        }
+    }
+    assert!(blocked > 1000 && free > 5000, "{blocked} {free}");
+}
+
+#[test]
+fn routes_stay_clear_of_obstacles() {
+    let b = building(4);
+    let lap = Route::corridor_loop(&b);
+    for (_, pose) in lap.walk(0.6, 5.0, 0.5).unwrap() {
+        let p = pose.translation.vector.xy();
+        assert!(b.clearance(p) > 0.4, "loop passes {p:?}");
+    }
+    let rooms = b.rooms();
+    let config = RouteConfig::default();
+    for (i, j) in [(0, rooms.len() - 1), (3, rooms.len() / 2), (1, 2)] {
+        let (s, g) = (rooms[i].entry_point(), rooms[j].entry_point());
+        let route = Route::between(&b, s, g, &config).unwrap();
+        assert_eq!(route.points()[0], s);
+        assert_eq!(*route.points().last().unwrap(), g);
+        assert!(route.length() >= (g - s).norm());
+        let steps = (route.length() / 0.02) as usize;
+        for k in 0..=steps {
+            let p = route.point_at(k as f64 * 0.02);
+            assert!(
+                b.clearance(p) >= config.clearance - 1e-9,
+                "route {i}->{j} passes {p:?}"
+            );
+        }
+    }
+    let wall = Vector2::new(0.05, 3.0);
+    assert!(matches!(
+        Route::between(&b, wall, rooms[0].entry_point(), &config),
+        Err(spot_adapter::AdapterError::BlockedEndpoint { which: "start", .. })
+    ));
+}
