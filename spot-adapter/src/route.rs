@@ -145,17 +145,17 @@ impl Route {
         let mut last_yaw: Option<f64> = None;
         for k in 0..=n {
             let s = (k as f64 * step).min(len);
-            // At the very end of a closed route evaluate just before the wrap so that the
-            // heading continues the lap instead of jumping to the start's.
-            let pose = self.pose_at(if self.closed && k == n { len - 1e-9 } else { s });
+            // At the very end of a closed route take the heading just before the wrap so that
+            // it continues the lap instead of jumping to the start's.
+            let pose = self.pose_at(if self.closed && k == n { len - 1e-6 } else { s });
             let mut yaw = pose.rotation.angle();
+            let t = self.point_at(s);
             // Keep yaw continuous (no jumps of 2 pi), though the pose does not care.
             if let Some(prev) = last_yaw {
                 yaw = prev + (yaw - prev + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
                     - std::f64::consts::PI;
             }
             last_yaw = Some(yaw);
-            let t = pose.translation.vector;
             out.push((
                 k as f64 / rate,
                 Pose3::from_parts(

@@ -1,6 +1,10 @@
 //! The generated building: determinism, scale, floor plan and ray casting against a brute-force
 //! oracle.
 
+// Test helpers outside #[test] functions unwrap too, and exact float equality is the point
+// where stored values must round-trip bit for bit.
+#![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
+
 use nalgebra::{Point3, Vector2, Vector3};
 use spot_adapter::{Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox};
 

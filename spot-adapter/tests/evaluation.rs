@@ -1,0 +1,194 @@
+//! ATE, alignment and drift against closed-form oracles.
+
+// Test helpers outside #[test] functions unwrap too, and exact float equality is the point
+// where stored values must round-trip bit for bit.
+#![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
+
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3, Vector6};
+use slam_core::io::StampedPose;
+use slam_core::{Pose3, se3_exp};
+use spot_adapter::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, SimRng, absolute_trajectory_error, align_rigid, associate,
+    end_point_drift, loop_end_point_error, path_length, segment_drift,
+};
+
+/// A wandering 3D trajectory: a circle of radius 5 m with a gentle climb, 0.1 s apart.
+fn reference(n: usize) -> Vec<StampedPose> {
+    (0..n)
+        .map(|i| {
+            let a = i as f64 * 0.02;
+            StampedPose {
+                stamp: i as f64 * 0.1,
+                pose: Pose3::from_parts(
+                    Translation3::new(5.0 * a.cos(), 5.0 * a.sin(), 0.01 * i as f64),
+                    UnitQuaternion::from_euler_angles(0.0, 0.0, a + 1.5),
+                ),
+            }
+        })
+        .collect()
+}
+
+fn random_pose(rng: &mut SimRng) -> Pose3 {
+    se3_exp(&Vector6::from_fn(|_, _| rng.normal(1.0)))
+}
+
+#[test]
+fn rigidly_moved_trajectory_has_zero_ate() {
+    let mut rng = SimRng::new(1, 1);
+    let gt = reference(300);
+    for _ in 0..5 {
+        let t = random_pose(&mut rng);
+        let est: Vec<StampedPose> = gt
+            .iter()
+            .map(|p| StampedPose {
+                stamp: p.stamp,
+                pose: t * p.pose,
+            })
+            .collect();
+        let ate = absolute_trajectory_error(&est, &gt, DEFAULT_MAX_STAMP_DIFFERENCE).unwrap();
+        assert!(ate.rmse < 1e-9 && ate.max < 1e-9, "{ate:?}");
+        assert_eq!(ate.pairs, 300);
+        // The alignment undoes the transform.
+        let back = ate.alignment * t;
+        assert!(back.translation.vector.norm() < 1e-9 && back.rotation.angle() < 1e-9);
+    }
+}
+
+#[test]
+fn alignment_is_a_least_squares_minimum() {
+    let mut rng = SimRng::new(2, 2);
+    let a: Vec<Point3<f64>> = (0..50)
+        .map(|_| {
+            Point3::new(
+                rng.range(-5.0, 5.0),
+                rng.range(-5.0, 5.0),
+                rng.range(-1.0, 1.0),
+            )
+        })
+        .collect();
+    let t = random_pose(&mut rng);
+    let b: Vec<Point3<f64>> = a
+        .iter()
+        .map(|p| t * p + Vector3::new(rng.normal(0.1), rng.normal(0.1), rng.normal(0.1)))
+        .collect();
+    let best = align_rigid(&a, &b).unwrap();
+    let cost = |x: &Pose3| {
+        a.iter()
+            .zip(&b)
+            .map(|(p, q)| (x * p - q).norm_squared())
+            .sum::<f64>()
+    };
+    let c0 = cost(&best);
+    // Brute-force check: no small step in any of the 6 directions (or random ones) does better.
+    for k in 0..6 {
+        for s in [-1e-4, 1e-4, -1e-2, 1e-2] {
+            let mut xi = Vector6::zeros();
+            xi[k] = s;
+            assert!(
+                cost(&(se3_exp(&xi) * best)) >= c0 - 1e-12,
+                "direction {k} step {s}"
+            );
+        }
+    }
+    for _ in 0..200 {
+        let xi = Vector6::from_fn(|_, _| rng.normal(0.01));
+        assert!(cost(&(se3_exp(&xi) * best)) >= c0 - 1e-12);
+    }
+    // And a reflection would fit mirrored data; the guard must still return a rotation.
+    let mirrored: Vec<Point3<f64>> = a.iter().map(|p| Point3::new(p.x, p.y, -p.z)).collect();
+    let r = align_rigid(&a, &mirrored).unwrap();
+    assert!((r.rotation.to_rotation_matrix().matrix().determinant() - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn known_offsets_give_known_ate() {
+    // Every reference position appears twice (at two stamps), once estimated d above it and
+    // once d below. For any rigid T, |T(p + dz) - r|^2 + |T(p - dz) - r|^2 >= (2d)^2 / 2 (the
+    // parallelogram law), with equality for T = identity: the ATE is exactly d.
+    let d = 0.05;
+    let mut gt = Vec::new();
+    let mut est = Vec::new();
+    for (i, p) in reference(200).into_iter().enumerate() {
+        for (k, sign) in [(0, 1.0), (1, -1.0)] {
+            let stamp = (2 * i + k) as f64 * 0.1;
+            gt.push(StampedPose {
+                stamp,
+                pose: p.pose,
+            });
+            let mut q = p.pose;
+            q.translation.z += sign * d;
+            est.push(StampedPose { stamp, pose: q });
+        }
+    }
+    let ate = absolute_trajectory_error(&est, &gt, DEFAULT_MAX_STAMP_DIFFERENCE).unwrap();
+    assert!((ate.rmse - d).abs() < 1e-9, "{ate:?}");
+    assert!((ate.median - d).abs() < 1e-9 && (ate.max - d).abs() < 1e-9);
+}
+
+#[test]
+fn association_by_stamp() {
+    let gt = reference(10);
+    let est: Vec<StampedPose> = gt
+        .iter()
+        .skip(2)
+        .map(|p| StampedPose {
+            stamp: p.stamp + 0.004,
+            pose: p.pose,
+        })
+        .collect();
+    let pairs = associate(&est, &gt, 0.01);
+    assert_eq!(pairs, (0..8).map(|i| (i, i + 2)).collect::<Vec<_>>());
+    assert!(associate(&est, &gt, 0.001).is_empty());
+}
+
+#[test]
+fn scale_error_gives_known_drift() {
+    // A straight 100 m walk whose estimate overshoots by 2 %: every segment and the end point
+    // drift 2 %.
+    let gt: Vec<Pose3> = (0..=1000)
+        .map(|i| Pose3::translation(0.1 * f64::from(i), 0.0, 0.0))
+        .collect();
+    let est: Vec<Pose3> = gt
+        .iter()
+        .map(|p| Pose3::translation(p.translation.x * 1.02, 0.0, 0.0))
+        .collect();
+    assert!((path_length(&gt) - 100.0).abs() < 1e-9);
+    let d = end_point_drift(&est, &gt).unwrap();
+    assert!((d.end_point_error - 2.0).abs() < 1e-9 && (d.relative_drift - 0.02).abs() < 1e-12);
+    let s = segment_drift(&est, &gt, &spot_adapter::INDOOR_SEGMENT_LENGTHS, 10).unwrap();
+    assert!((s.translation - 0.02).abs() < 1e-9, "{s:?}");
+    assert!(s.rotation.abs() < 1e-12);
+    assert_eq!(s.per_length.len(), 5);
+    // 10 m segments start at poses 0, 10, ..., 900.
+    assert_eq!(s.per_length[0].2, 91);
+    // A heading error of 1 degree at the start of an otherwise perfect run: a segment of
+    // length L that starts after it has no error; the end point is off by 2 sin(0.5 deg) * 100.
+    let yaw = 1f64.to_radians();
+    let bent: Vec<Pose3> = gt
+        .iter()
+        .map(|p| Pose3::rotation(Vector3::z() * yaw) * p)
+        .collect();
+    let mut est = vec![gt[0]];
+    est.extend_from_slice(&bent[1..]);
+    let d = end_point_drift(&est, &gt).unwrap();
+    let expect = 2.0 * (0.5 * yaw).sin() * 100.0;
+    assert!((d.end_point_error - expect).abs() < 1e-9);
+    let s = segment_drift(&est, &gt, &[10.0], 1).unwrap();
+    // Only segments starting at pose 0 see the bend; the others are exact.
+    let first = (2.0 * (0.5 * yaw).sin() * 10.0) / 10.0;
+    assert!(
+        (s.translation - first / s.segments as f64).abs() < 1e-9,
+        "{s:?}"
+    );
+}
+
+#[test]
+fn loop_error_is_the_gap_between_ends() {
+    let poses = [
+        Pose3::translation(1.0, 2.0, 0.0),
+        Pose3::translation(5.0, 2.0, 0.0),
+        Pose3::translation(1.0, 2.3, 0.4),
+    ];
+    assert!((loop_end_point_error(&poses) - 0.5).abs() < 1e-12);
+    assert!(loop_end_point_error(&[]) == 0.0);
+}

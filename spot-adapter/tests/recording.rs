@@ -1,0 +1,142 @@
+//! Recordings and KITTI folders: round trips and malformed input.
+
+// Test helpers outside #[test] functions unwrap too, and exact float equality is the point
+// where stored values must round-trip bit for bit.
+#![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
+
+use std::path::PathBuf;
+
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
+use slam_core::io::{write_kitti_bin, write_kitti_poses};
+use slam_core::{PointCloud, Pose3};
+use spot_adapter::{
+    AdapterError, Building, BuildingConfig, KittiOdometry, KittiSequence, Recording, Route,
+    SimulatedSpot, SimulationConfig,
+};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("spot-adapter-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn short_run() -> SimulatedSpot {
+    let b = Building::generate(2, &BuildingConfig::default()).unwrap();
+    let c = b.corridor_loop()[0];
+    let route = Route::new(vec![c, c + Vector2::new(0.5, 0.0)], false).unwrap();
+    SimulatedSpot::new(b, &route, &SimulationConfig::default()).unwrap()
+}
+
+fn close(a: &Pose3, b: &Pose3) -> bool {
+    (a.translation.vector - b.translation.vector).norm() < 1e-12
+        && a.rotation.angle_to(&b.rotation) < 1e-12
+}
+
+#[test]
+fn recording_round_trip() {
+    let dir = temp_dir("round-trip");
+    let expected: Vec<_> = short_run().collect();
+    assert_eq!(expected.len(), 6);
+    let rec = short_run().record(&dir).unwrap();
+    assert_eq!(rec.len(), expected.len());
+    assert!(close(&rec.body_t_lidar(), &expected[0].body_t_lidar));
+    for (got, want) in rec.samples().zip(&expected) {
+        let got = got.unwrap();
+        assert_eq!(
+            got.cloud, want.cloud,
+            "clouds are stored exactly, channels included"
+        );
+        assert_eq!(got.stamp, want.stamp);
+        assert!(close(&got.odom_t_body, &want.odom_t_body));
+        assert!(close(
+            &got.ground_truth.unwrap(),
+            &want.ground_truth.unwrap()
+        ));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn inconsistent_recordings_are_errors() {
+    let dir = temp_dir("broken");
+    let _ = short_run().record(&dir).unwrap();
+    // One odometry line fewer than scans.
+    let odo = std::fs::read_to_string(dir.join("odometry.tum")).unwrap();
+    let cut: Vec<&str> = odo.lines().collect();
+    std::fs::write(dir.join("odometry.tum"), cut[..cut.len() - 1].join("\n")).unwrap();
+    assert!(matches!(
+        Recording::open(&dir),
+        Err(AdapterError::Recording { .. })
+    ));
+    std::fs::write(dir.join("odometry.tum"), odo).unwrap();
+    assert!(Recording::open(&dir).is_ok());
+    std::fs::write(dir.join("calibration.txt"), "body_T_lidar 0 0 0.3 0 0 0\n").unwrap();
+    assert!(matches!(
+        Recording::open(&dir),
+        Err(AdapterError::Recording { .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(matches!(
+        Recording::open(&dir),
+        Err(AdapterError::Io { .. })
+    ));
+}
+
+#[test]
+fn kitti_folder_reads_scans_poses_times_and_calibration() {
+    let dir = temp_dir("kitti");
+    std::fs::create_dir_all(dir.join("velodyne")).unwrap();
+    let mut poses = Vec::new();
+    for i in 0..3u8 {
+        let cloud = PointCloud::from_points(vec![Point3::new(f32::from(i), 1.0, 2.0); 4])
+            .with_intensity(vec![0.5; 4])
+            .unwrap();
+        write_kitti_bin(dir.join(format!("velodyne/{i:06}.bin")), &cloud).unwrap();
+        poses.push(Pose3::from_parts(
+            Translation3::new(f64::from(i), 0.0, 0.5),
+            UnitQuaternion::from_euler_angles(0.0, 0.1 * f64::from(i), 0.0),
+        ));
+    }
+    write_kitti_poses(dir.join("poses.txt"), &poses).unwrap();
+    std::fs::write(dir.join("times.txt"), "0.0\n0.1036\n0.2072\n").unwrap();
+    std::fs::write(
+        dir.join("calib.txt"),
+        "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: 0 -1 0 0.1 0 0 -1 -0.2 1 0 0 -0.3\n",
+    )
+    .unwrap();
+    let seq = KittiSequence::open(&dir, KittiOdometry::GroundTruth).unwrap();
+    assert_eq!(seq.len(), 3);
+    let tr = seq.body_t_lidar();
+    // Tr maps the LiDAR's x (forward) to the camera's z (forward).
+    assert!((tr * nalgebra::Vector3::x() - nalgebra::Vector3::z()).norm() < 1e-12);
+    assert!((tr.translation.vector - nalgebra::Vector3::new(0.1, -0.2, -0.3)).norm() < 1e-12);
+    for (i, s) in seq.samples().enumerate() {
+        let s = s.unwrap();
+        assert_eq!(s.cloud.points()[0].x, i as f32);
+        assert!((s.stamp - [0.0, 0.1036, 0.2072][i]).abs() < 1e-12);
+        assert!(
+            close(&s.odom_t_body, &poses[i])
+                || (s.odom_t_body.translation.vector - poses[i].translation.vector).norm() < 1e-9
+        );
+        assert_eq!(
+            s.ground_truth.map(|g| g.translation.vector),
+            Some(poses[i].translation.vector)
+        );
+    }
+    std::fs::remove_file(dir.join("poses.txt")).unwrap();
+    assert!(matches!(
+        KittiSequence::open(&dir, KittiOdometry::GroundTruth),
+        Err(AdapterError::Recording { .. })
+    ));
+    let seq = KittiSequence::open(&dir, KittiOdometry::None).unwrap();
+    assert_eq!(
+        seq.sample(1).unwrap().unwrap().odom_t_body,
+        Pose3::identity()
+    );
+    std::fs::write(dir.join("times.txt"), "0.0\n0.1\n").unwrap();
+    assert!(matches!(
+        KittiSequence::open(&dir, KittiOdometry::None),
+        Err(AdapterError::Recording { .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,173 @@
+//! The simulated robot: LiDAR returns at the ray-cast distance, determinism, odometry drift.
+
+// Test helpers outside #[test] functions unwrap too, and exact float equality is the point
+// where stored values must round-trip bit for bit.
+#![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
+
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3};
+use slam_core::Pose3;
+use spot_adapter::{
+    Building, BuildingConfig, OdometryDriftConfig, OdometryModel, Route, SimRng, SimulatedSpot,
+    SimulationConfig, SpotGeometry, Vlp16, Vlp16Config, end_point_drift,
+};
+
+fn noiseless() -> Vlp16Config {
+    let mut c = Vlp16Config::default();
+    c.range_noise = 0.0;
+    c
+}
+
+#[test]
+fn scan_points_lie_at_the_ray_cast_distance() {
+    let b = Building::generate(21, &BuildingConfig::default()).unwrap();
+    let lidar = Vlp16::new(noiseless()).unwrap();
+    let start = b.corridor_loop()[1];
+    let world_t_lidar = Pose3::from_parts(
+        Translation3::new(start.x - 0.3, start.y + 0.2, 0.8),
+        UnitQuaternion::from_euler_angles(0.02, -0.03, 0.7),
+    );
+    let cloud = lidar.scan(&b, &world_t_lidar, &mut SimRng::new(0, 0));
+    let (ring, time) = (cloud.ring().unwrap(), cloud.time().unwrap());
+    assert!(
+        cloud.len() > 28_000,
+        "closed building: nearly every ray returns"
+    );
+    for (k, p) in cloud.points().iter().enumerate().step_by(37) {
+        // Rebuild the ray from the ring and time channels alone.
+        let col = (f64::from(time[k]) / 0.2 * 1800.0).round();
+        let az = col * 0.2f64.to_radians();
+        let el = (-15.0 + 2.0 * f64::from(ring[k])).to_radians();
+        let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        let p64 = nalgebra::convert::<_, Vector3<f64>>(p.coords);
+        assert!(
+            (p64.normalize() - dir).norm() < 1e-5,
+            "point {k} off its beam"
+        );
+        // Independent oracle: march along the world ray in 1 mm steps to the first obstacle
+        // (inside a box, below the floor or above the ceiling).
+        let o = Point3::from(world_t_lidar.translation.vector);
+        let wd = world_t_lidar.rotation * dir;
+        let inside = |q: Point3<f64>| {
+            q.z <= 0.0
+                || q.z >= b.ceiling_height()
+                || b.boxes()
+                    .iter()
+                    .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
+        };
+        let r = p64.norm();
+        assert!(
+            !inside(o + wd * (r - 2e-3)),
+            "point {k}: free space ends before the return"
+        );
+        assert!(
+            inside(o + wd * (r + 2e-3)),
+            "point {k}: no surface at the return"
+        );
+    }
+}
+
+#[test]
+fn noise_and_dropouts_have_the_configured_size() {
+    let b = Building::generate(3, &BuildingConfig::default()).unwrap();
+    let start = b.corridor_loop()[2];
+    let pose = Pose3::translation(start.x, start.y, 0.8);
+    let clean = Vlp16::new(noiseless())
+        .unwrap()
+        .scan(&b, &pose, &mut SimRng::new(0, 0));
+    let mut noisy_cfg = Vlp16Config::default();
+    noisy_cfg.range_noise = 0.02;
+    let noisy = Vlp16::new(noisy_cfg)
+        .unwrap()
+        .scan(&b, &pose, &mut SimRng::new(0, 0));
+    assert_eq!(clean.len(), noisy.len());
+    let n = clean.len() as f64;
+    let var = clean
+        .points()
+        .iter()
+        .zip(noisy.points())
+        .map(|(a, b)| f64::from(b.coords.norm() - a.coords.norm()).powi(2))
+        .sum::<f64>()
+        / n;
+    assert!((var.sqrt() - 0.02).abs() < 0.001, "sigma {}", var.sqrt());
+    let mut drop_cfg = noiseless();
+    drop_cfg.dropout_probability = 0.1;
+    let dropped = Vlp16::new(drop_cfg)
+        .unwrap()
+        .scan(&b, &pose, &mut SimRng::new(0, 0));
+    let kept = dropped.len() as f64 / n;
+    assert!((kept - 0.9).abs() < 0.01, "kept {kept}");
+}
+
+#[test]
+fn same_seeds_same_samples() {
+    let mut config = SimulationConfig::default();
+    config.seed = 9;
+    let a: Vec<_> = SimulatedSpot::corridor_loop(5, &config)
+        .unwrap()
+        .take(3)
+        .collect();
+    let b: Vec<_> = SimulatedSpot::corridor_loop(5, &config)
+        .unwrap()
+        .take(3)
+        .collect();
+    assert_eq!(a, b);
+    let mut other = SimulationConfig::default();
+    other.seed = 10;
+    let c: Vec<_> = SimulatedSpot::corridor_loop(5, &other)
+        .unwrap()
+        .take(3)
+        .collect();
+    assert_ne!(a[2].cloud, c[2].cloud);
+    assert_ne!(a[2].odom_t_body, c[2].odom_t_body);
+    // The ground truth depends only on the building and the route.
+    assert_eq!(a[2].ground_truth, c[2].ground_truth);
+}
+
+#[test]
+fn walk_is_a_closed_lap_at_walking_speed() {
+    let sim = SimulatedSpot::corridor_loop(8, &SimulationConfig::default()).unwrap();
+    let gt = sim.ground_truth();
+    let first = gt[0].pose;
+    let last = gt[gt.len() - 1].pose;
+    assert!((first.translation.vector - last.translation.vector).norm() < 1e-9);
+    assert!((first.rotation.angle_to(&last.rotation)).abs() < 0.05);
+    for w in gt.windows(2) {
+        let step = (w[1].pose.translation.vector - w[0].pose.translation.vector).norm();
+        assert!((w[1].stamp - w[0].stamp - 0.2).abs() < 1e-9);
+        assert!(step <= 0.12 + 1e-9, "speed {} m/s", step / 0.2);
+        // Smooth heading: at most 0.6 m of chord per 0.12 m step turns under 0.3 rad.
+        assert!(w[0].pose.rotation.angle_to(&w[1].pose.rotation) < 0.3);
+        assert!((w[0].pose.translation.z - SpotGeometry::default().body_height).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn odometry_drifts_about_1_9_percent() {
+    let b = Building::generate(1, &BuildingConfig::default()).unwrap();
+    let lap = Route::corridor_loop(&b);
+    let walk = lap.walk(0.6, 5.0, 0.5).unwrap();
+    // Two laps (> 200 m) per seed.
+    let truth: Vec<Pose3> = walk
+        .iter()
+        .chain(walk.iter().skip(1))
+        .map(|w| w.1)
+        .collect();
+    let mut drifts = Vec::new();
+    let mut vertical = Vec::new();
+    for seed in 0..12 {
+        let mut odo = OdometryModel::new(OdometryDriftConfig::default(), seed).unwrap();
+        let est: Vec<Pose3> = truth.iter().map(|p| odo.step(p)).collect();
+        let d = end_point_drift(&est, &truth).unwrap();
+        drifts.push(d.relative_drift);
+        let e = est[0].inverse() * est[est.len() - 1];
+        vertical.push(e.translation.z.abs() / d.path_length);
+    }
+    let mean = drifts.iter().sum::<f64>() / drifts.len() as f64;
+    assert!((mean - 0.019).abs() < 0.002, "mean drift {mean}");
+    assert!(
+        drifts.iter().all(|d| (0.012..0.026).contains(d)),
+        "{drifts:?}"
+    );
+    let vmean = vertical.iter().sum::<f64>() / vertical.len() as f64;
+    assert!((0.002..0.006).contains(&vmean), "vertical drift {vmean}");
+}
