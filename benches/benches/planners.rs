@@ -61,6 +61,10 @@ fn planners(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("JumpPointSearch", name), |b| {
             b.iter(|| run(&mut jps, &sample));
         });
+        let mut jps_cells = JumpPointSearch::with_cell_scans(grid);
+        group.bench_function(BenchmarkId::new("JumpPointSearch_cells", name), |b| {
+            b.iter(|| run(&mut jps_cells, &sample));
+        });
         let mut blocks = JumpPointSearchPlus::new(grid);
         group.bench_function(BenchmarkId::new("JumpPointSearchPlus_blocks", name), |b| {
             b.iter(|| run(&mut blocks, &sample));

@@ -122,9 +122,24 @@ fn main() {
         let pre = t.elapsed().as_secs_f64() * 1e3;
         print("AStar", &ours(&mut astar, &scenarios), pre, 4.0);
         let t = Instant::now();
+        let mut cells_jps = JumpPointSearch::with_cell_scans(grid);
+        let pre = t.elapsed().as_secs_f64() * 1e3;
+        print(
+            "JumpPointSearch (cell scans)",
+            &ours(&mut cells_jps, &scenarios),
+            pre,
+            4.0,
+        );
+        let t = Instant::now();
         let mut jps = JumpPointSearch::new(grid);
         let pre = t.elapsed().as_secs_f64() * 1e3;
-        print("JumpPointSearch", &ours(&mut jps, &scenarios), pre, 4.0);
+        let bytes = 4.0 + jps.preprocessed_bytes() as f64 / cells;
+        print(
+            "JumpPointSearch (word scans)",
+            &ours(&mut jps, &scenarios),
+            pre,
+            bytes,
+        );
         let t = Instant::now();
         let mut blocks = JumpPointSearchPlus::new(grid);
         let pre = t.elapsed().as_secs_f64() * 1e3;

@@ -2,7 +2,7 @@
 //! published optimum (too long and too short both fail), and print per planner: scenarios,
 //! matched, mean and p99 microseconds per query, mean expanded nodes.
 //!
-//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-plus|jps-plus-tables|all]`
+//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]`
 //!
 //! Exits non-zero on any mismatch. Example:
 //! `cargo run --release --example movingai -- pathfind/tests/data/arena.map pathfind/tests/data/arena.map.scen`
@@ -12,10 +12,22 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use pathfind::movingai::{read_map, read_scenarios};
 use pathfind::{AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus};
-use slam_core::Planner;
+use slam_core::{BitGrid, Planner};
 
-const USAGE: &str =
-    "usage: movingai MAP SCEN [--planner dijkstra|astar|jps|jps-plus|jps-plus-tables|all]";
+const USAGE: &str = "usage: movingai MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]";
+
+/// The planner called `name` on the command line.
+fn build<'g>(name: &str, grid: &'g BitGrid) -> Result<Box<dyn Planner + 'g>> {
+    Ok(match name {
+        "dijkstra" => Box::new(Dijkstra::new(grid)),
+        "astar" => Box::new(AStar::new(grid)),
+        "jps" => Box::new(JumpPointSearch::new(grid)),
+        "jps-cells" => Box::new(JumpPointSearch::with_cell_scans(grid)),
+        "jps-plus" => Box::new(JumpPointSearchPlus::new(grid)),
+        "jps-plus-tables" => Box::new(JumpPointSearchPlus::with_jump_tables(grid)?),
+        other => bail!("unknown planner {other:?}; {USAGE}"),
+    })
+}
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -58,7 +70,14 @@ fn main() -> Result<()> {
         );
     }
     let names: Vec<&str> = if which == "all" {
-        vec!["dijkstra", "astar", "jps", "jps-plus", "jps-plus-tables"]
+        vec![
+            "dijkstra",
+            "astar",
+            "jps",
+            "jps-cells",
+            "jps-plus",
+            "jps-plus-tables",
+        ]
     } else {
         vec![which.as_str()]
     };
@@ -69,14 +88,7 @@ fn main() -> Result<()> {
     let mut failures = 0usize;
     for name in names {
         let t = Instant::now();
-        let mut planner: Box<dyn Planner> = match name {
-            "dijkstra" => Box::new(Dijkstra::new(grid)),
-            "astar" => Box::new(AStar::new(grid)),
-            "jps" => Box::new(JumpPointSearch::new(grid)),
-            "jps-plus" => Box::new(JumpPointSearchPlus::new(grid)),
-            "jps-plus-tables" => Box::new(JumpPointSearchPlus::with_jump_tables(grid)?),
-            other => bail!("unknown planner {other:?}; {USAGE}"),
-        };
+        let mut planner = build(name, grid)?;
         let setup_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut us = Vec::with_capacity(scenarios.len());
         let (mut matched, mut expanded) = (0usize, 0usize);

@@ -3,7 +3,10 @@
 //! `trailing_zeros` / `leading_zeros` find the first blocked cell and the first forced cell at
 //! once. Columns are scanned as rows of the transposed grid.
 
-use slam_core::BitGrid;
+use slam_core::{BitGrid, Cell};
+
+use crate::jump_search::Jumper;
+use crate::movement::{DIRECTIONS, free};
 
 /// Word `i` of a row, or all blocked for a row off the grid.
 #[inline]
@@ -129,5 +132,75 @@ fn scan_west(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32)
         carry_down = d << 63;
         mask = u64::MAX;
         i -= 1;
+    }
+}
+
+/// Jumps by word scans: rows of the grid for horizontal runs, rows of the transposed grid for
+/// vertical runs, and diagonal runs one step at a time with a word scan along both components.
+pub(crate) struct BlockJumper<'g> {
+    grid: &'g BitGrid,
+    transposed: BitGrid,
+}
+
+impl<'g> BlockJumper<'g> {
+    /// Builds the transposed grid (one more bit per cell).
+    pub(crate) fn new(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            transposed: grid.transposed(),
+        }
+    }
+
+    /// Bytes of the transposed grid.
+    pub(crate) fn bytes(&self) -> usize {
+        self.transposed.words().len() * 8
+    }
+
+    #[inline]
+    fn horizontal(&self, x: u32, y: u32, dx: i32, goal: Cell) -> Option<u32> {
+        scan_row(self.grid, x, y, dx > 0, (goal.y == y).then_some(goal.x))
+    }
+
+    #[inline]
+    fn vertical(&self, x: u32, y: u32, dy: i32, goal: Cell) -> Option<u32> {
+        scan_row(
+            &self.transposed,
+            y,
+            x,
+            dy > 0,
+            (goal.x == x).then_some(goal.y),
+        )
+    }
+}
+
+impl Jumper for BlockJumper<'_> {
+    #[inline]
+    fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell> {
+        let (dx, dy) = DIRECTIONS[d as usize];
+        if dy == 0 {
+            return self
+                .horizontal(c.x, c.y, dx, goal)
+                .map(|x| Cell::new(x, c.y));
+        }
+        if dx == 0 {
+            return self.vertical(c.x, c.y, dy, goal).map(|y| Cell::new(c.x, y));
+        }
+        let g = self.grid;
+        let (mut x, mut y) = (i64::from(c.x), i64::from(c.y));
+        let (dx64, dy64) = (i64::from(dx), i64::from(dy));
+        loop {
+            if !(free(g, x + dx64, y) && free(g, x, y + dy64) && free(g, x + dx64, y + dy64)) {
+                return None;
+            }
+            x += dx64;
+            y += dy64;
+            let (ux, uy) = (x as u32, y as u32);
+            if (ux == goal.x && uy == goal.y)
+                || self.horizontal(ux, uy, dx, goal).is_some()
+                || self.vertical(ux, uy, dy, goal).is_some()
+            {
+                return Some(Cell::new(ux, uy));
+            }
+        }
     }
 }

@@ -1,30 +1,63 @@
-//! Online Jump Point Search (Harabor & Grastien 2011), adapted to no corner cutting, stepping one
-//! cell at a time.
+//! Online Jump Point Search (Harabor & Grastien 2011), adapted to no corner cutting.
 
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
+use crate::block_scan::BlockJumper;
 use crate::components::Components;
 use crate::jump_search::{Jumper, jump_search};
 use crate::movement::{DIRECTIONS, can_step, free};
 use crate::search_space::SearchSpace;
 
-/// Jump Point Search: A* over jump points, found by scanning the grid one cell at a time. No
-/// preprocessing beyond connected components; see
-/// [`JumpPointSearchPlus`](crate::JumpPointSearchPlus) for word-at-a-time scans and jump tables.
+/// Jump Point Search: A* over jump points found online, with no per-grid tables.
+///
+/// [`JumpPointSearch::new`] finds straight jumps with 64-cell word scans (the block-based
+/// scanning of Harabor & Grastien 2014; vertical runs read a transposed copy of the grid, one
+/// more bit per cell). [`JumpPointSearch::with_cell_scans`] steps one cell at a time as in the
+/// 2011 paper: slower, kept as the textbook reference and for ablation. For precomputed jump
+/// distances see [`JumpPointSearchPlus::with_jump_tables`](crate::JumpPointSearchPlus).
 pub struct JumpPointSearch<'g> {
     grid: &'g BitGrid,
     components: Components,
     space: SearchSpace,
+    scans: Scans<'g>,
+}
+
+enum Scans<'g> {
+    Words(BlockJumper<'g>),
+    Cells(CellJumper<'g>),
 }
 
 impl<'g> JumpPointSearch<'g> {
-    /// A planner for `grid` (labels its connected components once).
+    /// A planner for `grid` with word scans (labels its connected components and transposes the
+    /// grid once).
     #[must_use]
     pub fn new(grid: &'g BitGrid) -> Self {
         Self {
             grid,
             components: Components::new(grid),
             space: SearchSpace::new(grid.width(), grid.height()),
+            scans: Scans::Words(BlockJumper::new(grid)),
+        }
+    }
+
+    /// A planner for `grid` that scans one cell at a time (labels its connected components once).
+    #[must_use]
+    pub fn with_cell_scans(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            components: Components::new(grid),
+            space: SearchSpace::new(grid.width(), grid.height()),
+            scans: Scans::Cells(CellJumper(grid)),
+        }
+    }
+
+    /// Bytes of preprocessed data beyond the grid and the component labels (the transposed
+    /// grid with word scans, nothing with cell scans).
+    #[must_use]
+    pub fn preprocessed_bytes(&self) -> usize {
+        match &self.scans {
+            Scans::Words(b) => b.bytes(),
+            Scans::Cells(_) => 0,
         }
     }
 }
@@ -86,13 +119,13 @@ impl Jumper for CellJumper<'_> {
 
 impl Planner for JumpPointSearch<'_> {
     fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
-        jump_search(
-            self.grid,
-            &self.components,
-            &mut self.space,
-            &CellJumper(self.grid),
-            start,
-            goal,
-        )
+        match &self.scans {
+            Scans::Words(j) => {
+                jump_search(self.grid, &self.components, &mut self.space, j, start, goal)
+            }
+            Scans::Cells(j) => {
+                jump_search(self.grid, &self.components, &mut self.space, j, start, goal)
+            }
+        }
     }
 }

@@ -2,17 +2,17 @@
 
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
-use crate::block_scan::scan_row;
+use crate::block_scan::BlockJumper;
 use crate::components::Components;
 use crate::error::PathfindError;
-use crate::jump_search::{Jumper, jump_search};
+use crate::jump_search::jump_search;
 use crate::jump_tables::{JumpTables, MAX_TABLE_SIDE};
-use crate::movement::{DIRECTIONS, free};
 use crate::search_space::SearchSpace;
 
-/// Jump Point Search whose straight jumps read 64 cells per step (Harabor & Grastien 2014), on
-/// the grid's rows and on a transposed copy for columns; or, when built with
-/// [`JumpPointSearchPlus::with_jump_tables`], JPS+ with precomputed jump distances (O(1) per
+/// Jump Point Search with the search mode chosen at construction: [`JumpPointSearchPlus::new`]
+/// scans 64 cells per step (Harabor & Grastien 2014; the same online search as
+/// [`JumpPointSearch::new`](crate::JumpPointSearch::new)), and
+/// [`JumpPointSearchPlus::with_jump_tables`] is JPS+ with precomputed jump distances (O(1) per
 /// jump, 16 bytes per cell, built once per grid).
 pub struct JumpPointSearchPlus<'g> {
     grid: &'g BitGrid,
@@ -34,10 +34,7 @@ impl<'g> JumpPointSearchPlus<'g> {
             grid,
             components: Components::new(grid),
             space: SearchSpace::new(grid.width(), grid.height()),
-            mode: Mode::Blocks(BlockJumper {
-                grid,
-                transposed: grid.transposed(),
-            }),
+            mode: Mode::Blocks(BlockJumper::new(grid)),
         }
     }
 
@@ -66,63 +63,8 @@ impl<'g> JumpPointSearchPlus<'g> {
     #[must_use]
     pub fn preprocessed_bytes(&self) -> usize {
         match &self.mode {
-            Mode::Blocks(b) => b.transposed.words().len() * 8,
+            Mode::Blocks(b) => b.bytes(),
             Mode::Tables(t) => t.bytes(),
-        }
-    }
-}
-
-struct BlockJumper<'g> {
-    grid: &'g BitGrid,
-    transposed: BitGrid,
-}
-
-impl BlockJumper<'_> {
-    #[inline]
-    fn horizontal(&self, x: u32, y: u32, dx: i32, goal: Cell) -> Option<u32> {
-        scan_row(self.grid, x, y, dx > 0, (goal.y == y).then_some(goal.x))
-    }
-
-    #[inline]
-    fn vertical(&self, x: u32, y: u32, dy: i32, goal: Cell) -> Option<u32> {
-        scan_row(
-            &self.transposed,
-            y,
-            x,
-            dy > 0,
-            (goal.x == x).then_some(goal.y),
-        )
-    }
-}
-
-impl Jumper for BlockJumper<'_> {
-    #[inline]
-    fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell> {
-        let (dx, dy) = DIRECTIONS[d as usize];
-        if dy == 0 {
-            return self
-                .horizontal(c.x, c.y, dx, goal)
-                .map(|x| Cell::new(x, c.y));
-        }
-        if dx == 0 {
-            return self.vertical(c.x, c.y, dy, goal).map(|y| Cell::new(c.x, y));
-        }
-        let g = self.grid;
-        let (mut x, mut y) = (i64::from(c.x), i64::from(c.y));
-        let (dx64, dy64) = (i64::from(dx), i64::from(dy));
-        loop {
-            if !(free(g, x + dx64, y) && free(g, x, y + dy64) && free(g, x + dx64, y + dy64)) {
-                return None;
-            }
-            x += dx64;
-            y += dy64;
-            let (ux, uy) = (x as u32, y as u32);
-            if (ux == goal.x && uy == goal.y)
-                || self.horizontal(ux, uy, dx, goal).is_some()
-                || self.vertical(ux, uy, dy, goal).is_some()
-            {
-                return Some(Cell::new(ux, uy));
-            }
         }
     }
 }

@@ -5,9 +5,10 @@
 //!
 //! - [`Dijkstra`] and [`AStar`] (octile heuristic): the references.
 //! - [`JumpPointSearch`]: online JPS (Harabor & Grastien, AAAI 2011) with pruning rules derived
-//!   for no corner cutting.
-//! - [`JumpPointSearchPlus`]: JPS with 64-cell word scans (Harabor & Grastien, ICAPS 2014), or
-//!   with JPS+ jump tables precomputed per grid.
+//!   for no corner cutting; straight jumps scan 64 cells per word (Harabor & Grastien, ICAPS
+//!   2014), or one cell at a time with [`JumpPointSearch::with_cell_scans`].
+//! - [`JumpPointSearchPlus`]: the same word scans, or JPS+ jump tables precomputed per grid
+//!   ([`JumpPointSearchPlus::with_jump_tables`]), chosen at construction.
 //! - [`filter_path`]: the thesis' path filter, keeping only the waypoints a straight
 //!   collision-free segment cannot skip ([`line_of_sight`] walks every touched cell).
 //! - [`movingai`]: readers for the Moving AI `.map` and `.scen` benchmark files.

@@ -94,7 +94,8 @@ impl SearchSpace {
     #[inline]
     fn key(&self, f: f64, g: f64) -> u64 {
         if self.quantised {
-            let fq = (f * (1u64 << 26) as f64).round() as u64;
+            // `f >= 0`, so adding one half and truncating rounds (and avoids a libm call).
+            let fq = (f * (1u64 << 26) as f64 + 0.5) as u64;
             let tie = 0xFFFF - (g as u64).min(0xFFFF);
             (fq << 16) | tie
         } else {

@@ -37,6 +37,12 @@ fn all_planners(map: &str, with_slow: bool) {
     let m = read_map(data(&format!("{map}.map"))).unwrap();
     let g = &m.grid;
     let n = run("JPS", &mut JumpPointSearch::new(g), g, map);
+    run(
+        "JPS cells",
+        &mut JumpPointSearch::with_cell_scans(g),
+        g,
+        map,
+    );
     run("JPS blocks", &mut JumpPointSearchPlus::new(g), g, map);
     run(
         "JPS+ tables",

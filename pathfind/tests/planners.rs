@@ -90,6 +90,7 @@ proptest! {
         let mut dijkstra = Dijkstra::new(&grid);
         let mut astar = AStar::new(&grid);
         let mut jps = JumpPointSearch::new(&grid);
+        let mut jps_cells = JumpPointSearch::with_cell_scans(&grid);
         let mut blocks = JumpPointSearchPlus::new(&grid);
         let mut tables = JumpPointSearchPlus::with_jump_tables(&grid).unwrap();
         for (a, b) in picks {
@@ -98,6 +99,7 @@ proptest! {
                 let want = dijkstra.plan(start, goal);
                 check(&grid, &astar.plan(start, goal), &want, start, goal, "A*");
                 check(&grid, &jps.plan(start, goal), &want, start, goal, "JPS");
+                check(&grid, &jps_cells.plan(start, goal), &want, start, goal, "JPS cells");
                 check(&grid, &blocks.plan(start, goal), &want, start, goal, "JPS blocks");
                 check(&grid, &tables.plan(start, goal), &want, start, goal, "JPS+ tables");
                 if let Ok(p) = &want {
@@ -118,6 +120,7 @@ fn diagonal_wall_blocks_everything() {
         Dijkstra::new(&grid).plan(a, b),
         AStar::new(&grid).plan(a, b),
         JumpPointSearch::new(&grid).plan(a, b),
+        JumpPointSearch::with_cell_scans(&grid).plan(a, b),
         JumpPointSearchPlus::new(&grid).plan(a, b),
         JumpPointSearchPlus::with_jump_tables(&grid)
             .unwrap()
