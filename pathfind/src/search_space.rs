@@ -37,17 +37,21 @@ impl Ord for Open {
     }
 }
 
-/// One cell's search record, packed so a visit touches one cache line.
+/// One cell's search record, 16 bytes so that four share a cache line.
 #[derive(Clone, Copy, Debug)]
 struct NodeState {
     g: f64,
     parent: u32,
-    /// Generation in which `g`, `parent` and `direction` were written.
-    seen: u32,
-    /// Generation in which the cell was expanded.
-    closed: u32,
-    direction: u8,
+    /// `generation << STAMP_SHIFT | closed << 4 | direction`: `g`, `parent` and `direction` are
+    /// valid when the generation is the current one; `closed` says the cell was expanded then.
+    stamp: u32,
 }
+
+const STAMP_SHIFT: u32 = 5;
+const CLOSED_BIT: u32 = 1 << 4;
+const DIRECTION_MASK: u32 = 0xF;
+/// Generations run from 1 to this value, then the stamps are cleared once.
+const MAX_GENERATION: u32 = u32::MAX >> STAMP_SHIFT;
 
 /// Search state for one grid size.
 pub(crate) struct SearchSpace {
@@ -69,9 +73,7 @@ impl SearchSpace {
         let empty = NodeState {
             g: 0.0,
             parent: 0,
-            seen: 0,
-            closed: 0,
-            direction: NO_DIRECTION,
+            stamp: 0,
         };
         Self {
             width,
@@ -118,15 +120,14 @@ impl SearchSpace {
         self.heap.clear();
         self.same_f.clear();
         self.current_f = u64::MAX;
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            // Wrapped after 4 billion queries: clear the stamps once.
+        if self.generation >= MAX_GENERATION {
+            // After 134 million queries: clear the stamps once.
             for n in &mut self.nodes {
-                n.seen = 0;
-                n.closed = 0;
+                n.stamp = 0;
             }
-            self.generation = 1;
+            self.generation = 0;
         }
+        self.generation += 1;
     }
 
     /// Offer `g` as the cost of reaching cell `i` from `parent`, arriving in `direction`; queue it
@@ -135,15 +136,13 @@ impl SearchSpace {
     pub(crate) fn relax(&mut self, i: u32, g: f64, h: f64, parent: u32, direction: u8) {
         let generation = self.generation;
         let n = &mut self.nodes[i as usize];
-        if n.seen == generation && (n.g <= g || n.closed == generation) {
+        if n.stamp >> STAMP_SHIFT == generation && (n.g <= g || n.stamp & CLOSED_BIT != 0) {
             return;
         }
         *n = NodeState {
             g,
             parent,
-            seen: generation,
-            closed: n.closed,
-            direction,
+            stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
         let key = self.key(g + h, g);
         if self.quantised && key >> 16 == self.current_f {
@@ -153,25 +152,32 @@ impl SearchSpace {
         }
     }
 
+    /// Mark cell `i` expanded unless it already was in this query; returns its cost and arrival
+    /// direction.
+    #[inline]
+    fn close(&mut self, i: u32) -> Option<(f64, u8)> {
+        let n = &mut self.nodes[i as usize];
+        if n.stamp & CLOSED_BIT != 0 {
+            return None;
+        }
+        n.stamp |= CLOSED_BIT;
+        Some((n.g, (n.stamp & DIRECTION_MASK) as u8))
+    }
+
     /// Pop the best open cell that is not yet expanded, and mark it expanded.
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<(u32, f64, u8)> {
+        // Every queued cell was stamped in this generation, so only the closed bit needs a look.
         while let Some(i) = self.same_f.pop() {
-            let n = &mut self.nodes[i as usize];
-            if n.closed == self.generation {
-                continue;
+            if let Some((g, d)) = self.close(i) {
+                return Some((i, g, d));
             }
-            n.closed = self.generation;
-            return Some((i, n.g, n.direction));
         }
         while let Some(o) = self.heap.pop() {
-            let n = &mut self.nodes[o.index as usize];
-            if n.closed == self.generation {
-                continue;
+            if let Some((g, d)) = self.close(o.index) {
+                self.current_f = o.key >> 16;
+                return Some((o.index, g, d));
             }
-            n.closed = self.generation;
-            self.current_f = o.key >> 16;
-            return Some((o.index, n.g, n.direction));
         }
         None
     }
