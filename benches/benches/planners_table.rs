@@ -1,6 +1,8 @@
 //! Every scenario of eight Moving AI maps, every planner and the peer in the same run: prints the
 //! table recorded in `pathfind/README.md` (mean and p99 microseconds per query, speed-up over the
 //! peer, expansions, preprocessing). Every length is checked against the published optimum.
+//! Queries run round robin (each scenario with every planner in turn) so that load changes on a
+//! shared machine do not bias the ratios.
 //!
 //! `cargo bench -p spot-nav-benches --bench planners_table`
 //! (`SPOT_NAV_DATA` names the shared data folder; `PLANNERS_TABLE_STRIDE=k` runs every k-th
@@ -27,42 +29,45 @@ const MAPS: [(&str, &str); 8] = [
     ("random", "random512-25-0"),
 ];
 
-struct Row {
-    mean_us: f64,
-    p99_us: f64,
-    expanded: f64,
+/// One query: the path length found and the nodes expanded.
+type Query<'g> = Box<dyn FnMut(&Scenario) -> (f64, usize) + 'g>;
+
+/// One column of the table: a name, what it keeps per cell, how long it took to build, and the
+/// query.
+struct Entry<'g> {
+    name: &'static str,
+    bytes_per_cell: f64,
+    setup_ms: f64,
+    query: Query<'g>,
+    us: Vec<f64>,
+    expanded: usize,
 }
 
-fn time_queries(scenarios: &[Scenario], mut query: impl FnMut(&Scenario) -> (f64, usize)) -> Row {
-    let mut us = Vec::with_capacity(scenarios.len());
-    let mut expanded = 0usize;
-    for s in scenarios {
+impl<'g> Entry<'g> {
+    /// Build a planner with `make` (timed as preprocessing).
+    fn ours<P: Planner + 'g>(
+        name: &'static str,
+        make: impl FnOnce() -> P,
+        extra_bytes: impl FnOnce(&P) -> usize,
+        cells: f64,
+    ) -> Self {
         let t = Instant::now();
-        let (length, exp) = query(s);
-        us.push(t.elapsed().as_secs_f64() * 1e6);
-        expanded += exp;
-        assert!(
-            (length - s.optimal_length).abs() <= s.tolerance.max(1e-5 * s.optimal_length),
-            "length {length} but the optimum is {}",
-            s.optimal_length
-        );
+        let mut planner = make();
+        let setup_ms = t.elapsed().as_secs_f64() * 1e3;
+        // Component labels (4 bytes per cell) plus the planner's own tables.
+        let bytes_per_cell = 4.0 + extra_bytes(&planner) as f64 / cells;
+        Self {
+            name,
+            bytes_per_cell,
+            setup_ms,
+            query: Box::new(move |s: &Scenario| match planner.plan(s.start, s.goal) {
+                Ok(p) => (p.length, p.expanded),
+                Err(e) => panic!("{name}: {e}"),
+            }),
+            us: Vec::new(),
+            expanded: 0,
+        }
     }
-    let n = us.len() as f64;
-    let mean_us = us.iter().sum::<f64>() / n;
-    us.sort_by(f64::total_cmp);
-    let p99_us = us[((us.len() - 1) as f64 * 0.99).round() as usize];
-    Row {
-        mean_us,
-        p99_us,
-        expanded: expanded as f64 / n,
-    }
-}
-
-fn ours(planner: &mut impl Planner, scenarios: &[Scenario]) -> Row {
-    time_queries(scenarios, |s| match planner.plan(s.start, s.goal) {
-        Ok(p) => (p.length, p.expanded),
-        Err(e) => panic!("{e}"),
-    })
 }
 
 fn main() {
@@ -99,68 +104,83 @@ fn main() {
             continue;
         };
         let scenarios: Vec<Scenario> = all.into_iter().step_by(stride).collect();
-        let grid: &BitGrid = &map.grid;
-        let cells = grid.len() as f64;
-        let peer = time_queries(&scenarios, |s| {
-            (
-                pathfinding_peer::astar_length(grid, s.start, s.goal).unwrap_or(f64::INFINITY),
-                0,
-            )
-        });
-        let print = |planner: &str, r: &Row, pre_ms: f64, bytes: f64| {
-            println!(
-                "| {name} | {planner} | {:.1} | {:.1} | {:.1}x | {:.0} | {pre_ms:.1} | {bytes:.2} |",
-                r.mean_us,
-                r.p99_us,
-                peer.mean_us / r.mean_us,
-                r.expanded
-            );
-        };
-        print("pathfinding::astar (peer)", &peer, 0.0, 0.0);
-        let t = Instant::now();
-        let mut astar = AStar::new(grid);
-        let pre = t.elapsed().as_secs_f64() * 1e3;
-        print("AStar", &ours(&mut astar, &scenarios), pre, 4.0);
-        let t = Instant::now();
-        let mut cells_jps = JumpPointSearch::with_cell_scans(grid);
-        let pre = t.elapsed().as_secs_f64() * 1e3;
-        print(
+        print_map(name, &map.grid, &scenarios);
+    }
+}
+
+/// Time every planner on `scenarios` of one map and print its rows.
+fn print_map(name: &str, grid: &BitGrid, scenarios: &[Scenario]) {
+    let cells = grid.len() as f64;
+    let mut entries = vec![
+        Entry {
+            name: "pathfinding::astar (peer)",
+            bytes_per_cell: 0.0,
+            setup_ms: 0.0,
+            query: Box::new(|s: &Scenario| {
+                (
+                    pathfinding_peer::astar_length(grid, s.start, s.goal).unwrap_or(f64::INFINITY),
+                    0,
+                )
+            }),
+            us: Vec::new(),
+            expanded: 0,
+        },
+        Entry::ours("AStar", || AStar::new(grid), |_| 0, cells),
+        Entry::ours(
             "JumpPointSearch (cell scans)",
-            &ours(&mut cells_jps, &scenarios),
-            pre,
-            4.0,
-        );
-        let t = Instant::now();
-        let mut jps = JumpPointSearch::new(grid);
-        let pre = t.elapsed().as_secs_f64() * 1e3;
-        let bytes = 4.0 + jps.preprocessed_bytes() as f64 / cells;
-        print(
+            || JumpPointSearch::with_cell_scans(grid),
+            JumpPointSearch::preprocessed_bytes,
+            cells,
+        ),
+        Entry::ours(
             "JumpPointSearch (word scans)",
-            &ours(&mut jps, &scenarios),
-            pre,
-            bytes,
-        );
-        let t = Instant::now();
-        let mut blocks = JumpPointSearchPlus::new(grid);
-        let pre = t.elapsed().as_secs_f64() * 1e3;
-        let bytes = 4.0 + blocks.preprocessed_bytes() as f64 / cells;
-        print(
-            "JumpPointSearchPlus (block scans)",
-            &ours(&mut blocks, &scenarios),
-            pre,
-            bytes,
-        );
-        let t = Instant::now();
-        let Ok(mut tables) = JumpPointSearchPlus::with_jump_tables(grid) else {
-            continue;
-        };
-        let pre = t.elapsed().as_secs_f64() * 1e3;
-        let bytes = 4.0 + tables.preprocessed_bytes() as f64 / cells;
-        print(
+            || JumpPointSearch::new(grid),
+            JumpPointSearch::preprocessed_bytes,
+            cells,
+        ),
+        Entry::ours(
+            "JumpPointSearchPlus (word scans)",
+            || JumpPointSearchPlus::new(grid),
+            JumpPointSearchPlus::preprocessed_bytes,
+            cells,
+        ),
+    ];
+    if grid.width() <= 32_767 && grid.height() <= 32_767 {
+        entries.push(Entry::ours(
             "JumpPointSearchPlus (JPS+ tables)",
-            &ours(&mut tables, &scenarios),
-            pre,
-            bytes,
+            || JumpPointSearchPlus::with_jump_tables(grid).unwrap_or_else(|e| panic!("{e}")),
+            JumpPointSearchPlus::preprocessed_bytes,
+            cells,
+        ));
+    }
+    // Round robin per scenario, so a change of machine load hits every planner alike.
+    for s in scenarios {
+        for e in &mut entries {
+            let t = Instant::now();
+            let (length, expanded) = (e.query)(s);
+            e.us.push(t.elapsed().as_secs_f64() * 1e6);
+            e.expanded += expanded;
+            assert!(
+                (length - s.optimal_length).abs() <= s.tolerance,
+                "{}: length {length} but the optimum is {}",
+                e.name,
+                s.optimal_length
+            );
+        }
+    }
+    let n = scenarios.len().max(1) as f64;
+    let peer_mean = entries[0].us.iter().sum::<f64>() / n;
+    for e in &mut entries {
+        let mean = e.us.iter().sum::<f64>() / n;
+        e.us.sort_by(f64::total_cmp);
+        let p99 = e.us[((e.us.len() - 1) as f64 * 0.99).round() as usize];
+        println!(
+            "| {name} | {} | {mean:.1} | {p99:.1} | {:.1}x | {:.0} | {:.1} | {:.2} |",
+            e.name,
+            peer_mean / mean,
+            e.expanded as f64 / n,
+            e.setup_ms,
+            e.bytes_per_cell
         );
     }
 }
