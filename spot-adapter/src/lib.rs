@@ -79,7 +79,7 @@ pub use kitti::{KittiOdometry, KittiSequence};
 pub use lidar::{Vlp16, Vlp16Config};
 pub use odometry::{OdometryDriftConfig, OdometryModel};
 pub use ray_cast::{HitTarget, RayHit};
-pub use recording::{Recording, RecordingWriter};
+pub use recording::{Recording, RecordingSamples, RecordingWriter};
 pub use rng::SimRng;
 pub use route::Route;
 pub use route_planner::RouteConfig;

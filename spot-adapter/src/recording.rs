@@ -312,3 +312,41 @@ impl Recording {
         })
     }
 }
+
+/// An owning iterator over a recording's samples (from [`Recording::into_iter`]).
+#[derive(Clone, Debug)]
+pub struct RecordingSamples {
+    recording: Recording,
+    next: usize,
+}
+
+impl Iterator for RecordingSamples {
+    type Item = Result<Sample, AdapterError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let item = self.recording.sample(self.next)?;
+        self.next += 1;
+        Some(item)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.recording.len() - self.next;
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for RecordingSamples {}
+
+impl IntoIterator for Recording {
+    type Item = Result<Sample, AdapterError>;
+    type IntoIter = RecordingSamples;
+
+    /// Every sample in order, each cloud read when reached; the iterator owns the recording, so
+    /// it can be returned or boxed beside a [`SimulatedSpot`](crate::SimulatedSpot).
+    fn into_iter(self) -> RecordingSamples {
+        RecordingSamples {
+            recording: self,
+            next: 0,
+        }
+    }
+}

@@ -53,6 +53,15 @@ fn recording_round_trip() {
             &want.ground_truth.unwrap()
         ));
     }
+    // The owning iterator yields the same samples, boxed like any other sample source.
+    let stream: Box<dyn Iterator<Item = Result<spot_adapter::Sample, AdapterError>>> =
+        Box::new(Recording::open(&dir).unwrap().into_iter());
+    let mut count = 0;
+    for (got, want) in stream.map(Result::unwrap).zip(&expected) {
+        assert!(got.cloud == want.cloud && close(&got.odom_t_body, &want.odom_t_body));
+        count += 1;
+    }
+    assert_eq!(count, expected.len());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
