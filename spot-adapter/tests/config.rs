@@ -8,6 +8,7 @@ use spot_adapter::{
     SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
 };
 
+#[allow(clippy::needless_pass_by_value)] // Takes the results straight from the calls.
 fn invalid<T: std::fmt::Debug>(r: Result<T, AdapterError>) -> bool {
     matches!(r, Err(AdapterError::InvalidConfig(_)))
 }
