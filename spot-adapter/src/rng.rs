@@ -7,6 +7,10 @@ use rand_pcg::rand_core::{Rng, SeedableRng};
 /// A seeded generator whose streams are the same on every platform: PCG-64 (MCG variant) for the
 /// integers, the top 53 bits for uniform floats, and `rand_distr`'s ziggurat (pinned version, libm
 /// maths) for normal draws.
+///
+/// The simulator's geometry also calls `f64::sin`/`cos`/`atan2`, which Rust takes from the
+/// platform's maths library; those may differ in the last bit between platforms, so a seed gives
+/// the same building, route and noise everywhere, and the same points to within rounding.
 #[derive(Clone, Debug)]
 pub struct SimRng(Pcg64Mcg);
 
@@ -41,7 +45,7 @@ impl SimRng {
         if n == 0 {
             return 0;
         }
-        // Lemire-free modulo: the bias for the small n used here is below 2^-50.
+        // Plain modulo: for the small n used here (< 2^10) its bias is below 2^-50.
         (self.0.next_u64() % n as u64) as usize
     }
 
