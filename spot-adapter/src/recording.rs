@@ -85,7 +85,13 @@ impl RecordingWriter {
                 sample.stamp
             )));
         }
-        if sample.ground_truth.is_some() != (self.ground_truth.len() == self.entries.len()) {
+        // The first sample decides whether the recording carries ground truth.
+        let with_truth = if self.entries.is_empty() {
+            sample.ground_truth.is_some()
+        } else {
+            !self.ground_truth.is_empty()
+        };
+        if sample.ground_truth.is_some() != with_truth {
             return Err(err(
                 "ground truth must be given for all samples or none".into()
             ));

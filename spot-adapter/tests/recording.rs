@@ -10,8 +10,8 @@ use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::io::{write_kitti_bin, write_kitti_poses};
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::{
-    AdapterError, Building, BuildingConfig, KittiOdometry, KittiSequence, Recording, Route,
-    SimulatedSpot, SimulationConfig,
+    AdapterError, Building, BuildingConfig, KittiOdometry, KittiSequence, Recording,
+    RecordingWriter, Route, SimulatedSpot, SimulationConfig,
 };
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -63,6 +63,44 @@ fn recording_round_trip() {
     }
     assert_eq!(count, expected.len());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn recording_without_ground_truth() {
+    let dir = temp_dir("no-truth");
+    let mut samples: Vec<_> = short_run().collect();
+    for s in &mut samples {
+        s.ground_truth = None;
+    }
+    let mut w = RecordingWriter::create(&dir, samples[0].body_t_lidar).unwrap();
+    for s in &samples {
+        w.write(s).unwrap();
+    }
+    let rec = Recording::open(w.finish().unwrap()).unwrap();
+    assert!(rec.ground_truth().is_none() && !dir.join("ground_truth.tum").exists());
+    assert_eq!(rec.len(), samples.len());
+    assert!(rec.sample(0).unwrap().unwrap().ground_truth.is_none());
+    // Mixing samples with and without ground truth, out-of-order stamps, or another mounting
+    // are errors.
+    let mut w = RecordingWriter::create(&dir, samples[0].body_t_lidar).unwrap();
+    w.write(&samples[1]).unwrap();
+    let mut with_truth = samples[2].clone();
+    with_truth.ground_truth = Some(Pose3::identity());
+    assert!(matches!(
+        w.write(&with_truth),
+        Err(AdapterError::Recording { .. })
+    ));
+    assert!(matches!(
+        w.write(&samples[0]),
+        Err(AdapterError::Recording { .. })
+    ));
+    let mut moved = samples[3].clone();
+    moved.body_t_lidar = Pose3::translation(0.0, 0.0, 0.5);
+    assert!(matches!(
+        w.write(&moved),
+        Err(AdapterError::Recording { .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
