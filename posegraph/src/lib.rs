@@ -1,1 +1,46 @@
-//! SE(3)/SE(2) pose-graph optimisation (Gauss-Newton, Levenberg-Marquardt) and g2o files for spot-nav.
+//! # posegraph
+//!
+//! Pose-graph optimisation for spot-nav: [`GaussNewton`] and [`LevenbergMarquardt`] over
+//! [`slam_core::PoseGraph`] (SE(3) and SE(2)), with analytic Jacobians of the log-map error
+//! (`e = log(z^-1 a^-1 b)`, as GTSAM's `BetweenFactor`), the sparse normal equations assembled
+//! straight into a CSC pattern built once per graph structure, and faer's sparse Cholesky with the
+//! symbolic factorisation reused for every numeric one. Robust kernels enter as IRLS weights.
+//! [`g2o`] reads and writes g2o files and evaluates g2o's own chi2 convention.
+//!
+//! ```
+//! use posegraph::LevenbergMarquardt;
+//! use slam_core::{GraphPose, Optimizer, PoseGraph, Pose2};
+//!
+//! // Three poses on a line, a loop edge that disagrees by 0.3 m.
+//! let mut g = PoseGraph::<Pose2>::new();
+//! for i in 0..3u64 {
+//!     g.add_node(i, Pose2::new([i as f64, 0.0].into(), 0.0))?;
+//! }
+//! g.fix(0)?;
+//! let info = Pose2::identity_information();
+//! g.add_edge(0, 1, Pose2::new([1.0, 0.0].into(), 0.0), info, None)?;
+//! g.add_edge(1, 2, Pose2::new([1.0, 0.0].into(), 0.0), info, None)?;
+//! g.add_edge(0, 2, Pose2::new([2.3, 0.0].into(), 0.0), info, None)?;
+//! let report = LevenbergMarquardt::default().optimize(&mut g)?;
+//! // The 0.3 m disagreement is shared equally by the three edges: 3 * 0.1^2.
+//! assert!((report.final_cost - 0.03).abs() < 1e-9);
+//! # Ok::<(), slam_core::OptimizeError>(())
+//! ```
+//!
+//! When not to use it: for graphs that need a certified global optimum from a poor start (use a
+//! chordal or SE-Sync initialisation first), or for landmark-based factor graphs (this crate
+//! handles between-pose constraints only).
+
+mod error;
+pub mod g2o;
+mod gauss_newton;
+mod levenberg_marquardt;
+mod linearize;
+mod normal_equations;
+mod solver;
+
+pub use error::GraphFileError;
+pub use gauss_newton::GaussNewton;
+pub use levenberg_marquardt::LevenbergMarquardt;
+pub use linearize::Linearize;
+pub use solver::SolverConfig;

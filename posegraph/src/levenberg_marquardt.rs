@@ -1,0 +1,67 @@
+//! Levenberg-Marquardt.
+
+use slam_core::{OptimizationReport, OptimizeError, Optimizer, Pose2, Pose3, PoseGraph};
+
+use crate::solver::{Cache, SolverConfig, optimize};
+
+/// Levenberg-Marquardt: Gauss-Newton steps on `H + lambda diag(H)`; a step that raises the cost is
+/// rejected and the damping raised (times 2, 4, 8, ...), an accepted one lowers it (divided by 3).
+/// The sparse pattern and the symbolic Cholesky are kept between calls while the graph's structure
+/// is unchanged.
+pub struct LevenbergMarquardt {
+    /// Stopping rules.
+    pub config: SolverConfig,
+    /// Initial damping (relative to the diagonal), default 1e-5.
+    pub initial_lambda: f64,
+    cache3: Cache<6>,
+    cache2: Cache<3>,
+}
+
+impl Default for LevenbergMarquardt {
+    fn default() -> Self {
+        Self::new(SolverConfig::default())
+    }
+}
+
+impl LevenbergMarquardt {
+    /// LM with the given stopping rules.
+    #[must_use]
+    pub fn new(config: SolverConfig) -> Self {
+        Self {
+            config,
+            initial_lambda: 1e-5,
+            cache3: None,
+            cache2: None,
+        }
+    }
+}
+
+impl Optimizer<Pose3> for LevenbergMarquardt {
+    fn optimize(
+        &mut self,
+        graph: &mut PoseGraph<Pose3>,
+    ) -> Result<OptimizationReport, OptimizeError> {
+        optimize(
+            graph,
+            &mut self.cache3,
+            &self.config,
+            true,
+            self.initial_lambda,
+        )
+    }
+}
+
+impl Optimizer<Pose2> for LevenbergMarquardt {
+    fn optimize(
+        &mut self,
+        graph: &mut PoseGraph<Pose2>,
+    ) -> Result<OptimizationReport, OptimizeError> {
+        optimize(
+            graph,
+            &mut self.cache2,
+            &self.config,
+            true,
+            self.initial_lambda,
+        )
+    }
+}

@@ -1,0 +1,210 @@
+//! The sparse normal equations `H dx = -b` of a pose graph: a CSC pattern (upper triangle, every
+//! diagonal entry present for damping) built once per graph structure, with faer's symbolic
+//! Cholesky computed once and reused for every numeric factorisation.
+
+use faer::Side;
+use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::linalg::solvers::SymbolicLlt;
+use nalgebra::{SMatrix, SVector};
+use slam_core::{OptimizeError, PoseGraph};
+
+use crate::linearize::Linearize;
+
+/// Where each edge's blocks go in the value array.
+#[derive(Clone, Copy, Debug)]
+struct EdgeSlots {
+    /// Variable of the edge's `from` node (`None` when fixed).
+    a: Option<usize>,
+    /// Variable of the edge's `to` node.
+    b: Option<usize>,
+    /// Rank of the lower variable among the higher one's column neighbours (both free).
+    rank_lo: usize,
+}
+
+/// The pattern and symbolic factorisation for one graph structure.
+pub(crate) struct NormalEquations<const D: usize> {
+    /// (nodes, edges, fixed flags hash) the pattern was built for.
+    key: (usize, usize, u64),
+    /// Variable of each node (`None` for fixed nodes).
+    var_of_node: Vec<Option<usize>>,
+    n_vars: usize,
+    col_ptr: Vec<usize>,
+    /// Neighbour count (including itself) of each variable's column block.
+    neighbours: Vec<usize>,
+    edges: Vec<EdgeSlots>,
+    symbolic_pattern: SymbolicSparseColMat<usize>,
+    pub(crate) symbolic: SymbolicLlt<usize>,
+    /// Numeric values (upper triangle, CSC order).
+    pub(crate) values: Vec<f64>,
+    /// Right-hand side `b = J^T W e`.
+    pub(crate) gradient: Vec<f64>,
+}
+
+fn structure_key<P>(graph: &PoseGraph<P>) -> (usize, usize, u64)
+where
+    P: slam_core::GraphPose,
+{
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for (i, n) in graph.nodes().iter().enumerate() {
+        if n.fixed {
+            h = (h ^ i as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    (graph.node_count(), graph.edge_count(), h)
+}
+
+impl<const D: usize> NormalEquations<D> {
+    /// Whether this pattern still fits `graph`.
+    pub(crate) fn fits<P: Linearize<D>>(&self, graph: &PoseGraph<P>) -> bool {
+        self.key == structure_key(graph)
+    }
+
+    /// Build the pattern and the symbolic factorisation for `graph`.
+    pub(crate) fn new<P: Linearize<D>>(graph: &PoseGraph<P>) -> Result<Self, OptimizeError> {
+        let mut var_of_node = Vec::with_capacity(graph.node_count());
+        let mut n_vars = 0;
+        for n in graph.nodes() {
+            if n.fixed {
+                var_of_node.push(None);
+            } else {
+                var_of_node.push(Some(n_vars));
+                n_vars += 1;
+            }
+        }
+        // Upper-triangle neighbours of each variable: lower-numbered variables sharing an edge.
+        let mut lower: Vec<Vec<usize>> = vec![Vec::new(); n_vars];
+        for e in graph.edges() {
+            if let (Some(a), Some(b)) = (var_of_node[e.from], var_of_node[e.to]) {
+                let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                lower[hi].push(lo);
+            }
+        }
+        for l in &mut lower {
+            l.sort_unstable();
+            l.dedup();
+        }
+        let n = n_vars * D;
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut neighbours = Vec::with_capacity(n_vars);
+        col_ptr.push(0);
+        for (j, l) in lower.iter().enumerate() {
+            neighbours.push(l.len() + 1);
+            for c in 0..D {
+                for &i in l {
+                    row_idx.extend((0..D).map(|r| i * D + r));
+                }
+                row_idx.extend((0..=c).map(|r| j * D + r));
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let edges = graph
+            .edges()
+            .iter()
+            .map(|e| {
+                let (a, b) = (var_of_node[e.from], var_of_node[e.to]);
+                let rank_lo = match (a, b) {
+                    (Some(a), Some(b)) => {
+                        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                        lower[hi].binary_search(&lo).unwrap_or(0)
+                    }
+                    _ => 0,
+                };
+                EdgeSlots { a, b, rank_lo }
+            })
+            .collect();
+        let nnz = row_idx.len();
+        let symbolic_pattern =
+            SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx);
+        let symbolic = SymbolicLlt::try_new(symbolic_pattern.as_ref(), Side::Upper)
+            .map_err(|e| OptimizeError::Factorization(format!("symbolic Cholesky: {e:?}")))?;
+        Ok(Self {
+            key: structure_key(graph),
+            var_of_node,
+            n_vars,
+            col_ptr,
+            neighbours,
+            edges,
+            symbolic_pattern,
+            symbolic,
+            values: vec![0.0; nnz],
+            gradient: vec![0.0; n],
+        })
+    }
+
+    /// Number of scalar unknowns.
+    pub(crate) fn dimension(&self) -> usize {
+        self.n_vars * D
+    }
+
+    /// The variable of node `i`.
+    pub(crate) fn variable(&self, node: usize) -> Option<usize> {
+        self.var_of_node[node]
+    }
+
+    /// The pattern.
+    pub(crate) fn pattern(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
+        self.symbolic_pattern.as_ref()
+    }
+
+    /// Position of entry (row `i*D + r`, column `j*D + c`) for `i <= j`, `rank` = rank of `i` in
+    /// column block `j` (the diagonal block is last).
+    #[inline]
+    fn pos(&self, rank: usize, r: usize, j: usize, c: usize) -> usize {
+        self.col_ptr[j * D + c] + rank * D + r
+    }
+
+    /// Position of the diagonal entry of unknown `k`.
+    #[inline]
+    pub(crate) fn diagonal_position(&self, k: usize) -> usize {
+        let (j, c) = (k / D, k % D);
+        self.pos(self.neighbours[j] - 1, c, j, c)
+    }
+
+    /// Fill `values` and `gradient` at the current poses (robust kernels as IRLS weights).
+    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>) {
+        self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.gradient.iter_mut().for_each(|v| *v = 0.0);
+        for (e, slots) in graph.edges().iter().zip(self.edges.clone()) {
+            let (a, b) = (&graph.nodes()[e.from].pose, &graph.nodes()[e.to].pose);
+            let (err, ja, jb) = P::linearize(&e.measurement, a, b);
+            let mut omega = P::info(&e.information);
+            if let Some(k) = e.kernel {
+                omega *= k.weight((err.transpose() * omega * err)[0]);
+            }
+            let oe: SVector<f64, D> = omega * err;
+            let parts = [(slots.a, ja), (slots.b, jb)];
+            for &(v, j) in &parts {
+                if let Some(v) = v {
+                    let g = j.transpose() * oe;
+                    for r in 0..D {
+                        self.gradient[v * D + r] += g[r];
+                    }
+                    let h: SMatrix<f64, D, D> = j.transpose() * omega * j;
+                    let diag_rank = self.neighbours[v] - 1;
+                    for c in 0..D {
+                        for r in 0..=c {
+                            let p = self.pos(diag_rank, r, v, c);
+                            self.values[p] += h[(r, c)];
+                        }
+                    }
+                }
+            }
+            if let (Some(va), Some(vb)) = (slots.a, slots.b) {
+                let (lo, jlo, hi, jhi) = if va < vb {
+                    (va, ja, vb, jb)
+                } else {
+                    (vb, jb, va, ja)
+                };
+                let _ = lo;
+                let h: SMatrix<f64, D, D> = jlo.transpose() * omega * jhi;
+                for c in 0..D {
+                    for r in 0..D {
+                        let p = self.pos(slots.rank_lo, r, hi, c);
+                        self.values[p] += h[(r, c)];
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! The damped Gauss-Newton loop shared by [`GaussNewton`](crate::GaussNewton) and
+//! [`LevenbergMarquardt`](crate::LevenbergMarquardt).
+
+use faer::Side;
+use faer::linalg::solvers::Solve;
+use faer::sparse::SparseColMatRef;
+use faer::sparse::linalg::solvers::Llt;
+use nalgebra::SVector;
+use slam_core::{OptimizationReport, OptimizeError, PoseGraph, StopReason};
+
+use crate::linearize::Linearize;
+use crate::normal_equations::NormalEquations;
+
+/// Stopping and damping settings shared by both optimisers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverConfig {
+    /// Stop after this many iterations (accepted or rejected steps).
+    pub max_iterations: usize,
+    /// Stop when an accepted step lowers the cost by less than this fraction.
+    pub relative_cost_tolerance: f64,
+    /// Stop when the step's largest component is below this (metres or radians).
+    pub step_tolerance: f64,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            relative_cost_tolerance: 1e-10,
+            step_tolerance: 1e-10,
+        }
+    }
+}
+
+/// `sum rho(e^T Omega e)` with `poses` in place of the graph's.
+fn cost_with<P: Linearize<D>, const D: usize>(graph: &PoseGraph<P>, poses: &[P]) -> f64 {
+    graph
+        .edges()
+        .iter()
+        .map(|e| {
+            let err = P::edge_error(&e.measurement, &poses[e.from], &poses[e.to]);
+            let s = P::mahalanobis_squared(&err, &e.information);
+            e.kernel.map_or(s, |k| k.rho(s))
+        })
+        .sum()
+}
+
+/// Cached structure of an optimiser.
+pub(crate) type Cache<const D: usize> = Option<NormalEquations<D>>;
+
+/// Run the loop. `levenberg` chooses LM (adaptive damping, rejected steps) or GN (no damping
+/// unless the factorisation needs it, every step accepted).
+pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
+    graph: &mut PoseGraph<P>,
+    cache: &mut Cache<D>,
+    config: &SolverConfig,
+    levenberg: bool,
+    initial_lambda: f64,
+) -> Result<OptimizationReport, OptimizeError> {
+    graph.check_gauge()?;
+    let initial_cost = graph.cost();
+    if !cache.as_ref().is_some_and(|c| c.fits(graph)) {
+        *cache = Some(NormalEquations::new(graph)?);
+    }
+    let Some(ne) = cache.as_mut() else {
+        return Err(OptimizeError::Factorization("no normal equations".into()));
+    };
+    if ne.dimension() == 0 || graph.edge_count() == 0 {
+        return Ok(OptimizationReport {
+            iterations: 0,
+            initial_cost,
+            final_cost: initial_cost,
+            stop_reason: StopReason::NothingToDo,
+        });
+    }
+    let n = ne.dimension();
+    let mut cost = initial_cost;
+    let mut lambda = if levenberg { initial_lambda } else { 0.0 };
+    let mut nu = 2.0;
+    let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
+    let mut rhs = faer::Mat::<f64>::zeros(n, 1);
+    let mut iterations = 0;
+    let mut stop = StopReason::MaxIterations;
+    let mut relinearize = true;
+    let mut diagonal = vec![0.0; n];
+    'outer: while iterations < config.max_iterations {
+        if relinearize {
+            ne.assemble(graph);
+            for (k, d) in diagonal.iter_mut().enumerate() {
+                *d = ne.values[ne.diagonal_position(k)];
+            }
+            relinearize = false;
+        }
+        iterations += 1;
+        // Damped system: H + lambda * diag(H) (Marquardt's scaling, floored for empty rows).
+        let mut damped = ne.values.clone();
+        if lambda > 0.0 {
+            for (k, &d) in diagonal.iter().enumerate() {
+                damped[ne.diagonal_position(k)] += lambda * d.max(1e-9);
+            }
+        }
+        let matrix = SparseColMatRef::new(ne.pattern(), &damped);
+        let Ok(llt) = Llt::try_new_with_symbolic(ne.symbolic.clone(), matrix, Side::Upper) else {
+            // A non-positive pivot: raise the damping instead of failing.
+            lambda = if lambda == 0.0 { 1e-9 } else { lambda * nu };
+            nu *= 2.0;
+            if lambda > 1e16 {
+                stop = StopReason::DampingExhausted;
+                break;
+            }
+            continue;
+        };
+        for k in 0..n {
+            rhs[(k, 0)] = -ne.gradient[k];
+        }
+        llt.solve_in_place(rhs.as_mut());
+        let mut step_max: f64 = 0.0;
+        let mut trial = poses.clone();
+        for (i, node) in graph.nodes().iter().enumerate() {
+            if let Some(v) = ne.variable(i) {
+                let d = SVector::<f64, D>::from_fn(|r, _| rhs[(v * D + r, 0)]);
+                step_max = step_max.max(d.amax());
+                trial[i] = node.pose.retract(&d);
+            }
+        }
+        if !step_max.is_finite() {
+            return Err(OptimizeError::Factorization("non-finite step".into()));
+        }
+        let new_cost = cost_with(graph, &trial);
+        // NaN costs count as worse.
+        let improved = new_cost < cost;
+        if levenberg && !improved {
+            // Rejected: more damping, same linearisation.
+            lambda *= nu;
+            nu *= 2.0;
+            if lambda > 1e16 {
+                stop = StopReason::DampingExhausted;
+                break 'outer;
+            }
+            continue;
+        }
+        let decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+        for (i, p) in trial.iter().enumerate() {
+            graph.set_pose(i, *p);
+        }
+        poses = trial;
+        cost = new_cost;
+        relinearize = true;
+        if levenberg {
+            lambda = (lambda / 3.0).max(1e-15);
+            nu = 2.0;
+        } else if lambda > 0.0 {
+            lambda = 0.0;
+        }
+        if step_max < config.step_tolerance {
+            stop = StopReason::StepConverged;
+            break;
+        }
+        if decrease.abs() < config.relative_cost_tolerance || cost == 0.0 {
+            stop = StopReason::CostConverged;
+            break;
+        }
+    }
+    Ok(OptimizationReport {
+        iterations,
+        initial_cost,
+        final_cost: cost,
+        stop_reason: stop,
+    })
+}
