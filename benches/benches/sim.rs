@@ -42,6 +42,13 @@ fn sim(c: &mut Criterion) {
             black_box(lidar.scan(&building, &poses[k], &mut rng))
         });
     });
+    group.bench_function("vlp16_scan_moving", |b| {
+        b.iter(|| {
+            k = (k + 1) % poses.len();
+            let end = poses[k] * Pose3::translation(0.12, 0.0, 0.0);
+            black_box(lidar.scan_moving(&building, &poses[k], &end, &mut rng))
+        });
+    });
     group.throughput(Throughput::Elements(1));
     group.bench_function("building_generate", |b| {
         b.iter(|| black_box(Building::generate(black_box(7), &BuildingConfig::default())));

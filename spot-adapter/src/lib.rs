@@ -40,8 +40,9 @@
 //! # Ok::<(), spot_adapter::AdapterError>(())
 //! ```
 //!
-//! Simplifications, each documented where it lives: a scan is cast from one pose (no motion
-//! distortion, so no deskewing is needed), the body stays level at a fixed height (no gait
+//! Simplifications, each documented where it lives: by default a scan is cast from one pose (no
+//! motion distortion, so no deskewing is needed; `SimulationConfig::motion_distortion` turns it
+//! on), the body stays level at a fixed height (no gait
 //! sway), and surfaces reflect every ray (no intensity, no multi-path).
 //!
 //! When not to use it: the simulator is for testing SLAM and navigation logic at scale, not for

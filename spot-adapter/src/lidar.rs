@@ -2,7 +2,7 @@
 //! optional dropouts, ray-cast against the [`Building`].
 
 use nalgebra::{Point3, Vector3};
-use slam_core::{PointCloud, Pose3};
+use slam_core::{PointCloud, Pose3, interpolate};
 
 use crate::building::Building;
 use crate::error::AdapterError;
@@ -143,30 +143,64 @@ impl Vlp16 {
     /// `max_range`, closer than `min_range`, or dropped out give no point.
     #[must_use]
     pub fn scan(&self, building: &Building, world_t_lidar: &Pose3, rng: &mut SimRng) -> PointCloud {
+        self.cast(building, |_| *world_t_lidar, rng)
+    }
+
+    /// One full turn while the LiDAR moves from `start` (at time 0) to `end` (one sweep period
+    /// later), each column cast from the pose interpolated at its firing time: the motion
+    /// distortion a real spinning LiDAR shows, for testing deskewing. Each point is in the LiDAR
+    /// frame at its own firing time, as the sensor reports it.
+    #[must_use]
+    pub fn scan_moving(
+        &self,
+        building: &Building,
+        start: &Pose3,
+        end: &Pose3,
+        rng: &mut SimRng,
+    ) -> PointCloud {
+        let columns = f64::from(self.config.columns);
+        self.cast(
+            building,
+            |col| interpolate(start, end, f64::from(col) / columns),
+            rng,
+        )
+    }
+
+    /// Cast every ray, column `col` from `pose_of(col)`.
+    fn cast(
+        &self,
+        building: &Building,
+        pose_of: impl Fn(u32) -> Pose3,
+        rng: &mut SimRng,
+    ) -> PointCloud {
         let c = &self.config;
         let n = self.directions.len();
         let mut points = Vec::with_capacity(n);
         let mut rings = Vec::with_capacity(n);
         let mut times = Vec::with_capacity(n);
-        let origin = Point3::from(world_t_lidar.translation.vector);
-        let rot = world_t_lidar.rotation.to_rotation_matrix();
         let rings_per_col = c.rings as usize;
         let dt = self.sweep_period() / f64::from(c.columns);
-        for (i, d) in self.directions.iter().enumerate() {
-            let world_dir = rot * d;
-            let Some(hit) = building.cast_ray(&origin, &world_dir, c.max_range) else {
-                continue;
-            };
-            // One noise draw per hit, so the stream depends only on the geometry and the seed.
-            let noise = rng.normal(c.range_noise);
-            let dropped = c.dropout_probability > 0.0 && rng.chance(c.dropout_probability);
-            let range = hit.range + noise;
-            if dropped || range < c.min_range || range > c.max_range {
-                continue;
+        for (col, dirs) in self.directions.chunks_exact(rings_per_col).enumerate() {
+            let pose = pose_of(col as u32);
+            let origin = Point3::from(pose.translation.vector);
+            let rot = pose.rotation.to_rotation_matrix();
+            let time = (col as f64 * dt) as f32;
+            for (ring, d) in dirs.iter().enumerate() {
+                let world_dir = rot * d;
+                let Some(hit) = building.cast_ray(&origin, &world_dir, c.max_range) else {
+                    continue;
+                };
+                // One noise draw per hit, so the stream depends only on the geometry and the seed.
+                let noise = rng.normal(c.range_noise);
+                let dropped = c.dropout_probability > 0.0 && rng.chance(c.dropout_probability);
+                let range = hit.range + noise;
+                if dropped || range < c.min_range || range > c.max_range {
+                    continue;
+                }
+                points.push(Point3::from((d * range).cast::<f32>()));
+                rings.push(ring as u16);
+                times.push(time);
             }
-            points.push(Point3::from((d * range).cast::<f32>()));
-            rings.push((i % rings_per_col) as u16);
-            times.push(((i / rings_per_col) as f64 * dt) as f32);
         }
         // The channel lengths match the points by construction, so this never falls back.
         PointCloud::from_points(points)

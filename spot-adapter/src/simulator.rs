@@ -28,6 +28,10 @@ pub struct SimulationConfig {
     pub odometry: OdometryDriftConfig,
     /// Body height and LiDAR mounting.
     pub spot: SpotGeometry,
+    /// Cast each column from the pose at its firing time (the robot walks 12 cm during a
+    /// sweep), as a real spinning LiDAR sees it; `false` (the default) casts the whole turn from
+    /// the pose at the sample's stamp, so no deskewing is needed.
+    pub motion_distortion: bool,
 }
 
 impl Default for SimulationConfig {
@@ -38,6 +42,7 @@ impl Default for SimulationConfig {
             lidar: Vlp16Config::default(),
             odometry: OdometryDriftConfig::default(),
             spot: SpotGeometry::default(),
+            motion_distortion: false,
         }
     }
 }
@@ -67,6 +72,7 @@ pub struct SimulatedSpot {
     body_t_lidar: Pose3,
     truth: Vec<(f64, Pose3)>,
     next: usize,
+    motion_distortion: bool,
 }
 
 impl SimulatedSpot {
@@ -93,6 +99,7 @@ impl SimulatedSpot {
             body_t_lidar: config.spot.body_t_lidar,
             truth,
             next: 0,
+            motion_distortion: config.motion_distortion,
         })
     }
 
@@ -169,11 +176,17 @@ impl Iterator for SimulatedSpot {
         let &(stamp, world_t_body) = self.truth.get(self.next)?;
         self.next += 1;
         let odom_t_body = self.odometry.step(&world_t_body);
-        let cloud = self.lidar.scan(
-            &self.building,
-            &(world_t_body * self.body_t_lidar),
-            &mut self.noise,
-        );
+        let start = world_t_body * self.body_t_lidar;
+        let cloud = match self.truth.get(self.next) {
+            Some(&(_, next_body)) if self.motion_distortion => self.lidar.scan_moving(
+                &self.building,
+                &start,
+                &(next_body * self.body_t_lidar),
+                &mut self.noise,
+            ),
+            // The last sample of a run has no later pose: the robot has stopped.
+            _ => self.lidar.scan(&self.building, &start, &mut self.noise),
+        };
         Some(Sample {
             stamp,
             odom_t_body,

@@ -67,6 +67,58 @@ fn scan_points_lie_at_the_ray_cast_distance() {
 }
 
 #[test]
+fn moving_scan_casts_each_column_from_its_firing_pose() {
+    let b = Building::generate(6, &BuildingConfig::default()).unwrap();
+    let lidar = Vlp16::new(noiseless()).unwrap();
+    let c = b.corridor_loop()[0];
+    let start = Pose3::from_parts(
+        Translation3::new(c.x + 2.0, c.y, 0.8),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, 0.1),
+    );
+    // 0.12 m forward and 3 degrees of turn during the sweep.
+    let end = start
+        * Pose3::from_parts(
+            Translation3::new(0.12, 0.0, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 3f64.to_radians()),
+        );
+    let moving = lidar.scan_moving(&b, &start, &end, &mut SimRng::new(0, 0));
+    let still = lidar.scan(&b, &start, &mut SimRng::new(0, 0));
+    let time = moving.time().unwrap();
+    // Column 0 fires at the start pose: identical points.
+    let first = time.iter().take_while(|&&t| t == 0.0).count();
+    assert_eq!(moving.points()[..first], still.points()[..first]);
+    let inside = |q: Point3<f64>| {
+        q.z <= 0.0
+            || q.z >= b.ceiling_height()
+            || b.boxes()
+                .iter()
+                .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
+    };
+    let mut moved = 0;
+    for (k, p) in moving.points().iter().enumerate().step_by(41) {
+        let pose = slam_core::interpolate(&start, &end, f64::from(time[k]) / 0.2);
+        let local = nalgebra::convert::<_, Vector3<f64>>(p.coords);
+        let (o, dir, r) = (
+            Point3::from(pose.translation.vector),
+            pose.rotation * local.normalize(),
+            local.norm(),
+        );
+        assert!(
+            !inside(o + dir * (r - 2e-3)) && inside(o + dir * (r + 2e-3)),
+            "point {k}"
+        );
+        // The same point seen as if from the start pose lands off the surface late in the sweep.
+        let naive = start * Point3::from(local);
+        moved +=
+            usize::from(time[k] > 0.15 && (naive - (pose * Point3::from(local))).norm() > 0.05);
+    }
+    assert!(
+        moved > 50,
+        "late columns are displaced by the motion: {moved}"
+    );
+}
+
+#[test]
 fn noise_and_dropouts_have_the_configured_size() {
     let b = Building::generate(3, &BuildingConfig::default()).unwrap();
     let start = b.corridor_loop()[2];
