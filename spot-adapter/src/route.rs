@@ -60,11 +60,11 @@ impl Route {
         let c = building.corridor_loop();
         let start = 0.5 * (c[0] + c[1]);
         let points = vec![start, c[1], c[2], c[3], c[0], start];
-        // Four distinct corners: never fails.
+        // Four distinct corners: `new` cannot fail; fall back to a straight line if it did.
         Self::new(points, true).unwrap_or_else(|_| Self {
-            points: vec![start],
-            cumulative: vec![0.0],
-            closed: true,
+            points: vec![c[0], c[1]],
+            cumulative: vec![0.0, (c[1] - c[0]).norm()],
+            closed: false,
         })
     }
 
