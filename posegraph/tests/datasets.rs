@@ -194,3 +194,26 @@ fn g2o_round_trip_is_exact() {
         assert_eq!(a.information, b.information);
     }
 }
+
+/// `input_INTEL_g2o`, where GTSAM's LM does not move: Gauss-Newton converges to a log-map chi2
+/// of 215.84 (g2o's GN reaches 215.83 in g2o's convention). With its 1e12 translation
+/// information on pure rotations, the two conventions have different optima: g2o's chi2 at our
+/// log-map optimum is about 1.2e5, printed but not asserted.
+#[test]
+#[ignore = "reads the shared data folder; run with --ignored"]
+fn intel_where_gtsam_lm_is_stuck() {
+    let Some(p) = shared("input_INTEL_g2o.g2o") else {
+        return;
+    };
+    let G2oGraph::Se2(mut g) = read_g2o(p).unwrap() else {
+        panic!("a 2D file")
+    };
+    fix_first(&mut g);
+    let r = GaussNewton::default().optimize(&mut g).unwrap();
+    let chi2 = g2o_chi2(&G2oGraph::Se2(g));
+    eprintln!(
+        "INTEL: GN {} iterations, log-map chi2 {}, g2o-convention chi2 {chi2}",
+        r.iterations, r.final_cost
+    );
+    assert!(r.final_cost <= 216.0, "log-map chi2 {}", r.final_cost);
+}
