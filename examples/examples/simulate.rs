@@ -10,7 +10,7 @@ use slam_core::Pose3;
 use slam_core::io::StampedPose;
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, RecordingWriter, SimulatedSpot,
-    SimulationConfig, absolute_trajectory_error, end_point_drift, segment_drift,
+    SimulationConfig, TrajectoryEvaluation,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -71,18 +71,28 @@ fn main() -> anyhow::Result<()> {
         1e3 * worst,
         if out.is_some() { ", PCD writing" } else { "" }
     );
-    let ate = absolute_trajectory_error(&odometry, &truth, DEFAULT_MAX_STAMP_DIFFERENCE)?;
-    let est: Vec<Pose3> = odometry.iter().map(|p| p.pose).collect();
-    let drift = end_point_drift(&est, &gt)?;
-    let seg = segment_drift(&est, &gt, &INDOOR_SEGMENT_LENGTHS, 10)?;
+    let e = TrajectoryEvaluation::compute(
+        &odometry,
+        &truth,
+        DEFAULT_MAX_STAMP_DIFFERENCE,
+        &INDOOR_SEGMENT_LENGTHS,
+    )?;
+    let segments = e
+        .segments
+        .map(|s| {
+            format!(
+                "{:.2} % ({} segments of 10-50 m)",
+                100.0 * s.translation,
+                s.segments
+            )
+        })
+        .unwrap_or_else(|| "n/a (path too short)".into());
     println!(
-        "odometry: ATE {:.3} m, loop end-point error {:.3} m ({:.2} % of {:.1} m), segment drift {:.2} % ({} segments of 10-50 m)",
-        ate.rmse,
-        drift.end_point_error,
-        100.0 * drift.relative_drift,
-        drift.path_length,
-        100.0 * seg.translation,
-        seg.segments
+        "odometry: ATE {:.3} m, loop end-point error {:.3} m ({:.2} % of {:.1} m), segment drift {segments}",
+        e.ate.rmse,
+        e.loop_end_point_error,
+        100.0 * e.end_point.relative_drift,
+        e.end_point.path_length,
     );
     if let Some(w) = writer {
         println!("recording written to {}", w.finish()?.display());

@@ -1,7 +1,7 @@
 //! Per-cell search state reused across queries: one packed record per cell (cost, parent,
 //! arrival direction, generation stamps), reset in O(1) by a generation counter, and an open list
-//! of 64-bit keys with lazy deletion: a binary heap, plus a stack for cells whose `f` equals the
-//! `f` being expanded.
+//! of 64-bit keys with lazy deletion: a stack for cells whose `f` equals the `f` being expanded,
+//! and a radix heap (a binary heap on grids too large for quantised keys) for the rest.
 //!
 //! The stack is sound because the heuristics used here are consistent: `f` never decreases along
 //! an expansion order, so any open cell with the current minimum `f` may be expanded next, and a
@@ -12,6 +12,8 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use slam_core::{Cell, GridPath};
+
+use crate::radix_heap::RadixHeap;
 
 /// No arrival direction (the start).
 pub(crate) const NO_DIRECTION: u8 = 8;
@@ -58,10 +60,15 @@ pub(crate) struct SearchSpace {
     width: u32,
     nodes: Vec<NodeState>,
     generation: u32,
+    /// The open list on grids with quantised keys: only keys above `current_f` reach it (equal
+    /// ones go to `same_f`), so its keys are monotone and a radix heap applies.
+    radix: RadixHeap,
+    /// The open list on grids too large for quantised keys.
     heap: BinaryHeap<Open>,
     /// Cells queued with `f` equal to `current_f`; expanded before anything on the heap.
     same_f: Vec<u32>,
     /// Quantised `f` (the key without its tie-break bits) of the last cell taken off the heap.
+    /// A key at or below it (below only by a rounding of `g + h`) joins `same_f`.
     current_f: u64,
     /// Whether every path cost on this grid stays below [`QUANTISED_LIMIT`].
     quantised: bool,
@@ -79,9 +86,10 @@ impl SearchSpace {
             width,
             nodes: vec![empty; n],
             generation: 0,
+            radix: RadixHeap::new(),
             heap: BinaryHeap::new(),
             same_f: Vec::new(),
-            current_f: u64::MAX,
+            current_f: 0,
             // No shortest path visits a cell twice, so costs stay below cells * sqrt(2).
             quantised: (n as f64) * std::f64::consts::SQRT_2 < QUANTISED_LIMIT,
         }
@@ -118,8 +126,9 @@ impl SearchSpace {
     /// Start a new query.
     pub(crate) fn reset(&mut self) {
         self.heap.clear();
+        self.radix.clear();
         self.same_f.clear();
-        self.current_f = u64::MAX;
+        self.current_f = 0;
         if self.generation >= MAX_GENERATION {
             // After 134 million queries: clear the stamps once.
             for n in &mut self.nodes {
@@ -145,10 +154,12 @@ impl SearchSpace {
             stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
         let key = self.key(g + h, g);
-        if self.quantised && key >> 16 == self.current_f {
+        if !self.quantised {
+            self.heap.push(Open { key, index: i });
+        } else if key >> 16 <= self.current_f {
             self.same_f.push(i);
         } else {
-            self.heap.push(Open { key, index: i });
+            self.radix.push(key, i);
         }
     }
 
@@ -173,10 +184,18 @@ impl SearchSpace {
                 return Some((i, g, d));
             }
         }
-        while let Some(o) = self.heap.pop() {
-            if let Some((g, d)) = self.close(o.index) {
-                self.current_f = o.key >> 16;
-                return Some((o.index, g, d));
+        if self.quantised {
+            while let Some((key, i)) = self.radix.pop() {
+                if let Some((g, d)) = self.close(i) {
+                    self.current_f = key >> 16;
+                    return Some((i, g, d));
+                }
+            }
+        } else {
+            while let Some(o) = self.heap.pop() {
+                if let Some((g, d)) = self.close(o.index) {
+                    return Some((o.index, g, d));
+                }
             }
         }
         None

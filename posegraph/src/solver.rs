@@ -48,6 +48,8 @@ fn cost_with<P: Linearize<D>, const D: usize>(graph: &PoseGraph<P>, poses: &[P])
 /// Cached structure of an optimiser.
 pub(crate) type Cache<const D: usize> = Option<NormalEquations<D>>;
 
+// One loop with the damping state machine in plain sight; splitting it would hide the control flow.
+#[allow(clippy::too_many_lines)]
 /// Run the loop. `levenberg` chooses LM (adaptive damping, rejected steps) or GN (no damping
 /// unless the factorisation needs it, every step accepted).
 pub(crate) fn optimize<P: Linearize<D>, const D: usize>(

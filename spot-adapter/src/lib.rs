@@ -15,7 +15,8 @@
 //! - [`SimulatedSpot`]: all of the above as an iterator of [`Sample`]s with ground truth.
 //! - [`RecordingWriter`], [`Recording`], [`KittiSequence`]: runs on disk.
 //! - [`absolute_trajectory_error`], [`end_point_drift`], [`segment_drift`],
-//!   [`loop_end_point_error`]: accuracy against ground truth.
+//!   [`loop_end_point_error`], all at once in [`TrajectoryEvaluation`]: accuracy against ground
+//!   truth.
 //!
 //! ```
 //! use spot_adapter::{
@@ -53,6 +54,7 @@ mod ate;
 mod building;
 mod drift;
 mod error;
+mod evaluation;
 mod floor_plan;
 mod frames;
 mod kitti;
@@ -74,6 +76,7 @@ pub use drift::{
     loop_end_point_error, path_length, segment_drift,
 };
 pub use error::AdapterError;
+pub use evaluation::TrajectoryEvaluation;
 pub use floor_plan::OBSTACLE_HEIGHT;
 pub use frames::SpotGeometry;
 pub use kitti::{KittiOdometry, KittiSequence};
