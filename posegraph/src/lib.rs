@@ -38,6 +38,7 @@ mod levenberg_marquardt;
 mod linearize;
 mod normal_equations;
 mod solver;
+pub mod toro;
 
 pub use error::GraphFileError;
 pub use gauss_newton::GaussNewton;

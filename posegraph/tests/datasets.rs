@@ -217,3 +217,37 @@ fn intel_where_gtsam_lm_is_stuck() {
     );
     assert!(r.final_cost <= 216.0, "log-map chi2 {}", r.final_cost);
 }
+
+/// FR079 in TORO's format: LM reaches GTSAM's 37.5718.
+#[test]
+#[ignore = "reads the shared data folder; run with --ignored"]
+fn fr079_toro() {
+    let Some(p) = shared("FR079.graph") else {
+        return;
+    };
+    let mut g = posegraph::toro::read_toro(p).unwrap();
+    fix_first(&mut g);
+    let r = LevenbergMarquardt::default().optimize(&mut g).unwrap();
+    assert_rel(r.final_cost, 37.5718, 1e-4, "FR079");
+}
+
+#[test]
+fn toro_information_order() {
+    let g = posegraph::toro::parse_toro(
+        "VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0\nEDGE2 0 1 1 0 0 10 1 20 30 2 3\n",
+    )
+    .unwrap();
+    let i = g.edges()[0].information;
+    assert_eq!(
+        (
+            i[(0, 0)],
+            i[(0, 1)],
+            i[(1, 1)],
+            i[(2, 2)],
+            i[(0, 2)],
+            i[(1, 2)]
+        ),
+        (10.0, 1.0, 20.0, 30.0, 2.0, 3.0)
+    );
+    assert!(posegraph::toro::parse_toro("VERTEX2 0 0 0 0\nFOO 1\n").is_err());
+}
