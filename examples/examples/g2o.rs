@@ -1,0 +1,94 @@
+//! Optimise a g2o (or TORO `.graph`) pose graph and print nodes, edges, iterations, initial and
+//! final cost in both conventions (log-map `sum e^T Omega e`, and g2o's own chi2) and milliseconds.
+//!
+//! `cargo run --release --example g2o -- FILE [--optimizer gn|lm] [--out OUT.g2o]`
+//!
+//! The first node is fixed when the file fixes none.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o, write_g2o};
+use posegraph::toro::read_toro;
+use posegraph::{GaussNewton, LevenbergMarquardt};
+use slam_core::{GraphPose, OptimizationReport, Optimizer, Pose2, Pose3, PoseGraph};
+
+const USAGE: &str = "usage: g2o FILE [--optimizer gn|lm] [--out OUT.g2o]";
+
+fn fix_first<P: GraphPose>(g: &mut PoseGraph<P>) -> Result<()> {
+    if !g.nodes().iter().any(|n| n.fixed) {
+        let id = g.nodes().first().context("the graph has no nodes")?.id;
+        g.fix(id)?;
+    }
+    Ok(())
+}
+
+fn run<P, O>(g: &mut PoseGraph<P>, optimizer: &mut O) -> Result<OptimizationReport>
+where
+    P: GraphPose,
+    O: Optimizer<P>,
+{
+    fix_first(g)?;
+    Ok(optimizer.optimize(g)?)
+}
+
+fn main() -> Result<()> {
+    let mut args = std::env::args().skip(1);
+    let (mut file, mut optimizer, mut out) = (None, "lm".to_string(), None);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--optimizer" => optimizer = args.next().context(USAGE)?,
+            "--out" => out = Some(args.next().context(USAGE)?),
+            "-h" | "--help" => {
+                println!("{USAGE}");
+                return Ok(());
+            }
+            _ if file.is_none() => file = Some(a),
+            _ => bail!("unexpected argument {a:?}; {USAGE}"),
+        }
+    }
+    let file = file.context(USAGE)?;
+    let mut graph = if file.ends_with(".graph") {
+        G2oGraph::Se2(read_toro(&file)?)
+    } else {
+        read_g2o(&file).with_context(|| format!("reading {file}"))?
+    };
+    let (nodes, edges) = match &graph {
+        G2oGraph::Se2(g) => (g.node_count(), g.edge_count()),
+        G2oGraph::Se3(g) => (g.node_count(), g.edge_count()),
+    };
+    let g2o_before = g2o_chi2(&graph);
+    let t = Instant::now();
+    let report = match (&mut graph, optimizer.as_str()) {
+        (G2oGraph::Se3(g), "lm") => run::<Pose3, _>(g, &mut LevenbergMarquardt::default())?,
+        (G2oGraph::Se3(g), "gn") => run::<Pose3, _>(g, &mut GaussNewton::default())?,
+        (G2oGraph::Se2(g), "lm") => run::<Pose2, _>(g, &mut LevenbergMarquardt::default())?,
+        (G2oGraph::Se2(g), "gn") => run::<Pose2, _>(g, &mut GaussNewton::default())?,
+        (_, other) => bail!("unknown optimizer {other:?}; {USAGE}"),
+    };
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    println!("file        {file}");
+    println!(
+        "graph       {nodes} nodes, {edges} edges ({})",
+        if matches!(graph, G2oGraph::Se3(_)) {
+            "SE(3)"
+        } else {
+            "SE(2)"
+        }
+    );
+    println!(
+        "optimizer   {optimizer}: {} iterations, {:?}",
+        report.iterations, report.stop_reason
+    );
+    println!(
+        "log-map     {:.6} -> {:.6} (GTSAM's error is half of this)",
+        report.initial_cost, report.final_cost
+    );
+    println!("g2o chi2    {g2o_before:.6} -> {:.6}", g2o_chi2(&graph));
+    println!("time        {ms:.1} ms");
+    if let Some(out) = out {
+        write_g2o(&out, &graph)?;
+        println!("wrote       {out}");
+    }
+    Ok(())
+}
