@@ -171,3 +171,15 @@ fn routes_stay_clear_of_obstacles() {
         Err(spot_adapter::AdapterError::BlockedEndpoint { which: "start", .. })
     ));
 }
+
+#[test]
+fn every_room_is_reachable_from_the_corridor() {
+    for seed in 0..4 {
+        let b = building(seed);
+        let start = Route::corridor_loop(&b).point_at(0.0);
+        for (i, room) in b.rooms().iter().enumerate() {
+            let r = Route::between(&b, start, room.entry_point(), &RouteConfig::default());
+            assert!(r.is_ok(), "seed {seed}: room {i} {:?}", r.err());
+        }
+    }
+}
