@@ -43,8 +43,8 @@
 //!
 //! Simplifications, each documented where it lives: by default a scan is cast from one pose (no
 //! motion distortion, so no deskewing is needed; `SimulationConfig::motion_distortion` turns it
-//! on), the body stays level at a fixed height (no gait
-//! sway), and surfaces reflect every ray (no intensity, no multi-path).
+//! on), the body stays level at a fixed height unless
+//! [`GaitSway`] is set, and surfaces reflect every ray (no intensity, no multi-path).
 //!
 //! When not to use it: the simulator is for testing SLAM and navigation logic at scale, not for
 //! photorealistic sensor studies (no materials, no beam divergence, no mixed pixels).
@@ -78,7 +78,7 @@ pub use drift::{
 pub use error::AdapterError;
 pub use evaluation::TrajectoryEvaluation;
 pub use floor_plan::OBSTACLE_HEIGHT;
-pub use frames::SpotGeometry;
+pub use frames::{GaitSway, SpotGeometry};
 pub use kitti::{KittiOdometry, KittiSequence};
 pub use lidar::{Vlp16, Vlp16Config};
 pub use odometry::{OdometryDriftConfig, OdometryModel};

@@ -6,7 +6,7 @@ use slam_core::io::StampedPose;
 
 use crate::building::{Building, BuildingConfig};
 use crate::error::AdapterError;
-use crate::frames::SpotGeometry;
+use crate::frames::{GaitSway, SpotGeometry};
 use crate::lidar::{Vlp16, Vlp16Config};
 use crate::odometry::{OdometryDriftConfig, OdometryModel};
 use crate::recording::{Recording, RecordingWriter};
@@ -28,6 +28,8 @@ pub struct SimulationConfig {
     pub odometry: OdometryDriftConfig,
     /// Body height and LiDAR mounting.
     pub spot: SpotGeometry,
+    /// The body's sway while walking (none by default).
+    pub gait_sway: GaitSway,
     /// Cast each column from the pose at its firing time (the robot walks 12 cm during a
     /// sweep), as a real spinning LiDAR sees it; `false` (the default) casts the whole turn from
     /// the pose at the sample's stamp, so no deskewing is needed.
@@ -42,6 +44,7 @@ impl Default for SimulationConfig {
             lidar: Vlp16Config::default(),
             odometry: OdometryDriftConfig::default(),
             spot: SpotGeometry::default(),
+            gait_sway: GaitSway::default(),
             motion_distortion: false,
         }
     }
@@ -86,11 +89,21 @@ impl SimulatedSpot {
         config: &SimulationConfig,
     ) -> Result<Self, AdapterError> {
         let lidar = Vlp16::new(config.lidar.clone())?;
-        let truth = route.walk(
+        let sway = &config.gait_sway;
+        if ![sway.height, sway.tilt, sway.frequency]
+            .iter()
+            .all(|v| v.is_finite() && *v >= 0.0)
+        {
+            return Err(AdapterError::InvalidConfig(format!("{sway:?}")));
+        }
+        let mut truth = route.walk(
             config.speed,
             config.lidar.rotation_rate,
             config.spot.body_height,
         )?;
+        for (t, pose) in &mut truth {
+            *pose *= sway.offset(*t);
+        }
         Ok(Self {
             building,
             lidar,

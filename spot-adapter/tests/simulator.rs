@@ -223,3 +223,46 @@ fn odometry_drifts_about_1_9_percent() {
     let vmean = vertical.iter().sum::<f64>() / vertical.len() as f64;
     assert!((0.002..0.006).contains(&vmean), "vertical drift {vmean}");
 }
+
+#[test]
+fn gait_sway_moves_the_body_within_its_amplitudes() {
+    let mut config = SimulationConfig::default();
+    config.lidar.range_noise = 0.0;
+    config.gait_sway.height = 0.01;
+    config.gait_sway.tilt = 0.01;
+    let b = Building::generate(4, &BuildingConfig::default()).unwrap();
+    let lap = Route::corridor_loop(&b);
+    let level = lap.walk(0.6, 5.0, 0.5).unwrap();
+    let mut sim = SimulatedSpot::new(b.clone(), &lap, &config).unwrap();
+    let (mut max_dz, mut max_tilt) = (0.0f64, 0.0f64);
+    for (g, l) in sim.ground_truth().iter().zip(&level) {
+        let d = l.1.inverse() * g.pose;
+        max_dz = max_dz.max(d.translation.z.abs());
+        max_tilt = max_tilt.max(d.rotation.angle());
+        assert!(d.translation.vector.xy().norm() < 1e-12);
+    }
+    assert!(max_dz <= 0.01 + 1e-12 && max_dz > 0.005, "{max_dz}");
+    assert!(
+        max_tilt <= 0.01 * 2f64.sqrt() + 1e-9 && max_tilt > 0.005,
+        "{max_tilt}"
+    );
+    // Scans are cast from the swaying pose: points land on surfaces through it.
+    let sample = sim.nth(7).unwrap();
+    let world_t_lidar = sample.ground_truth.unwrap() * sample.body_t_lidar;
+    let inside = |q: Point3<f64>| {
+        q.z <= 0.0
+            || q.z >= b.ceiling_height()
+            || b.boxes()
+                .iter()
+                .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
+    };
+    for p in sample.cloud.points().iter().step_by(97) {
+        let local = nalgebra::convert::<_, Vector3<f64>>(p.coords);
+        let (o, dir, r) = (
+            Point3::from(world_t_lidar.translation.vector),
+            world_t_lidar.rotation * local.normalize(),
+            local.norm(),
+        );
+        assert!(!inside(o + dir * (r - 2e-3)) && inside(o + dir * (r + 2e-3)));
+    }
+}
