@@ -175,6 +175,28 @@ impl BuildingConfig {
 }
 
 /// The generated building: boxes, rooms, the corridor loop and a ray-casting index.
+///
+/// ```
+/// use nalgebra::{Point3, Vector3};
+/// use spot_adapter::{Building, BuildingConfig, HitTarget};
+///
+/// let building = Building::generate(42, &BuildingConfig::default())?;
+/// let corner = building.corridor_loop()[0];
+/// assert!(!building.is_obstacle(corner), "the corridor is free");
+/// assert!(building.is_obstacle(nalgebra::Vector2::new(0.05, 5.0)), "the outer wall is not");
+///
+/// // Straight down from 0.8 m: the floor, 0.8 m away.
+/// let origin = Point3::new(corner.x, corner.y, 0.8);
+/// let hit = building.cast_ray(&origin, &-Vector3::z(), 100.0).unwrap();
+/// assert_eq!(hit.target, HitTarget::Floor);
+/// assert!((hit.range - 0.8).abs() < 1e-12);
+///
+/// // The ground-truth occupancy grid at 10 cm agrees.
+/// let grid = building.occupancy_grid(0.1)?;
+/// let (x, y) = grid.geometry().cell_coords(corner);
+/// assert!(grid.is_free_signed(x, y));
+/// # Ok::<(), spot_adapter::AdapterError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Building {
     pub(crate) boxes: Vec<SolidBox>,
