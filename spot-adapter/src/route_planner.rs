@@ -224,3 +224,35 @@ impl Route {
         Route::new(kept, false)
     }
 }
+
+impl Route {
+    /// A collision-free route visiting `waypoints` in order (plan-view metres), each leg planned
+    /// as in [`Route::between`]; with `closed`, a last leg returns to the first waypoint. For
+    /// tours that enter rooms, e.g. through [`Room::entry_point`](crate::Room::entry_point)s.
+    ///
+    /// # Errors
+    /// As [`Route::between`] for any leg; [`AdapterError::InvalidConfig`] for fewer than two
+    /// waypoints.
+    pub fn through(
+        building: &Building,
+        waypoints: &[Vector2<f64>],
+        closed: bool,
+        config: &RouteConfig,
+    ) -> Result<Self, AdapterError> {
+        if waypoints.len() < 2 {
+            return Err(AdapterError::InvalidConfig(
+                "a tour needs at least two waypoints".into(),
+            ));
+        }
+        let mut stops = waypoints.to_vec();
+        if closed {
+            stops.push(waypoints[0]);
+        }
+        let mut points = vec![stops[0]];
+        for leg in stops.windows(2) {
+            let route = Self::between(building, leg[0], leg[1], config)?;
+            points.extend_from_slice(&route.points()[1..]);
+        }
+        Self::new(points, closed)
+    }
+}

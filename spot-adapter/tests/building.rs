@@ -183,3 +183,31 @@ fn every_room_is_reachable_from_the_corridor() {
         }
     }
 }
+
+#[test]
+fn tour_through_rooms_returns_to_its_start() {
+    let b = building(9);
+    let start = Route::corridor_loop(&b).point_at(0.0);
+    let rooms = b.rooms();
+    let stops = [
+        start,
+        rooms[2].entry_point(),
+        rooms[rooms.len() - 2].entry_point(),
+        rooms[rooms.len() / 2].entry_point(),
+    ];
+    let config = RouteConfig::default();
+    let tour = Route::through(&b, &stops, true, &config).unwrap();
+    assert!(tour.is_closed());
+    assert_eq!(*tour.points().last().unwrap(), start);
+    let mut visited = 0;
+    let steps = (tour.length() / 0.02) as usize;
+    for k in 0..=steps {
+        let p = tour.point_at(k as f64 * 0.02);
+        assert!(
+            b.clearance(p) >= config.clearance - 1e-9,
+            "tour passes {p:?}"
+        );
+        visited += stops.iter().filter(|s| (p - **s).norm() < 0.011).count();
+    }
+    assert!(visited >= stops.len(), "every stop is on the tour");
+}
