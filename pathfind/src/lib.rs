@@ -51,7 +51,6 @@ mod line_of_sight;
 pub mod movement;
 pub mod movingai;
 mod path_filter;
-mod radix_heap;
 mod search_space;
 
 pub use astar::AStar;

@@ -1,7 +1,7 @@
 //! Per-cell search state reused across queries: one packed record per cell (cost, parent,
 //! arrival direction, generation stamps), reset in O(1) by a generation counter, and an open list
-//! of 64-bit keys with lazy deletion: a stack for cells whose `f` equals the `f` being expanded,
-//! and a radix heap (a binary heap on grids too large for quantised keys) for the rest.
+//! of 64-bit keys with lazy deletion: a binary heap, plus a stack for cells whose `f` equals the
+//! `f` being expanded.
 //!
 //! The stack is sound because the heuristics used here are consistent: `f` never decreases along
 //! an expansion order, so any open cell with the current minimum `f` may be expanded next, and a
@@ -12,8 +12,6 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use slam_core::{Cell, GridPath};
-
-use crate::radix_heap::RadixHeap;
 
 /// No arrival direction (the start).
 pub(crate) const NO_DIRECTION: u8 = 8;
@@ -60,10 +58,6 @@ pub(crate) struct SearchSpace {
     width: u32,
     nodes: Vec<NodeState>,
     generation: u32,
-    /// The open list on grids with quantised keys: only keys above `current_f` reach it (equal
-    /// ones go to `same_f`), so its keys are monotone and a radix heap applies.
-    radix: RadixHeap,
-    /// The open list on grids too large for quantised keys.
     heap: BinaryHeap<Open>,
     /// Cells queued with `f` equal to `current_f`; expanded before anything on the heap.
     same_f: Vec<u32>,
@@ -86,7 +80,6 @@ impl SearchSpace {
             width,
             nodes: vec![empty; n],
             generation: 0,
-            radix: RadixHeap::new(),
             heap: BinaryHeap::new(),
             same_f: Vec::new(),
             current_f: 0,
@@ -126,7 +119,6 @@ impl SearchSpace {
     /// Start a new query.
     pub(crate) fn reset(&mut self) {
         self.heap.clear();
-        self.radix.clear();
         self.same_f.clear();
         self.current_f = 0;
         if self.generation >= MAX_GENERATION {
@@ -154,12 +146,10 @@ impl SearchSpace {
             stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
         let key = self.key(g + h, g);
-        if !self.quantised {
-            self.heap.push(Open { key, index: i });
-        } else if key >> 16 <= self.current_f {
+        if self.quantised && key >> 16 <= self.current_f {
             self.same_f.push(i);
         } else {
-            self.radix.push(key, i);
+            self.heap.push(Open { key, index: i });
         }
     }
 
@@ -184,18 +174,10 @@ impl SearchSpace {
                 return Some((i, g, d));
             }
         }
-        if self.quantised {
-            while let Some((key, i)) = self.radix.pop() {
-                if let Some((g, d)) = self.close(i) {
-                    self.current_f = key >> 16;
-                    return Some((i, g, d));
-                }
-            }
-        } else {
-            while let Some(o) = self.heap.pop() {
-                if let Some((g, d)) = self.close(o.index) {
-                    return Some((o.index, g, d));
-                }
+        while let Some(o) = self.heap.pop() {
+            if let Some((g, d)) = self.close(o.index) {
+                self.current_f = o.key >> 16;
+                return Some((o.index, g, d));
             }
         }
         None
