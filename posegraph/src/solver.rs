@@ -149,7 +149,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
         cost = new_cost;
         relinearize = true;
         if levenberg {
-            lambda = (lambda / 3.0).max(1e-15);
+            lambda = (lambda / 10.0).max(1e-15);
             nu = 2.0;
         } else if lambda > 0.0 {
             lambda = 0.0;

@@ -1,0 +1,35 @@
+"""Peer timing for the posegraph bench: GTSAM's Levenberg-Marquardt on the same g2o files.
+
+Run through gtsam_posegraph.sh, which installs GTSAM from PyPI into a virtual environment.
+Prints, per file, GTSAM's final error (0.5 * sum e^T Omega e, so twice it is comparable with
+spot-nav's log-map cost) and the best of five wall times.
+"""
+
+import sys
+import time
+
+import gtsam
+
+
+def solve(path):
+    is3d = any(line.startswith("VERTEX_SE3") for line in open(path))
+    graph, initial = gtsam.readG2o(path, is3d)
+    if is3d:
+        noise = gtsam.noiseModel.Diagonal.Sigmas([1e-6] * 6)
+        graph.add(gtsam.PriorFactorPose3(0, initial.atPose3(0), noise))
+    else:
+        noise = gtsam.noiseModel.Diagonal.Sigmas([1e-6] * 3)
+        graph.add(gtsam.PriorFactorPose2(0, initial.atPose2(0), noise))
+    params = gtsam.LevenbergMarquardtParams()
+    best = float("inf")
+    result = None
+    for _ in range(5):
+        start = time.perf_counter()
+        result = gtsam.LevenbergMarquardtOptimizer(graph, initial, params).optimize()
+        best = min(best, time.perf_counter() - start)
+    return graph.error(result), best
+
+
+for path in sys.argv[1:]:
+    error, seconds = solve(path)
+    print(f"{path}\tgtsam_lm_error={error:.6f}\tchi2={2 * error:.6f}\tms={seconds * 1e3:.1f}")
