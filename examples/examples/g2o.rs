@@ -48,7 +48,10 @@ fn main() -> Result<()> {
         }
     }
     let file = file.context(USAGE)?;
-    let mut graph = if file.ends_with(".graph") {
+    let is_toro = std::path::Path::new(&file)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("graph"));
+    let mut graph = if is_toro {
         G2oGraph::Se2(read_toro(&file)?)
     } else {
         read_g2o(&file).with_context(|| format!("reading {file}"))?

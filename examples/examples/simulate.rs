@@ -77,16 +77,16 @@ fn main() -> anyhow::Result<()> {
         DEFAULT_MAX_STAMP_DIFFERENCE,
         &INDOOR_SEGMENT_LENGTHS,
     )?;
-    let segments = e
-        .segments
-        .map(|s| {
+    let segments = e.segments.map_or_else(
+        || "n/a (path too short)".into(),
+        |s| {
             format!(
                 "{:.2} % ({} segments of 10-50 m)",
                 100.0 * s.translation,
                 s.segments
             )
-        })
-        .unwrap_or_else(|| "n/a (path too short)".into());
+        },
+    );
     println!(
         "odometry: ATE {:.3} m, loop end-point error {:.3} m ({:.2} % of {:.1} m), segment drift {segments}",
         e.ate.rmse,
