@@ -1,0 +1,137 @@
+//! The ICP loop shared by the two backends: correspondences on the target's k-d tree, a step
+//! from the backend, convergence tests, and the final report.
+
+use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
+use slam_core::{Alignment, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat};
+
+use crate::config::IcpConfig;
+use crate::target::PreparedTarget;
+
+/// One correspondence: source point moved by the current pose, its target point, and the target
+/// normal when available.
+pub(crate) struct Pair {
+    pub(crate) p: Point3<f64>,
+    pub(crate) q: Point3<f64>,
+    pub(crate) n: Option<Vector3<f64>>,
+}
+
+/// How a backend turns correspondences into an update (applied on the left).
+pub(crate) trait IcpStep {
+    /// The residual of a pair (metres).
+    fn residual(pair: &Pair) -> f64;
+    /// The update `delta` with `pose <- exp(delta) pose`, or `None` when the system is singular.
+    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>>;
+    /// `J^T W J` of the pairs (left perturbation, `[rho; phi]`).
+    fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64>;
+}
+
+/// Jacobian of `p` moved by a left perturbation: `d(exp(d) p)/dd = [I, -[p]x]`.
+pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
+    let mut j = nalgebra::Matrix3x6::zeros();
+    j.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&nalgebra::Matrix3::identity());
+    j.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-so3_hat(&p.coords)));
+    j
+}
+
+fn correspondences(
+    source: &[Point3<f64>],
+    target: &PreparedTarget,
+    pose: &Pose3,
+    max_d2: f64,
+) -> Vec<Pair> {
+    source
+        .iter()
+        .filter_map(|s| {
+            let p = pose * s;
+            let (i, d2) = target.nearest(&p);
+            (d2 <= max_d2).then(|| Pair {
+                p,
+                q: target.points[i],
+                n: target.normals.as_ref().map(|n| n[i]),
+            })
+        })
+        .collect()
+}
+
+pub(crate) fn align<S: IcpStep>(
+    config: &IcpConfig,
+    source: &[Point3<f64>],
+    target: &PreparedTarget,
+    initial: &Pose3,
+) -> Result<Alignment, RegistrationError> {
+    if !pose3_is_finite(initial) {
+        return Err(RegistrationError::NonFiniteInitialGuess);
+    }
+    let max_d2 = config.max_correspondence_distance * config.max_correspondence_distance;
+    let mut pose = *initial;
+    let mut converged = false;
+    let mut iterations = 0;
+    let mut weights = Vec::new();
+    for _ in 0..config.max_iterations {
+        iterations += 1;
+        let pairs = correspondences(source, target, &pose, max_d2);
+        if pairs.len() < config.min_correspondences {
+            return Err(RegistrationError::TooFewCorrespondences {
+                found: pairs.len(),
+                required: config.min_correspondences,
+            });
+        }
+        weights = pairs
+            .iter()
+            .map(|p| config.kernel.weight(S::residual(p)))
+            .collect();
+        let Some(delta) = S::step(&pairs, &weights) else {
+            return Err(RegistrationError::Degenerate(
+                "singular normal equations".into(),
+            ));
+        };
+        if !delta.iter().all(|v| v.is_finite()) {
+            return Err(RegistrationError::Degenerate("non-finite update".into()));
+        }
+        pose = se3_exp(&delta) * pose;
+        let dt = delta.fixed_rows::<3>(0).norm();
+        let dr = delta.fixed_rows::<3>(3).norm();
+        if dt < config.translation_tolerance && dr < config.rotation_tolerance {
+            converged = true;
+            break;
+        }
+    }
+    // Report at the final pose.
+    let pairs = correspondences(source, target, &pose, max_d2);
+    if pairs.len() < config.min_correspondences {
+        return Err(RegistrationError::TooFewCorrespondences {
+            found: pairs.len(),
+            required: config.min_correspondences,
+        });
+    }
+    weights.clear();
+    weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
+    let inliers = weights.iter().filter(|&&w| w > 0.0).count();
+    let sq: f64 = pairs
+        .iter()
+        .zip(&weights)
+        .filter(|(_, w)| **w > 0.0)
+        .map(|(p, _)| S::residual(p).powi(2))
+        .sum();
+    let rmse = if inliers > 0 {
+        (sq / inliers as f64).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let information = S::information(&pairs, &weights);
+    let eig = SymmetricEigen::new(information).eigenvalues;
+    let (lo, hi) = (eig.min(), eig.max());
+    let min_eigenvalue_ratio = if hi > 0.0 { (lo / hi).max(0.0) } else { 0.0 };
+    Ok(Alignment {
+        pose,
+        converged,
+        iterations,
+        inliers,
+        inlier_ratio: inliers as f64 / source.len().max(1) as f64,
+        rmse,
+        information,
+        min_eigenvalue_ratio,
+    })
+}

@@ -1,0 +1,102 @@
+//! Point-to-plane ICP: Gauss-Newton on SE(3) with target normals from PCA.
+
+use nalgebra::{Matrix6, Point3, Vector6};
+use slam_core::{Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator};
+
+use crate::config::IcpConfig;
+use crate::icp::{IcpStep, Pair, align};
+use crate::target::{PreparedTarget, finite_points};
+
+/// Point-to-plane ICP: residual `n . (T p - q)` against the target point's normal (PCA over its
+/// nearest neighbours), minimised by Gauss-Newton steps on SE(3) with robust weights.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointToPlaneIcp {
+    /// Settings.
+    pub config: IcpConfig,
+}
+
+struct GaussNewtonPlane;
+
+/// `J = [n^T, (p x n)^T]` for a left perturbation of the moved point `p`.
+fn row(pair: &Pair) -> Vector6<f64> {
+    let n = pair.n.unwrap_or_default();
+    let c = pair.p.coords.cross(&n);
+    Vector6::new(n.x, n.y, n.z, c.x, c.y, c.z)
+}
+
+impl IcpStep for GaussNewtonPlane {
+    fn residual(pair: &Pair) -> f64 {
+        pair.n.map_or(f64::INFINITY, |n| n.dot(&(pair.p - pair.q)))
+    }
+
+    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>> {
+        let mut h = Matrix6::zeros();
+        let mut b = Vector6::zeros();
+        for (p, w) in pairs.iter().zip(weights) {
+            if *w == 0.0 {
+                continue;
+            }
+            let j = row(p);
+            h += j * j.transpose() * *w;
+            b += j * (Self::residual(p) * w);
+        }
+        h.cholesky().map(|c| -c.solve(&b))
+    }
+
+    fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {
+        pairs
+            .iter()
+            .zip(weights)
+            .fold(Matrix6::zeros(), |m, (p, w)| {
+                let j = row(p);
+                m + j * j.transpose() * *w
+            })
+    }
+}
+
+impl Registrator for PointToPlaneIcp {
+    type Source = Vec<Point3<f64>>;
+    type Target = PreparedTarget;
+
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
+        let pts = finite_points(cloud, self.config.source_voxel);
+        if pts.len() < self.config.min_correspondences {
+            return Err(RegistrationError::TooFewPoints {
+                what: "source",
+                points: pts.len(),
+                required: self.config.min_correspondences,
+            });
+        }
+        Ok(pts)
+    }
+
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
+        PreparedTarget::new(
+            finite_points(cloud, self.config.target_voxel),
+            Some(self.config.normal_neighbours),
+            self.config.min_correspondences,
+        )
+    }
+
+    fn align(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError> {
+        align::<GaussNewtonPlane>(&self.config, source, target, initial)
+    }
+}
+
+impl MapRegistrator for PointToPlaneIcp {
+    fn target_from_sources(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError> {
+        let pts: Vec<Point3<f32>> = parts
+            .iter()
+            .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
+            .collect();
+        self.prepare_target(&PointCloud::from_points(pts))
+    }
+}

@@ -1,0 +1,114 @@
+//! Point-to-point ICP with a closed-form weighted SVD (Arun/Umeyama) step.
+
+use nalgebra::{Matrix3, Matrix6, Point3, Rotation3, UnitQuaternion, Vector3, Vector6};
+use slam_core::{
+    Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, se3_log,
+};
+
+use crate::config::IcpConfig;
+use crate::icp::{IcpStep, Pair, align, point_jacobian};
+use crate::target::{PreparedTarget, finite_points};
+
+/// Point-to-point ICP: each iteration pairs every source point with its nearest target point and
+/// takes the weighted least-squares rigid transform between the pairs in closed form.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointToPointIcp {
+    /// Settings.
+    pub config: IcpConfig,
+}
+
+struct Svd;
+
+impl IcpStep for Svd {
+    fn residual(pair: &Pair) -> f64 {
+        (pair.p - pair.q).norm()
+    }
+
+    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>> {
+        let wsum: f64 = weights.iter().sum();
+        if wsum <= 0.0 {
+            return None;
+        }
+        let ca = pairs
+            .iter()
+            .zip(weights)
+            .fold(Vector3::zeros(), |a, (p, w)| a + p.p.coords * *w)
+            / wsum;
+        let cb = pairs
+            .iter()
+            .zip(weights)
+            .fold(Vector3::zeros(), |a, (p, w)| a + p.q.coords * *w)
+            / wsum;
+        let h = pairs
+            .iter()
+            .zip(weights)
+            .fold(Matrix3::zeros(), |m, (p, w)| {
+                m + (p.p.coords - ca) * (p.q.coords - cb).transpose() * *w
+            });
+        let svd = h.svd(true, true);
+        let (u, vt) = (svd.u?, svd.v_t?);
+        let mut d = Matrix3::identity();
+        d[(2, 2)] = (vt.transpose() * u.transpose()).determinant().signum();
+        let r = vt.transpose() * d * u.transpose();
+        let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
+        let step = Pose3::from_parts((cb - rot * ca).into(), rot);
+        Some(se3_log(&step))
+    }
+
+    fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {
+        pairs
+            .iter()
+            .zip(weights)
+            .fold(Matrix6::zeros(), |m, (p, w)| {
+                let j = point_jacobian(&p.p);
+                m + j.transpose() * j * *w
+            })
+    }
+}
+
+impl Registrator for PointToPointIcp {
+    type Source = Vec<Point3<f64>>;
+    type Target = PreparedTarget;
+
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
+        let pts = finite_points(cloud, self.config.source_voxel);
+        if pts.len() < self.config.min_correspondences {
+            return Err(RegistrationError::TooFewPoints {
+                what: "source",
+                points: pts.len(),
+                required: self.config.min_correspondences,
+            });
+        }
+        Ok(pts)
+    }
+
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
+        PreparedTarget::new(
+            finite_points(cloud, self.config.target_voxel),
+            None,
+            self.config.min_correspondences,
+        )
+    }
+
+    fn align(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError> {
+        align::<Svd>(&self.config, source, target, initial)
+    }
+}
+
+impl MapRegistrator for PointToPointIcp {
+    fn target_from_sources(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError> {
+        let pts: Vec<Point3<f32>> = parts
+            .iter()
+            .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
+            .collect();
+        self.prepare_target(&PointCloud::from_points(pts))
+    }
+}

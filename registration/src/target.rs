@@ -1,0 +1,101 @@
+//! A prepared target: points in a k-d tree, with PCA normals for point-to-plane.
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use nalgebra::{Matrix3, Point3, SymmetricEigen, Vector3};
+use slam_core::{PointCloud, RegistrationError};
+
+/// Target points, their k-d tree and (optionally) unit normals.
+pub struct PreparedTarget {
+    pub(crate) points: Vec<Point3<f64>>,
+    pub(crate) tree: ImmutableKdTree<f64, 3>,
+    pub(crate) normals: Option<Vec<Vector3<f64>>>,
+}
+
+impl std::fmt::Debug for PreparedTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedTarget")
+            .field("points", &self.points.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// Finite points of `cloud` as f64, voxel-filtered when `voxel > 0`.
+pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> {
+    let mut c = PointCloud::from_points(cloud.points().to_vec());
+    c.remove_non_finite();
+    let c = if voxel > 0.0 {
+        c.voxel_downsample(voxel).unwrap_or(c)
+    } else {
+        c
+    };
+    c.points().iter().map(|p| p.cast::<f64>()).collect()
+}
+
+impl PreparedTarget {
+    /// Build the tree (and normals from `normal_neighbours` nearest points when asked).
+    pub(crate) fn new(
+        points: Vec<Point3<f64>>,
+        normal_neighbours: Option<usize>,
+        min_points: usize,
+    ) -> Result<Self, RegistrationError> {
+        if points.len() < min_points {
+            return Err(RegistrationError::TooFewPoints {
+                what: "target",
+                points: points.len(),
+                required: min_points,
+            });
+        }
+        let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
+        let tree = ImmutableKdTree::new_from_slice(&coords)
+            .map_err(|e| RegistrationError::Degenerate(format!("k-d tree: {e:?}")))?;
+        let normals = normal_neighbours.map(|k| {
+            let k = std::num::NonZero::new(k.max(3)).unwrap_or(std::num::NonZero::<usize>::MIN);
+            coords
+                .iter()
+                .map(|q| {
+                    let nn = tree
+                        .query(q)
+                        .nearest_n::<SquaredEuclidean<f64>>(k)
+                        .execute();
+                    let pts: Vec<Vector3<f64>> =
+                        nn.iter().map(|r| points[r.item as usize].coords).collect();
+                    let mean = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
+                    let cov = pts.iter().fold(Matrix3::zeros(), |m, p| {
+                        m + (p - mean) * (p - mean).transpose()
+                    });
+                    let eig = SymmetricEigen::new(cov);
+                    let i = eig.eigenvalues.imin();
+                    eig.eigenvectors.column(i).into_owned()
+                })
+                .collect()
+        });
+        Ok(Self {
+            points,
+            tree,
+            normals,
+        })
+    }
+
+    /// Nearest target point to `q`: (index, squared distance).
+    #[inline]
+    pub(crate) fn nearest(&self, q: &Point3<f64>) -> (usize, f64) {
+        let r = self
+            .tree
+            .query(&[q.x, q.y, q.z])
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        (r.item as usize, r.distance)
+    }
+
+    /// Number of target points.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether the target has no points.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+}
