@@ -20,6 +20,32 @@ use spot_adapter::{
 
 const USAGE: &str = "usage: slam [RECORDING_DIR] [--seed N] [--out DIR]";
 
+/// Samples to feed the engine.
+type Samples = Box<dyn Iterator<Item = Result<Sample>>>;
+
+/// Samples, the LiDAR mounting and (when known) the ground truth of a recording or a simulation.
+fn open(recording: Option<&str>, seed: u64) -> Result<(Samples, Pose3, Option<Vec<StampedPose>>)> {
+    if let Some(dir) = recording {
+        let rec = Recording::open(dir)?;
+        let body_t_lidar = rec.body_t_lidar();
+        let truth = rec.ground_truth().map(<[StampedPose]>::to_vec);
+        let all: Vec<Result<Sample>> = rec
+            .samples()
+            .map(|s| s.map_err(anyhow::Error::from))
+            .collect();
+        Ok((Box::new(all.into_iter()), body_t_lidar, truth))
+    } else {
+        let mut config = SimulationConfig::default();
+        config.seed = seed;
+        let sim = SimulatedSpot::corridor_loop(seed, &config)?;
+        let body_t_lidar = sim.body_t_lidar();
+        let truth = Some(sim.ground_truth());
+        Ok((Box::new(sim.map(Ok)), body_t_lidar, truth))
+    }
+}
+
+// Argument parsing, the run and the report in reading order.
+#[allow(clippy::too_many_lines)]
 fn main() -> Result<()> {
     let (mut recording, mut seed, mut out) = (None, 1u64, None);
     let mut args = std::env::args().skip(1);
@@ -35,28 +61,7 @@ fn main() -> Result<()> {
             _ => bail!("unexpected argument {a:?}; {USAGE}"),
         }
     }
-    // Samples, the mounting and (when known) the ground truth.
-    let (samples, body_t_lidar, truth): (
-        Box<dyn Iterator<Item = Result<Sample>>>,
-        Pose3,
-        Option<Vec<StampedPose>>,
-    ) = if let Some(dir) = &recording {
-        let rec = Recording::open(dir)?;
-        let body_t_lidar = rec.body_t_lidar();
-        let truth = rec.ground_truth().map(<[StampedPose]>::to_vec);
-        let all: Vec<Result<Sample>> = rec
-            .samples()
-            .map(|s| s.map_err(anyhow::Error::from))
-            .collect();
-        (Box::new(all.into_iter()), body_t_lidar, truth)
-    } else {
-        let mut config = SimulationConfig::default();
-        config.seed = seed;
-        let sim = SimulatedSpot::corridor_loop(seed, &config)?;
-        let body_t_lidar = sim.body_t_lidar();
-        let truth = Some(sim.ground_truth());
-        (Box::new(sim.map(Ok)), body_t_lidar, truth)
-    };
+    let (samples, body_t_lidar, truth) = open(recording.as_deref(), seed)?;
     let odometry = PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.1 },
@@ -96,7 +101,7 @@ fn main() -> Result<()> {
         let sample = sample?;
         let outcome = slam.process(&sample.scan_input());
         n += 1;
-        if n % 50 == 0 {
+        if n.is_multiple_of(50) {
             eprint!(
                 "\r{n} scans, {} keyframes, {} loops",
                 slam.keyframe_count(),
