@@ -2,7 +2,12 @@
 //! test-only backends (brute-force point-to-point ICP and dense Gauss-Newton), so the engine's own
 //! logic (prediction, keyframes, local map, loop closure, edge frames, optimisation, outputs) is
 //! checked against ground truth independently of the real backends.
-#![allow(clippy::unwrap_used, clippy::panic, clippy::many_single_char_names, clippy::too_many_lines)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::panic,
+    clippy::many_single_char_names,
+    clippy::too_many_lines
+)]
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
