@@ -5,7 +5,7 @@ use slam_core::{Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError,
 
 use crate::config::IcpConfig;
 use crate::icp::{IcpStep, Pair, align};
-use crate::target::{PreparedTarget, finite_points};
+use crate::target::{PreparedTarget, finite_points, merge_sources, prepare_source_points};
 
 /// Point-to-plane ICP: residual `n . (T p - q)` against the target point's normal (PCA over its
 /// nearest neighbours), minimised by Gauss-Newton steps on SE(3) with robust weights.
@@ -59,15 +59,7 @@ impl Registrator for PointToPlaneIcp {
     type Target = PreparedTarget;
 
     fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
-        let pts = finite_points(cloud, self.config.source_voxel);
-        if pts.len() < self.config.min_correspondences {
-            return Err(RegistrationError::TooFewPoints {
-                what: "source",
-                points: pts.len(),
-                required: self.config.min_correspondences,
-            });
-        }
-        Ok(pts)
+        prepare_source_points(&self.config, cloud)
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
@@ -93,10 +85,6 @@ impl MapRegistrator for PointToPlaneIcp {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
-        let pts: Vec<Point3<f32>> = parts
-            .iter()
-            .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
-            .collect();
-        self.prepare_target(&PointCloud::from_points(pts))
+        self.prepare_target(&merge_sources(parts))
     }
 }

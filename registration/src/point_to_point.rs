@@ -7,7 +7,7 @@ use slam_core::{
 
 use crate::config::IcpConfig;
 use crate::icp::{IcpStep, Pair, align, point_jacobian};
-use crate::target::{PreparedTarget, finite_points};
+use crate::target::{PreparedTarget, finite_points, merge_sources, prepare_source_points};
 
 /// Point-to-point ICP: each iteration pairs every source point with its nearest target point and
 /// takes the weighted least-squares rigid transform between the pairs in closed form.
@@ -71,15 +71,7 @@ impl Registrator for PointToPointIcp {
     type Target = PreparedTarget;
 
     fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
-        let pts = finite_points(cloud, self.config.source_voxel);
-        if pts.len() < self.config.min_correspondences {
-            return Err(RegistrationError::TooFewPoints {
-                what: "source",
-                points: pts.len(),
-                required: self.config.min_correspondences,
-            });
-        }
-        Ok(pts)
+        prepare_source_points(&self.config, cloud)
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
@@ -105,10 +97,6 @@ impl MapRegistrator for PointToPointIcp {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
-        let pts: Vec<Point3<f32>> = parts
-            .iter()
-            .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
-            .collect();
-        self.prepare_target(&PointCloud::from_points(pts))
+        self.prepare_target(&merge_sources(parts))
     }
 }

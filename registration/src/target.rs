@@ -2,7 +2,9 @@
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix3, Point3, SymmetricEigen, Vector3};
-use slam_core::{PointCloud, RegistrationError};
+use slam_core::{PointCloud, Pose3, RegistrationError};
+
+use crate::config::IcpConfig;
 
 /// Target points, their k-d tree and (optionally) unit normals.
 pub struct PreparedTarget {
@@ -98,4 +100,30 @@ impl PreparedTarget {
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
     }
+}
+
+/// The source points of `cloud` for `config` (finite, voxel-filtered), at least
+/// `min_correspondences` of them.
+pub(crate) fn prepare_source_points(
+    config: &IcpConfig,
+    cloud: &PointCloud,
+) -> Result<Vec<Point3<f64>>, RegistrationError> {
+    let pts = finite_points(cloud, config.source_voxel);
+    if pts.len() < config.min_correspondences {
+        return Err(RegistrationError::TooFewPoints {
+            what: "source",
+            points: pts.len(),
+            required: config.min_correspondences,
+        });
+    }
+    Ok(pts)
+}
+
+/// Prepared sources moved by their poses, as one cloud (a local map).
+pub(crate) fn merge_sources(parts: &[(&Vec<Point3<f64>>, Pose3)]) -> PointCloud {
+    let pts: Vec<Point3<f32>> = parts
+        .iter()
+        .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
+        .collect();
+    PointCloud::from_points(pts)
 }
