@@ -49,7 +49,7 @@ fn correspondences(
             (d2 <= max_d2).then(|| Pair {
                 p,
                 q: target.points[i],
-                n: target.normals.as_ref().map(|n| n[i]),
+                n: target.normal(i),
             })
         })
         .collect()

@@ -1,5 +1,7 @@
 //! A prepared target: points in a k-d tree, with PCA normals for point-to-plane.
 
+use std::cell::OnceCell;
+
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix3, Point3, SymmetricEigen, Vector3};
 use slam_core::{PointCloud, Pose3, RegistrationError};
@@ -10,7 +12,13 @@ use crate::config::IcpConfig;
 pub struct PreparedTarget {
     pub(crate) points: Vec<Point3<f64>>,
     pub(crate) tree: ImmutableKdTree<f64, 3>,
-    pub(crate) normals: Option<Vec<Vector3<f64>>>,
+    normals: Option<NormalCache>,
+}
+
+/// PCA normals of the target points, computed once each on first use.
+struct NormalCache {
+    k: std::num::NonZero<usize>,
+    cells: Vec<OnceCell<Vector3<f64>>>,
 }
 
 impl std::fmt::Debug for PreparedTarget {
@@ -50,32 +58,41 @@ impl PreparedTarget {
         let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
         let tree = ImmutableKdTree::new_from_slice(&coords)
             .map_err(|e| RegistrationError::Degenerate(format!("k-d tree: {e:?}")))?;
-        let normals = normal_neighbours.map(|k| {
-            let k = std::num::NonZero::new(k.max(3)).unwrap_or(std::num::NonZero::<usize>::MIN);
-            coords
-                .iter()
-                .map(|q| {
-                    let nn = tree
-                        .query(q)
-                        .nearest_n::<SquaredEuclidean<f64>>(k)
-                        .execute();
-                    let pts: Vec<Vector3<f64>> =
-                        nn.iter().map(|r| points[r.item as usize].coords).collect();
-                    let mean = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
-                    let cov = pts.iter().fold(Matrix3::zeros(), |m, p| {
-                        m + (p - mean) * (p - mean).transpose()
-                    });
-                    let eig = SymmetricEigen::new(cov);
-                    let i = eig.eigenvalues.imin();
-                    eig.eigenvectors.column(i).into_owned()
-                })
-                .collect()
+        // Normals are computed on first use: an alignment touches only the target points that
+        // are some source point's nearest neighbour, a fraction of a local map's points.
+        let normals = normal_neighbours.map(|k| NormalCache {
+            k: std::num::NonZero::new(k.max(3)).unwrap_or(std::num::NonZero::<usize>::MIN),
+            cells: (0..points.len()).map(|_| OnceCell::new()).collect(),
         });
         Ok(Self {
             points,
             tree,
             normals,
         })
+    }
+
+    /// The unit normal of target point `i` (PCA of its nearest neighbours), when the target was
+    /// prepared with normals.
+    pub(crate) fn normal(&self, i: usize) -> Option<Vector3<f64>> {
+        let cache = self.normals.as_ref()?;
+        Some(*cache.cells[i].get_or_init(|| {
+            let p = self.points[i];
+            let nn = self
+                .tree
+                .query(&[p.x, p.y, p.z])
+                .nearest_n::<SquaredEuclidean<f64>>(cache.k)
+                .execute();
+            let pts: Vec<Vector3<f64>> = nn
+                .iter()
+                .map(|r| self.points[r.item as usize].coords)
+                .collect();
+            let mean = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
+            let cov = pts.iter().fold(Matrix3::zeros(), |m, q| {
+                m + (q - mean) * (q - mean).transpose()
+            });
+            let eig = SymmetricEigen::new(cov);
+            eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned()
+        }))
     }
 
     /// Nearest target point to `q`: (index, squared distance).
