@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use posegraph::LevenbergMarquardt;
 use posegraph::g2o::{G2oGraph, write_g2o};
 use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
-use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
+use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{GraphSlam, GraphSlamConfig, Pose3, ScanOutcome};
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, Recording, Sample, SimulatedSpot,
@@ -165,11 +165,9 @@ fn main() -> Result<()> {
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir)?;
-        write_ply(
-            dir.join("map.ply"),
-            &slam.map(0.05)?,
-            PlyEncoding::BinaryLittleEndian,
-        )?;
+        let map = slam.map(0.05)?;
+        write_ply(dir.join("map.ply"), &map, PlyEncoding::BinaryLittleEndian)?;
+        write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
         write_tum(dir.join("trajectory.tum"), &estimate)?;
         write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
         println!("wrote       {}", dir.display());
