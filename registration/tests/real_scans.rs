@@ -205,3 +205,26 @@ fn degenerate_input_is_an_error_or_flagged() {
         Err(RegistrationError::NonFiniteInitialGuess)
     ));
 }
+
+/// Three consecutive OS1-128 frames at 2.5 m/s: each frame-to-frame step within 5 cm and 0.2
+/// degrees of the shipped reference poses (themselves an estimate; eight other ICP variants agree
+/// with them to 0.7-3.8 cm).
+#[test]
+fn os1_128_steps_match_the_reference_poses() {
+    let poses =
+        slam_core::io::read_kitti_poses(here("../slam-core/tests/data/os1_128_poses_kitti.txt"))
+            .unwrap();
+    let frames = [
+        here("../slam-core/tests/data/os1_128_frame_00_fid1795.pcd"),
+        here("tests/data/os1_128_frame_01_fid1796.pcd"),
+        here("tests/data/os1_128_frame_02_fid1797.pcd"),
+    ]
+    .map(|p| slam_core::io::read_pcd(p).unwrap());
+    let icp = PointToPlaneIcp::default();
+    for k in 0..2 {
+        let reference = poses[k].inverse() * poses[k + 1];
+        let estimate = run(&icp, &frames[k + 1], &frames[k], &Pose3::identity());
+        let (rot, trans) = error(&reference, &estimate);
+        assert!(rot < 0.2 && trans < 0.05, "step {k}: {rot} deg, {trans} m");
+    }
+}
