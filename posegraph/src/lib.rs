@@ -31,6 +31,7 @@
 //! chordal or SE-Sync initialisation first), or for landmark-based factor graphs (this crate
 //! handles between-pose constraints only).
 
+mod chordal;
 mod error;
 pub mod g2o;
 mod gauss_newton;
@@ -40,6 +41,7 @@ mod normal_equations;
 mod solver;
 pub mod toro;
 
+pub use chordal::{ChordalInitialization, initialize_chordal};
 pub use error::GraphFileError;
 pub use gauss_newton::GaussNewton;
 pub use levenberg_marquardt::LevenbergMarquardt;

@@ -6,7 +6,7 @@ use faer::Side;
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::solvers::SymbolicLlt;
 use nalgebra::{SMatrix, SVector};
-use slam_core::{OptimizeError, PoseGraph};
+use slam_core::{GraphPose, OptimizeError, PoseGraph};
 
 use crate::linearize::Linearize;
 
@@ -40,10 +40,7 @@ pub(crate) struct NormalEquations<const D: usize> {
     pub(crate) gradient: Vec<f64>,
 }
 
-fn structure_key<P>(graph: &PoseGraph<P>) -> (usize, usize, u64)
-where
-    P: slam_core::GraphPose,
-{
+fn structure_key<P: GraphPose>(graph: &PoseGraph<P>) -> (usize, usize, u64) {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for (i, n) in graph.nodes().iter().enumerate() {
         if n.fixed {
@@ -55,12 +52,13 @@ where
 
 impl<const D: usize> NormalEquations<D> {
     /// Whether this pattern still fits `graph`.
-    pub(crate) fn fits<P: Linearize<D>>(&self, graph: &PoseGraph<P>) -> bool {
+    pub(crate) fn fits<P: GraphPose>(&self, graph: &PoseGraph<P>) -> bool {
         self.key == structure_key(graph)
     }
 
-    /// Build the pattern and the symbolic factorisation for `graph`.
-    pub(crate) fn new<P: Linearize<D>>(graph: &PoseGraph<P>) -> Result<Self, OptimizeError> {
+    /// Build the pattern and the symbolic factorisation for `graph`, with `D` unknowns per free
+    /// node (the pose's degrees of freedom for the optimisers, fewer for the chordal relaxation).
+    pub(crate) fn new<P: GraphPose>(graph: &PoseGraph<P>) -> Result<Self, OptimizeError> {
         let mut var_of_node = Vec::with_capacity(graph.node_count());
         let mut n_vars = 0;
         for n in graph.nodes() {
@@ -161,50 +159,75 @@ impl<const D: usize> NormalEquations<D> {
         self.pos(self.neighbours[j] - 1, c, j, c)
     }
 
-    /// Fill `values` and `gradient` at the current poses (robust kernels as IRLS weights).
-    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>) {
+    /// The variables of edge `k`'s two nodes (`None` for a fixed node).
+    #[inline]
+    pub(crate) fn edge_variables(&self, k: usize) -> (Option<usize>, Option<usize>) {
+        let s = &self.edges[k];
+        (s.a, s.b)
+    }
+
+    /// Set `values` and `gradient` to zero.
+    pub(crate) fn clear(&mut self) {
         self.values.iter_mut().for_each(|v| *v = 0.0);
         self.gradient.iter_mut().for_each(|v| *v = 0.0);
-        for (e, slots) in graph.edges().iter().zip(self.edges.clone()) {
+    }
+
+    /// Add edge `k`'s blocks `J^T Omega J` (Jacobians `ja`, `jb` of its two nodes) to `values`;
+    /// a fixed node's blocks are skipped.
+    #[inline]
+    pub(crate) fn add_hessian(
+        &mut self,
+        k: usize,
+        ja: &SMatrix<f64, D, D>,
+        jb: &SMatrix<f64, D, D>,
+        omega: &SMatrix<f64, D, D>,
+    ) {
+        let slots = self.edges[k];
+        for (v, j) in [(slots.a, ja), (slots.b, jb)] {
+            if let Some(v) = v {
+                let h: SMatrix<f64, D, D> = j.transpose() * omega * j;
+                let diag_rank = self.neighbours[v] - 1;
+                for c in 0..D {
+                    for r in 0..=c {
+                        let p = self.pos(diag_rank, r, v, c);
+                        self.values[p] += h[(r, c)];
+                    }
+                }
+            }
+        }
+        if let (Some(va), Some(vb)) = (slots.a, slots.b) {
+            let (jlo, hi, jhi) = if va < vb { (ja, vb, jb) } else { (jb, va, ja) };
+            let h: SMatrix<f64, D, D> = jlo.transpose() * omega * jhi;
+            for c in 0..D {
+                for r in 0..D {
+                    let p = self.pos(slots.rank_lo, r, hi, c);
+                    self.values[p] += h[(r, c)];
+                }
+            }
+        }
+    }
+
+    /// Fill `values` and `gradient` at the current poses (robust kernels as IRLS weights).
+    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>) {
+        self.clear();
+        for (k, e) in graph.edges().iter().enumerate() {
             let (a, b) = (&graph.nodes()[e.from].pose, &graph.nodes()[e.to].pose);
             let (err, ja, jb) = P::linearize(&e.measurement, a, b);
             let mut omega = P::info(&e.information);
-            if let Some(k) = e.kernel {
-                omega *= k.weight((err.transpose() * omega * err)[0]);
+            if let Some(kernel) = e.kernel {
+                omega *= kernel.weight((err.transpose() * omega * err)[0]);
             }
             let oe: SVector<f64, D> = omega * err;
-            let parts = [(slots.a, ja), (slots.b, jb)];
-            for &(v, j) in &parts {
+            let (va, vb) = self.edge_variables(k);
+            for (v, j) in [(va, &ja), (vb, &jb)] {
                 if let Some(v) = v {
                     let g = j.transpose() * oe;
                     for r in 0..D {
                         self.gradient[v * D + r] += g[r];
                     }
-                    let h: SMatrix<f64, D, D> = j.transpose() * omega * j;
-                    let diag_rank = self.neighbours[v] - 1;
-                    for c in 0..D {
-                        for r in 0..=c {
-                            let p = self.pos(diag_rank, r, v, c);
-                            self.values[p] += h[(r, c)];
-                        }
-                    }
                 }
             }
-            if let (Some(va), Some(vb)) = (slots.a, slots.b) {
-                let (lo, jlo, hi, jhi) = if va < vb {
-                    (va, ja, vb, jb)
-                } else {
-                    (vb, jb, va, ja)
-                };
-                let _ = lo;
-                let h: SMatrix<f64, D, D> = jlo.transpose() * omega * jhi;
-                for c in 0..D {
-                    for r in 0..D {
-                        let p = self.pos(slots.rank_lo, r, hi, c);
-                        self.values[p] += h[(r, c)];
-                    }
-                }
-            }
+            self.add_hessian(k, &ja, &jb, &omega);
         }
     }
 }
