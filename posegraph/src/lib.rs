@@ -45,5 +45,5 @@ pub use chordal::{ChordalInitialization, initialize_chordal};
 pub use error::GraphFileError;
 pub use gauss_newton::GaussNewton;
 pub use levenberg_marquardt::LevenbergMarquardt;
-pub use linearize::Linearize;
+pub use linearize::{ErrorModel, Linearize};
 pub use solver::SolverConfig;

@@ -8,7 +8,7 @@ use faer::sparse::linalg::solvers::SymbolicLlt;
 use nalgebra::{SMatrix, SVector};
 use slam_core::{GraphPose, OptimizeError, PoseGraph};
 
-use crate::linearize::Linearize;
+use crate::linearize::{ErrorModel, Linearize};
 
 /// Where each edge's blocks go in the value array.
 #[derive(Clone, Copy, Debug)]
@@ -207,12 +207,13 @@ impl<const D: usize> NormalEquations<D> {
         }
     }
 
-    /// Fill `values` and `gradient` at the current poses (robust kernels as IRLS weights).
-    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>) {
+    /// Fill `values` and `gradient` at the current poses for `model` (robust kernels as IRLS
+    /// weights).
+    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>, model: ErrorModel) {
         self.clear();
         for (k, e) in graph.edges().iter().enumerate() {
             let (a, b) = (&graph.nodes()[e.from].pose, &graph.nodes()[e.to].pose);
-            let (err, ja, jb) = P::linearize(&e.measurement, a, b);
+            let (err, ja, jb) = P::linearize(model, &e.measurement, a, b);
             let mut omega = P::info(&e.information);
             if let Some(kernel) = e.kernel {
                 omega *= kernel.weight((err.transpose() * omega * err)[0]);

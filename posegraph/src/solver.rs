@@ -8,7 +8,7 @@ use faer::sparse::linalg::solvers::Llt;
 use nalgebra::SVector;
 use slam_core::{OptimizationReport, OptimizeError, PoseGraph, StopReason};
 
-use crate::linearize::Linearize;
+use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
 
 /// Stopping and damping settings shared by both optimisers.
@@ -20,6 +20,8 @@ pub struct SolverConfig {
     pub relative_cost_tolerance: f64,
     /// Stop when the step's largest component is below this (metres or radians).
     pub step_tolerance: f64,
+    /// The edge error minimised; the report's costs are in this convention.
+    pub error_model: ErrorModel,
 }
 
 impl Default for SolverConfig {
@@ -28,18 +30,23 @@ impl Default for SolverConfig {
             max_iterations: 100,
             relative_cost_tolerance: 1e-10,
             step_tolerance: 1e-10,
+            error_model: ErrorModel::LogMap,
         }
     }
 }
 
 /// `sum rho(e^T Omega e)` with `poses` in place of the graph's.
-fn cost_with<P: Linearize<D>, const D: usize>(graph: &PoseGraph<P>, poses: &[P]) -> f64 {
+fn cost_with<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    poses: &[P],
+    model: ErrorModel,
+) -> f64 {
     graph
         .edges()
         .iter()
         .map(|e| {
-            let err = P::edge_error(&e.measurement, &poses[e.from], &poses[e.to]);
-            let s = P::mahalanobis_squared(&err, &e.information);
+            let err = P::error(model, &e.measurement, &poses[e.from], &poses[e.to]);
+            let s = (err.transpose() * P::info(&e.information) * err)[0];
             e.kernel.map_or(s, |k| k.rho(s))
         })
         .sum()
@@ -60,7 +67,9 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     initial_lambda: f64,
 ) -> Result<OptimizationReport, OptimizeError> {
     graph.check_gauge()?;
-    let initial_cost = graph.cost();
+    let model = config.error_model;
+    let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
+    let initial_cost = cost_with(graph, &poses, model);
     if !cache.as_ref().is_some_and(|c| c.fits(graph)) {
         *cache = Some(NormalEquations::new(graph)?);
     }
@@ -79,7 +88,6 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let mut cost = initial_cost;
     let mut lambda = if levenberg { initial_lambda } else { 0.0 };
     let mut nu = 2.0;
-    let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
     let mut rhs = faer::Mat::<f64>::zeros(n, 1);
     let mut iterations = 0;
     let mut stop = StopReason::MaxIterations;
@@ -87,7 +95,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let mut diagonal = vec![0.0; n];
     'outer: while iterations < config.max_iterations {
         if relinearize {
-            ne.assemble(graph);
+            ne.assemble(graph, model);
             for (k, d) in diagonal.iter_mut().enumerate() {
                 *d = ne.values[ne.diagonal_position(k)];
             }
@@ -128,7 +136,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
         if !step_max.is_finite() {
             return Err(OptimizeError::Factorization("non-finite step".into()));
         }
-        let new_cost = cost_with(graph, &trial);
+        let new_cost = cost_with(graph, &trial, model);
         // NaN costs count as worse.
         let improved = new_cost < cost;
         if levenberg && !improved {

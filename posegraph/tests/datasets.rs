@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use posegraph::g2o::{G2oGraph, g2o_chi2, parse_g2o, read_g2o};
-use posegraph::{GaussNewton, LevenbergMarquardt};
+use posegraph::{ErrorModel, GaussNewton, LevenbergMarquardt, SolverConfig};
 use slam_core::{GraphPose, OptimizeError, Optimizer, PoseGraph};
 
 fn data(name: &str) -> PathBuf {
@@ -195,27 +195,44 @@ fn g2o_round_trip_is_exact() {
     }
 }
 
-/// `input_INTEL_g2o`, where GTSAM's LM does not move: Gauss-Newton converges to a log-map chi2
-/// of 215.84 (g2o's GN reaches 215.83 in g2o's convention). With its 1e12 translation
-/// information on pure rotations, the two conventions have different optima: g2o's chi2 at our
-/// log-map optimum is about 1.2e5, printed but not asserted.
+/// `input_INTEL_g2o`, where GTSAM's LM does not move. Its edge 160->161 has a translational
+/// information of 2.7e12 on a near-pure rotation, so the log-map and g2o's convention have
+/// different optima: at the log-map optimum (215.84) g2o's chi2 is 1.2e5, nearly all of it that
+/// edge. Minimising g2o's own error ([`ErrorModel::G2o`]), Gauss-Newton reaches g2o's chi2 of
+/// 215.83 (g2o's GN, shared README), evaluated independently by `g2o_chi2`.
 #[test]
 #[ignore = "reads the shared data folder; run with --ignored"]
 fn intel_where_gtsam_lm_is_stuck() {
     let Some(p) = shared("input_INTEL_g2o.g2o") else {
+        eprintln!("input_INTEL_g2o.g2o not found; skipped");
         return;
     };
     let G2oGraph::Se2(mut g) = read_g2o(p).unwrap() else {
         panic!("a 2D file")
     };
     fix_first(&mut g);
+    let file_guess = g.clone();
     let r = GaussNewton::default().optimize(&mut g).unwrap();
-    let chi2 = g2o_chi2(&G2oGraph::Se2(g));
     eprintln!(
-        "INTEL: GN {} iterations, log-map chi2 {}, g2o-convention chi2 {chi2}",
-        r.iterations, r.final_cost
+        "INTEL log-map: GN {} iterations, log-map chi2 {}, g2o chi2 {}",
+        r.iterations,
+        r.final_cost,
+        g2o_chi2(&G2oGraph::Se2(g.clone()))
     );
     assert!(r.final_cost <= 216.0, "log-map chi2 {}", r.final_cost);
+    let config = SolverConfig {
+        error_model: ErrorModel::G2o,
+        ..SolverConfig::default()
+    };
+    let mut g = file_guess;
+    let r = GaussNewton::new(config).optimize(&mut g).unwrap();
+    let chi2 = g2o_chi2(&G2oGraph::Se2(g));
+    eprintln!(
+        "INTEL g2o convention: GN {} iterations, g2o chi2 {chi2}",
+        r.iterations
+    );
+    assert!(chi2 <= 216.0, "g2o chi2 {chi2}");
+    assert_rel(r.final_cost, chi2, 1e-12, "reported cost vs g2o_chi2");
 }
 
 /// FR079 in TORO's format: LM reaches GTSAM's 37.5718.
@@ -250,4 +267,45 @@ fn toro_information_order() {
         (10.0, 1.0, 20.0, 30.0, 2.0, 3.0)
     );
     assert!(posegraph::toro::parse_toro("VERTEX2 0 0 0 0\nFOO 1\n").is_err());
+}
+
+/// Minimising g2o's own error reaches g2o's optimum in g2o's convention (g2o-python's GN, shared
+/// README): tinyGrid3D 6.72788, smallGrid3D 458.154, `input_M3500_g2o` 137.913.
+#[test]
+fn g2o_error_model_reaches_g2o_optimum() {
+    let config = SolverConfig {
+        error_model: ErrorModel::G2o,
+        ..SolverConfig::default()
+    };
+    for (file, want) in [
+        ("tinyGrid3D.g2o", 6.72788),
+        ("smallGrid3D.g2o", 458.154),
+        ("input_M3500_g2o.g2o", 137.913),
+    ] {
+        for lm in [true, false] {
+            let mut graph = read_g2o(data(file)).unwrap();
+            let r = match &mut graph {
+                G2oGraph::Se3(g) => {
+                    fix_first(g);
+                    if lm {
+                        LevenbergMarquardt::new(config).optimize(g)
+                    } else {
+                        GaussNewton::new(config).optimize(g)
+                    }
+                }
+                G2oGraph::Se2(g) => {
+                    fix_first(g);
+                    if lm {
+                        LevenbergMarquardt::new(config).optimize(g)
+                    } else {
+                        GaussNewton::new(config).optimize(g)
+                    }
+                }
+            }
+            .unwrap();
+            let chi2 = g2o_chi2(&graph);
+            assert_rel(chi2, want, 1e-4, file);
+            assert_rel(r.final_cost, chi2, 1e-12, "reported cost vs g2o_chi2");
+        }
+    }
 }
