@@ -8,28 +8,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
-use slam_core::PointCloud;
-use slam_core::io::{read_kitti_bin, read_pcd, read_ply};
+use anyhow::{Context, Result};
+use slam_core::io::read_cloud;
 
 fn default_scan() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../slam-core/tests/data/hdl32e_garage_1503604882.703390000.pcd")
-}
-
-fn read_any(path: &Path) -> Result<PointCloud> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    let cloud = match ext.as_str() {
-        "pcd" => read_pcd(path)?,
-        "ply" => read_ply(path)?,
-        "bin" => read_kitti_bin(path)?,
-        other => bail!("unknown cloud extension {other:?} (expected pcd, ply or bin)"),
-    };
-    Ok(cloud)
 }
 
 fn main() -> Result<()> {
@@ -37,7 +21,7 @@ fn main() -> Result<()> {
         .nth(1)
         .map_or_else(default_scan, PathBuf::from);
     let started = Instant::now();
-    let mut cloud = read_any(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut cloud = read_cloud(&path).with_context(|| format!("reading {}", path.display()))?;
     let read_ms = started.elapsed().as_secs_f64() * 1e3;
     println!("file        {}", path.display());
     println!("points      {} (read in {read_ms:.1} ms)", cloud.len());

@@ -121,9 +121,6 @@ pub(crate) fn align<S: IcpStep>(
         f64::INFINITY
     };
     let information = S::information(&pairs, &weights);
-    let eig = SymmetricEigen::new(information).eigenvalues;
-    let (lo, hi) = (eig.min(), eig.max());
-    let min_eigenvalue_ratio = if hi > 0.0 { (lo / hi).max(0.0) } else { 0.0 };
     Ok(Alignment {
         pose,
         converged,
@@ -131,7 +128,14 @@ pub(crate) fn align<S: IcpStep>(
         inliers,
         inlier_ratio: inliers as f64 / source.len().max(1) as f64,
         rmse,
+        min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
         information,
-        min_eigenvalue_ratio,
     })
+}
+
+/// Smallest eigenvalue of an information matrix over its largest (0 when it is not positive).
+pub(crate) fn min_eigenvalue_ratio(information: &Matrix6<f64>) -> f64 {
+    let eig = SymmetricEigen::new(*information).eigenvalues;
+    let (lo, hi) = (eig.min(), eig.max());
+    if hi > 0.0 { (lo / hi).max(0.0) } else { 0.0 }
 }

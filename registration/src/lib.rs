@@ -43,12 +43,19 @@
 mod config;
 mod icp;
 mod kernel;
+mod lidar_layout;
+mod loam;
+mod loam_features;
 mod point_to_plane;
 mod point_to_point;
+mod sym3;
 mod target;
 
 pub use config::IcpConfig;
 pub use kernel::IcpKernel;
+pub use lidar_layout::LidarLayout;
+pub use loam::{LoamConfig, LoamRegistrator, LoamTarget};
+pub use loam_features::{LoamFeatureConfig, LoamFeatures};
 pub use point_to_plane::PointToPlaneIcp;
 pub use point_to_point::PointToPointIcp;
 pub use target::PreparedTarget;

@@ -2,36 +2,13 @@
 //! published reference pose, and on degenerate input.
 #![allow(clippy::unwrap_used)]
 
-use std::path::PathBuf;
+mod common;
 
-use nalgebra::{Matrix4, Point3, UnitQuaternion};
+use common::{error, here, random_halves, reference, target_scan};
+use nalgebra::Point3;
 use registration::{IcpConfig, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
 use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
-
-fn here(p: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
-}
-
-fn target_scan() -> PointCloud {
-    read_ply(here("../slam-core/tests/data/hdl32e_pair_target.ply")).unwrap()
-}
-
-fn reference() -> Pose3 {
-    let txt = std::fs::read_to_string(here("tests/data/T_target_source.txt")).unwrap();
-    let v: Vec<f64> = txt.split_whitespace().map(|s| s.parse().unwrap()).collect();
-    let m = Matrix4::from_row_slice(&v);
-    Pose3::from_parts(
-        m.fixed_view::<3, 1>(0, 3).into_owned().into(),
-        UnitQuaternion::from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned()),
-    )
-}
-
-/// Rotation (degrees) and translation (metres) between two poses.
-fn error(a: &Pose3, b: &Pose3) -> (f64, f64) {
-    let e = a.inverse() * b;
-    (e.rotation.angle().to_degrees(), e.translation.vector.norm())
-}
 
 fn run<R: Registrator>(r: &R, source: &PointCloud, target: &PointCloud, initial: &Pose3) -> Pose3 {
     let a = r
@@ -44,33 +21,6 @@ fn run<R: Registrator>(r: &R, source: &PointCloud, target: &PointCloud, initial:
     assert!(a.converged, "did not converge: {a:?}");
     assert!(a.inlier_ratio > 0.5 && a.rmse.is_finite() && a.min_eigenvalue_ratio > 1e-4);
     a.pose
-}
-
-/// A real scan split into two random halves (not even/odd: the lasers interleave), the source
-/// half moved by a known transform: (source, target, `target_T_source`).
-fn random_halves() -> (PointCloud, PointCloud, Pose3) {
-    let scan = target_scan();
-    let mut s: u64 = 0x1234_5678_9ABC_DEF1;
-    let mut coin = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        s & 1 == 1
-    };
-    let (mut a, mut b) = (Vec::new(), Vec::new());
-    for &p in scan.points() {
-        if coin() {
-            a.push(p);
-        } else {
-            b.push(p);
-        }
-    }
-    let truth = pose3_from_xyz_rpy(0.4, -0.25, 0.1, 0.03, -0.05, 10f64.to_radians());
-    (
-        PointCloud::from_points(b).transformed(&truth.inverse()),
-        PointCloud::from_points(a),
-        truth,
-    )
 }
 
 /// Split a real scan into two random halves (not even/odd: the lasers interleave), move one by a
@@ -211,15 +161,7 @@ fn degenerate_input_is_an_error_or_flagged() {
 /// with them to 0.7-3.8 cm).
 #[test]
 fn os1_128_steps_match_the_reference_poses() {
-    let poses =
-        slam_core::io::read_kitti_poses(here("../slam-core/tests/data/os1_128_poses_kitti.txt"))
-            .unwrap();
-    let frames = [
-        here("../slam-core/tests/data/os1_128_frame_00_fid1795.pcd"),
-        here("tests/data/os1_128_frame_01_fid1796.pcd"),
-        here("tests/data/os1_128_frame_02_fid1797.pcd"),
-    ]
-    .map(|p| slam_core::io::read_pcd(p).unwrap());
+    let (frames, poses) = common::os1_128();
     let icp = PointToPlaneIcp::default();
     for k in 0..2 {
         let reference = poses[k].inverse() * poses[k + 1];

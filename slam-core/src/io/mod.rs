@@ -19,12 +19,14 @@
 //!
 //! [`FormatError`]: crate::FormatError
 
+mod cloud_file;
 mod kitti;
 mod pcd;
 mod ply;
 mod scalar;
 mod tum;
 
+pub use cloud_file::read_cloud;
 pub use kitti::{
     KITTI_ROTATION_TOLERANCE, parse_kitti_bin, parse_kitti_poses, read_kitti_bin, read_kitti_poses,
     write_kitti_bin, write_kitti_bin_to, write_kitti_poses, write_kitti_poses_to,
