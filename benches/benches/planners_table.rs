@@ -6,7 +6,9 @@
 //!
 //! `cargo bench -p spot-nav-benches --bench planners_table`
 //! (`SPOT_NAV_DATA` names the shared data folder; `PLANNERS_TABLE_STRIDE=k` runs every k-th
-//! scenario for a quick look; `PLANNERS_TABLE_MAPS=den520d,maze512-8-0` picks maps.)
+//! scenario for a quick look; `PLANNERS_TABLE_MAPS=den520d,maze512-8-0` picks maps;
+//! `PLANNERS_TABLE_PLANNERS=AStar,word` keeps the peer and the planners whose names contain one of
+//! the words.)
 
 // A wrong or missing path must stop the bench: its figures would be meaningless.
 #![allow(clippy::panic)]
@@ -155,6 +157,14 @@ fn print_map(name: &str, grid: &BitGrid, scenarios: &[Scenario]) {
             JumpPointSearchPlus::preprocessed_bytes,
             cells,
         ));
+    }
+    if let Ok(picked) = std::env::var("PLANNERS_TABLE_PLANNERS") {
+        let mut first = true;
+        entries.retain(|e| {
+            let keep = first || picked.split(',').any(|p| e.name.contains(p));
+            first = false;
+            keep
+        });
     }
     // Round robin over chunks of scenarios, so a change of machine load hits every planner alike
     // while each planner still runs warm (one query at a time would let the others evict its

@@ -5,6 +5,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 use crate::best_first::best_first;
 use crate::components::Components;
 use crate::movement::octile;
+use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
 
 /// A* with the octile-distance heuristic (admissible and consistent for this movement model, so
@@ -12,7 +13,7 @@ use crate::search_space::SearchSpace;
 pub struct AStar<'g> {
     grid: &'g BitGrid,
     components: Components,
-    space: SearchSpace,
+    space: SearchSpace<BucketRing>,
 }
 
 impl<'g> AStar<'g> {

@@ -5,6 +5,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
 use crate::components::Components;
 use crate::movement::{DIRECTIONS, SQRT_2, legal_steps};
+use crate::open_list::BucketRing;
 use crate::search_space::{NO_DIRECTION, SearchSpace};
 
 /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
@@ -12,7 +13,7 @@ use crate::search_space::{NO_DIRECTION, SearchSpace};
 pub(crate) fn best_first(
     grid: &BitGrid,
     components: &Components,
-    space: &mut SearchSpace,
+    space: &mut SearchSpace<BucketRing>,
     start: Cell,
     goal: Cell,
     heuristic: impl Fn(Cell) -> f64,

@@ -4,6 +4,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::best_first::best_first;
 use crate::components::Components;
+use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
 
 /// Dijkstra's algorithm on the grid (uniform-cost search, no heuristic). Exact and simple; use
@@ -11,7 +12,7 @@ use crate::search_space::SearchSpace;
 pub struct Dijkstra<'g> {
     grid: &'g BitGrid,
     components: Components,
-    space: SearchSpace,
+    space: SearchSpace<BucketRing>,
 }
 
 impl<'g> Dijkstra<'g> {

@@ -50,6 +50,7 @@ mod jump_tables;
 mod line_of_sight;
 pub mod movement;
 pub mod movingai;
+mod open_list;
 mod path_filter;
 mod search_space;
 

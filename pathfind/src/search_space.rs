@@ -1,41 +1,23 @@
 //! Per-cell search state reused across queries: one packed record per cell (cost, parent,
 //! arrival direction, generation stamps), reset in O(1) by a generation counter, and an open list
-//! of 64-bit keys with lazy deletion: a binary heap, plus a stack for cells whose `f` equals the
-//! `f` being expanded.
+//! of 64-bit keys with lazy deletion (a binary heap, or a ring of buckets for the cell-by-cell
+//! searches; see [`crate::open_list`]), plus a stack for cells whose `f` equals the `f` being
+//! expanded.
 //!
 //! The stack is sound because the heuristics used here are consistent: `f` never decreases along
 //! an expansion order, so any open cell with the current minimum `f` may be expanded next, and a
 //! successor with that same `f` has the larger `g` (the preferred tie-break). On open maps most
-//! successors are such cells (walking straight at the goal), and they skip the heap entirely.
-
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+//! successors are such cells (walking straight at the goal), and they skip the open list entirely.
 
 use slam_core::{Cell, GridPath};
+
+use crate::open_list::{KeyHeap, OpenList};
 
 /// No arrival direction (the start).
 pub(crate) const NO_DIRECTION: u8 = 8;
 
 /// Path costs below 2^22 cells get quantised keys with a tie-break; see [`SearchSpace::key`].
 const QUANTISED_LIMIT: f64 = (1u64 << 22) as f64;
-
-/// An open-list entry: the smallest key pops first.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Open {
-    key: u64,
-    index: u32,
-}
-
-impl PartialOrd for Open {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Open {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.key.cmp(&self.key)
-    }
-}
 
 /// One cell's search record, 16 bytes so that four share a cache line.
 #[derive(Clone, Copy, Debug)]
@@ -53,22 +35,22 @@ const DIRECTION_MASK: u32 = 0xF;
 /// Generations run from 1 to this value, then the stamps are cleared once.
 const MAX_GENERATION: u32 = u32::MAX >> STAMP_SHIFT;
 
-/// Search state for one grid size.
-pub(crate) struct SearchSpace {
+/// Search state for one grid size, with open list `Q`.
+pub(crate) struct SearchSpace<Q = KeyHeap> {
     width: u32,
     nodes: Vec<NodeState>,
     generation: u32,
-    heap: BinaryHeap<Open>,
-    /// Cells queued with `f` equal to `current_f`; expanded before anything on the heap.
+    open: Q,
+    /// Cells queued with `f` equal to `current_f`; expanded before anything on the open list.
     same_f: Vec<u32>,
-    /// Quantised `f` (the key without its tie-break bits) of the last cell taken off the heap.
+    /// Quantised `f` (the key without its tie-break bits) of the last cell taken off the open list.
     /// A key at or below it (below only by a rounding of `g + h`) joins `same_f`.
     current_f: u64,
     /// Whether every path cost on this grid stays below [`QUANTISED_LIMIT`].
     quantised: bool,
 }
 
-impl SearchSpace {
+impl<Q: OpenList> SearchSpace<Q> {
     pub(crate) fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
         let empty = NodeState {
@@ -80,7 +62,7 @@ impl SearchSpace {
             width,
             nodes: vec![empty; n],
             generation: 0,
-            heap: BinaryHeap::new(),
+            open: Q::default(),
             same_f: Vec::new(),
             current_f: 0,
             // No shortest path visits a cell twice, so costs stay below cells * sqrt(2).
@@ -88,13 +70,15 @@ impl SearchSpace {
         }
     }
 
-    /// The heap key of priority `f` for a node of cost `g`: smaller pops first.
+    /// The open-list key of priority `f` for a node of cost `g`: smaller pops first.
     ///
     /// On grids whose costs stay below 2^22, `f` is fixed point with 26 fractional bits in the top
     /// 48 bits, and the low 16 bits prefer the larger `g` among equal `f`. Distinct costs
     /// `a + b sqrt(2)` below 2^22 differ by far more than 2^-26, so the order of `f` is exact.
     /// On larger grids the key is the bit pattern of `f` (monotone for non-negative floats).
-    #[inline]
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
     fn key(&self, f: f64, g: f64) -> u64 {
         if self.quantised {
             // `f >= 0`, so adding one half and truncating rounds (and avoids a libm call).
@@ -118,7 +102,7 @@ impl SearchSpace {
 
     /// Start a new query.
     pub(crate) fn reset(&mut self) {
-        self.heap.clear();
+        self.open.clear();
         self.same_f.clear();
         self.current_f = 0;
         if self.generation >= MAX_GENERATION {
@@ -133,7 +117,9 @@ impl SearchSpace {
 
     /// Offer `g` as the cost of reaching cell `i` from `parent`, arriving in `direction`; queue it
     /// with priority `g + h` when it improves.
-    #[inline]
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
     pub(crate) fn relax(&mut self, i: u32, g: f64, h: f64, parent: u32, direction: u8) {
         let generation = self.generation;
         let n = &mut self.nodes[i as usize];
@@ -145,17 +131,20 @@ impl SearchSpace {
             parent,
             stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
-        let key = self.key(g + h, g);
+        let f = g + h;
+        let key = self.key(f, g);
         if self.quantised && key >> 16 <= self.current_f {
             self.same_f.push(i);
         } else {
-            self.heap.push(Open { key, index: i });
+            self.open.push(key, f, i);
         }
     }
 
     /// Mark cell `i` expanded unless it already was in this query; returns its cost and arrival
     /// direction.
-    #[inline]
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
     fn close(&mut self, i: u32) -> Option<(f64, u8)> {
         let n = &mut self.nodes[i as usize];
         if n.stamp & CLOSED_BIT != 0 {
@@ -166,7 +155,9 @@ impl SearchSpace {
     }
 
     /// Pop the best open cell that is not yet expanded, and mark it expanded.
-    #[inline]
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
     pub(crate) fn pop(&mut self) -> Option<(u32, f64, u8)> {
         // Every queued cell was stamped in this generation, so only the closed bit needs a look.
         while let Some(i) = self.same_f.pop() {
@@ -174,7 +165,7 @@ impl SearchSpace {
                 return Some((i, g, d));
             }
         }
-        while let Some(o) = self.heap.pop() {
+        while let Some(o) = self.open.pop() {
             if let Some((g, d)) = self.close(o.index) {
                 self.current_f = o.key >> 16;
                 return Some((o.index, g, d));

@@ -1,0 +1,162 @@
+//! Open lists for the best-first searches: a binary heap for the jump-point planners (successors
+//! can lie any distance ahead) and a ring of buckets for the cell-by-cell searches, whose
+//! successors' priorities lie within a fixed window ahead of the one being expanded.
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+/// An open-list entry: the smallest key pops first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Open {
+    pub(crate) key: u64,
+    pub(crate) index: u32,
+}
+
+impl PartialOrd for Open {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Open {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.key.cmp(&self.key)
+    }
+}
+
+/// A priority queue of cells keyed by `u64` (smallest first).
+pub(crate) trait OpenList: Default {
+    /// Drop every entry.
+    fn clear(&mut self);
+    /// Queue `index` with `key`; `f` is the priority the key encodes (same order).
+    fn push(&mut self, key: u64, f: f64, index: u32);
+    /// The entry with the smallest key.
+    fn pop(&mut self) -> Option<Open>;
+}
+
+/// A binary heap: any priorities.
+#[derive(Default)]
+pub(crate) struct KeyHeap(BinaryHeap<Open>);
+
+impl OpenList for KeyHeap {
+    #[inline]
+    fn clear(&mut self) {
+        self.0.clear();
+    }
+    #[inline]
+    fn push(&mut self, key: u64, _f: f64, index: u32) {
+        self.0.push(Open { key, index });
+    }
+    #[inline]
+    fn pop(&mut self) -> Option<Open> {
+        self.0.pop()
+    }
+}
+
+/// Buckets per cell of priority.
+const BUCKETS_PER_UNIT: f64 = 16.0;
+/// Buckets in the ring (one bit each in the occupancy word).
+const RING: usize = 64;
+
+/// A monotone bucket queue (Dial 1969, with buckets 1/16 of a cell wide kept in a ring).
+///
+/// Precondition: every pushed priority `f` lies in `[f_min, f_min + 3)`, where `f_min` is the
+/// priority last popped. A* with a consistent heuristic meets it on this grid: a successor's `f`
+/// exceeds its parent's by at most twice the step cost, 2 sqrt(2) < 3, so the window spans at
+/// most 48 of the 64 buckets. Within a bucket the entries are sorted by key when the bucket
+/// becomes the current one (and inserted in order after that), so pops come out in exact key
+/// order: the buckets only spare the heap's logarithmic sifting.
+pub(crate) struct BucketRing {
+    buckets: [Vec<Open>; RING],
+    /// Bit `s` set when ring slot `s` holds entries.
+    occupied: u64,
+    /// Absolute number of the current bucket (`floor(f * 16)` of the smallest entries).
+    base: u64,
+    /// Whether the current bucket is sorted (descending, so that its minimum pops off the end).
+    sorted: bool,
+}
+
+impl Default for BucketRing {
+    fn default() -> Self {
+        Self {
+            buckets: std::array::from_fn(|_| Vec::new()),
+            occupied: 0,
+            base: 0,
+            sorted: false,
+        }
+    }
+}
+
+impl BucketRing {
+    #[inline]
+    fn slot(bucket: u64) -> usize {
+        (bucket % RING as u64) as usize
+    }
+}
+
+impl OpenList for BucketRing {
+    fn clear(&mut self) {
+        while self.occupied != 0 {
+            let s = self.occupied.trailing_zeros() as usize;
+            self.occupied &= self.occupied - 1;
+            self.buckets[s].clear();
+        }
+        self.sorted = false;
+    }
+
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn push(&mut self, key: u64, f: f64, index: u32) {
+        // `f >= 0`; the cast truncates, which is the floor.
+        let mut bucket = (f * BUCKETS_PER_UNIT) as u64;
+        if self.occupied == 0 {
+            self.base = bucket;
+            self.sorted = false;
+        }
+        // A rounding of `g + h` a hair below the current bucket's floor belongs to it.
+        bucket = bucket.max(self.base);
+        debug_assert!(bucket - self.base < RING as u64, "priority beyond the ring");
+        let s = Self::slot(bucket);
+        let open = Open { key, index };
+        let list = &mut self.buckets[s];
+        if self.sorted && bucket == self.base {
+            // Descending order: insert after every larger key.
+            let at = list.partition_point(|o| o.key > key);
+            list.insert(at, open);
+        } else {
+            list.push(open);
+        }
+        self.occupied |= 1 << s;
+    }
+
+    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Open> {
+        if self.occupied == 0 {
+            return None;
+        }
+        let step = self
+            .occupied
+            .rotate_right(Self::slot(self.base) as u32)
+            .trailing_zeros();
+        if step != 0 {
+            self.base += u64::from(step);
+            self.sorted = false;
+        }
+        let s = Self::slot(self.base);
+        let list = &mut self.buckets[s];
+        if !self.sorted {
+            if list.len() > 1 {
+                list.sort_unstable_by_key(|o| Reverse(o.key));
+            }
+            self.sorted = true;
+        }
+        let open = list.pop();
+        if list.is_empty() {
+            self.occupied &= !(1 << s);
+            self.sorted = false;
+        }
+        open
+    }
+}
