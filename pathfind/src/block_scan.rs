@@ -6,52 +6,41 @@
 use slam_core::{BitGrid, Cell};
 
 use crate::jump_search::Jumper;
-use crate::movement::{DIRECTIONS, free};
 
-/// Word `i` of a row, or all blocked for a row off the grid.
-#[inline]
-fn word(row: Option<&[u64]>, i: usize) -> u64 {
-    row.map_or(u64::MAX, |r| r[i])
-}
-
-/// Scan row `y` from column `x` east (`east`) or west. Returns the column of the first jump point
-/// (a cell whose side is free while the side cell behind it is blocked) or of the goal column
-/// `goal` when it comes first; `None` when a wall comes first.
-#[inline]
-pub(crate) fn scan_row(
+/// Scan row `y` of `grid` from column `x` east (`EAST`) or west. Returns the column of the first
+/// jump point (a cell whose side is free while the side cell behind it is blocked) or of the goal
+/// column `goal` when it comes first; `None` when a wall comes first. `wall` is a row of
+/// `grid.stride_words()` blocked words that stands in for rows off the grid.
+// Inlined into each jump direction so the scan's direction is a constant there (measured: LLVM
+// keeps one out-of-line copy with plain `#[inline]`).
+#[allow(clippy::inline_always)]
+#[inline(always)]
+fn scan_row<const EAST: bool>(
     grid: &BitGrid,
+    wall: &[u64],
     x: u32,
     y: u32,
-    east: bool,
     goal: Option<u32>,
 ) -> Option<u32> {
     let here = grid.row_words(y);
-    let above = (y + 1 < grid.height()).then(|| grid.row_words(y + 1));
-    let below = (y > 0).then(|| grid.row_words(y - 1));
-    let stop = if east {
+    let above = if y + 1 < grid.height() {
+        grid.row_words(y + 1)
+    } else {
+        wall
+    };
+    let below = if y > 0 { grid.row_words(y - 1) } else { wall };
+    let stop = if EAST {
         scan_east(here, above, below, x)
     } else {
         scan_west(here, above, below, x)
     };
     if let Some(g) = goal {
         // The goal lies ahead, before the wall and not after the jump point.
-        let ahead = if east { g > x } else { g < x };
-        let g64 = i64::from(g);
-        let before_stop = match stop {
-            Stop::Jump(j) => {
-                if east {
-                    g <= j
-                } else {
-                    g >= j
-                }
-            }
-            Stop::Wall(w) => {
-                if east {
-                    g64 < w
-                } else {
-                    g64 > w
-                }
-            }
+        let (ahead, before_stop) = match (EAST, stop) {
+            (true, Stop::Jump(j)) => (g > x, g <= j),
+            (true, Stop::Wall(w)) => (g > x, i64::from(g) < w),
+            (false, Stop::Jump(j)) => (g < x, g >= j),
+            (false, Stop::Wall(w)) => (g < x, i64::from(g) > w),
         };
         if ahead && before_stop {
             return Some(g);
@@ -72,67 +61,74 @@ enum Stop {
     Wall(i64),
 }
 
+/// The stop among the set bits of `forced | blocked` at bit `b` of word `i`: a blocked cell is a
+/// wall even where its side looks forced.
 #[inline]
-fn scan_east(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32) -> Stop {
-    let mut i = (x / 64) as usize;
+fn stop_at(blocked: u64, i: usize, b: u32) -> Stop {
+    let column = i as u32 * 64 + b;
+    if blocked >> b & 1 != 0 {
+        Stop::Wall(i64::from(column))
+    } else {
+        Stop::Jump(column)
+    }
+}
+
+/// Scan east of column `x` along `here`, with the rows `above` and `below` (same length).
+#[allow(clippy::inline_always)]
+#[inline(always)]
+fn scan_east(here: &[u64], above: &[u64], below: &[u64], x: u32) -> Stop {
+    let first = (x / 64) as usize;
     // Only cells after x count.
     let mut mask = (u64::MAX << (x % 64)) << 1;
     let (mut carry_up, mut carry_down) = (0u64, 0u64);
-    loop {
-        let (h, u, d) = (here[i], word(above, i), word(below, i));
+    let words = here[first..]
+        .iter()
+        .zip(&above[first..])
+        .zip(&below[first..]);
+    for (i, ((&h, &u), &d)) in (first..).zip(words) {
         // Forced at bit b: side free at b, side blocked at b - 1 (bit 0 looks at the word before).
-        let forced = ((!u & ((u << 1) | carry_up)) | (!d & ((d << 1) | carry_down))) & mask;
+        let forced = (!u & ((u << 1) | carry_up)) | (!d & ((d << 1) | carry_down));
         let blocked = h & mask;
-        let base = i as u32 * 64;
-        if forced != 0 || blocked != 0 {
-            let (f, b) = (forced.trailing_zeros(), blocked.trailing_zeros());
-            return if f < b {
-                Stop::Jump(base + f)
-            } else {
-                Stop::Wall(i64::from(base + b))
-            };
-        }
-        // Padding bits past the width are blocked; a width that fills its last word has none.
-        if i + 1 == here.len() {
-            return Stop::Wall(i64::from(base) + 64);
+        let stops = (forced & mask) | blocked;
+        if stops != 0 {
+            return stop_at(blocked, i, stops.trailing_zeros());
         }
         carry_up = u >> 63;
         carry_down = d >> 63;
         mask = u64::MAX;
-        i += 1;
     }
+    // Padding bits past the width are blocked; a width that fills its last word has none.
+    Stop::Wall(here.len() as i64 * 64)
 }
 
-#[inline]
-fn scan_west(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32) -> Stop {
-    let mut i = (x / 64) as usize;
+/// Scan west of column `x` along `here`, with the rows `above` and `below` (same length).
+#[allow(clippy::inline_always)]
+#[inline(always)]
+fn scan_west(here: &[u64], above: &[u64], below: &[u64], x: u32) -> Stop {
+    let first = (x / 64) as usize;
     // Only cells before x count.
     let mut mask = (1u64 << (x % 64)) - 1;
     let (mut carry_up, mut carry_down) = (0u64, 0u64);
-    loop {
-        let (h, u, d) = (here[i], word(above, i), word(below, i));
+    let words = here[..=first]
+        .iter()
+        .zip(&above[..=first])
+        .zip(&below[..=first])
+        .enumerate()
+        .rev();
+    for (i, ((&h, &u), &d)) in words {
         // Travelling west, the cell behind b is b + 1 (bit 63 looks at the word after).
-        let forced = ((!u & ((u >> 1) | carry_up)) | (!d & ((d >> 1) | carry_down))) & mask;
+        let forced = (!u & ((u >> 1) | carry_up)) | (!d & ((d >> 1) | carry_down));
         let blocked = h & mask;
-        let base = i as u32 * 64;
-        if forced != 0 || blocked != 0 {
-            // The highest set bit is the first stop going west; an empty mask never wins.
-            let top = |m: u64| (m != 0).then(|| m.ilog2());
-            return match (top(forced), top(blocked)) {
-                (Some(f), Some(b)) if f > b => Stop::Jump(base + f),
-                (Some(f), None) => Stop::Jump(base + f),
-                (_, Some(b)) => Stop::Wall(i64::from(base + b)),
-                (None, None) => Stop::Wall(-1),
-            };
-        }
-        if i == 0 {
-            return Stop::Wall(-1);
+        let stops = (forced & mask) | blocked;
+        if stops != 0 {
+            // The highest set bit is the first stop going west.
+            return stop_at(blocked, i, stops.ilog2());
         }
         carry_up = u << 63;
         carry_down = d << 63;
         mask = u64::MAX;
-        i -= 1;
     }
+    Stop::Wall(-1)
 }
 
 /// Jumps by word scans: rows of the grid for horizontal runs, rows of the transposed grid for
@@ -140,14 +136,19 @@ fn scan_west(here: &[u64], above: Option<&[u64]>, below: Option<&[u64]>, x: u32)
 pub(crate) struct BlockJumper<'g> {
     grid: &'g BitGrid,
     transposed: BitGrid,
+    /// Blocked words standing in for the rows beyond the edges of either grid.
+    wall: Vec<u64>,
 }
 
 impl<'g> BlockJumper<'g> {
     /// Builds the transposed grid (one more bit per cell).
     pub(crate) fn new(grid: &'g BitGrid) -> Self {
+        let transposed = grid.transposed();
+        let wall = vec![u64::MAX; grid.stride_words().max(transposed.stride_words())];
         Self {
             grid,
-            transposed: grid.transposed(),
+            transposed,
+            wall,
         }
     }
 
@@ -156,51 +157,76 @@ impl<'g> BlockJumper<'g> {
         self.transposed.words().len() * 8
     }
 
-    #[inline]
-    fn horizontal(&self, x: u32, y: u32, dx: i32, goal: Cell) -> Option<u32> {
-        scan_row(self.grid, x, y, dx > 0, (goal.y == y).then_some(goal.x))
+    /// The next stop of a horizontal jump from `(x, y)`, east when `EAST`.
+    // Inlined into the diagonal loop (measured: a call per step otherwise).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn horizontal<const EAST: bool>(&self, x: u32, y: u32, goal: Cell) -> Option<u32> {
+        let wall = &self.wall[..self.grid.stride_words()];
+        scan_row::<EAST>(self.grid, wall, x, y, (goal.y == y).then_some(goal.x))
     }
 
+    /// The next stop of a vertical jump from `(x, y)`, towards larger `y` when `NORTH`.
+    // Inlined into the diagonal loop (measured: a call per step otherwise).
+    #[allow(clippy::inline_always)]
+    #[inline(always)]
+    fn vertical<const NORTH: bool>(&self, x: u32, y: u32, goal: Cell) -> Option<u32> {
+        let wall = &self.wall[..self.transposed.stride_words()];
+        let goal = (goal.x == x).then_some(goal.y);
+        scan_row::<NORTH>(&self.transposed, wall, y, x, goal)
+    }
+
+    /// A diagonal jump from `c` towards larger `x` when `EAST` and larger `y` when `NORTH`: one
+    /// step at a time, stopping where a straight component finds a jump point or the goal.
     #[inline]
-    fn vertical(&self, x: u32, y: u32, dy: i32, goal: Cell) -> Option<u32> {
-        scan_row(
-            &self.transposed,
-            y,
-            x,
-            dy > 0,
-            (goal.x == x).then_some(goal.y),
-        )
+    fn diagonal<const EAST: bool, const NORTH: bool>(&self, c: Cell, goal: Cell) -> Option<Cell> {
+        let g = self.grid;
+        let (dx, dy) = (if EAST { 1 } else { -1 }, if NORTH { 1 } else { -1 });
+        let (mut x, mut y) = (c.x, c.y);
+        loop {
+            let (nx, ny) = (x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
+            // Off the grid (a step west of column 0 wraps past the width).
+            if nx >= g.width() || ny >= g.height() {
+                return None;
+            }
+            // The step needs (nx, y), (x, ny) and (nx, ny) free.
+            let (row, next) = (g.row_words(y), g.row_words(ny));
+            let bit = |r: &[u64], x: u32| r[(x / 64) as usize] >> (x % 64);
+            if (bit(row, nx) | bit(next, x) | bit(next, nx)) & 1 != 0 {
+                return None;
+            }
+            (x, y) = (nx, ny);
+            if (x == goal.x && y == goal.y)
+                || self.horizontal::<EAST>(x, y, goal).is_some()
+                || self.vertical::<NORTH>(x, y, goal).is_some()
+            {
+                return Some(Cell::new(x, y));
+            }
+        }
     }
 }
 
 impl Jumper for BlockJumper<'_> {
     #[inline]
     fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell> {
-        let (dx, dy) = DIRECTIONS[d as usize];
-        if dy == 0 {
-            return self
-                .horizontal(c.x, c.y, dx, goal)
-                .map(|x| Cell::new(x, c.y));
-        }
-        if dx == 0 {
-            return self.vertical(c.x, c.y, dy, goal).map(|y| Cell::new(c.x, y));
-        }
-        let g = self.grid;
-        let (mut x, mut y) = (i64::from(c.x), i64::from(c.y));
-        let (dx64, dy64) = (i64::from(dx), i64::from(dy));
-        loop {
-            if !(free(g, x + dx64, y) && free(g, x, y + dy64) && free(g, x + dx64, y + dy64)) {
-                return None;
-            }
-            x += dx64;
-            y += dy64;
-            let (ux, uy) = (x as u32, y as u32);
-            if (ux == goal.x && uy == goal.y)
-                || self.horizontal(ux, uy, dx, goal).is_some()
-                || self.vertical(ux, uy, dy, goal).is_some()
-            {
-                return Some(Cell::new(ux, uy));
-            }
+        // The order of `crate::movement::DIRECTIONS`.
+        match d {
+            0 => self
+                .horizontal::<true>(c.x, c.y, goal)
+                .map(|x| Cell::new(x, c.y)),
+            1 => self
+                .horizontal::<false>(c.x, c.y, goal)
+                .map(|x| Cell::new(x, c.y)),
+            2 => self
+                .vertical::<true>(c.x, c.y, goal)
+                .map(|y| Cell::new(c.x, y)),
+            3 => self
+                .vertical::<false>(c.x, c.y, goal)
+                .map(|y| Cell::new(c.x, y)),
+            4 => self.diagonal::<true, true>(c, goal),
+            5 => self.diagonal::<true, false>(c, goal),
+            6 => self.diagonal::<false, true>(c, goal),
+            _ => self.diagonal::<false, false>(c, goal),
         }
     }
 }
