@@ -14,10 +14,6 @@
 //! [`GaussNewton`](crate::GaussNewton), not an optimum: on torus3D, LM from the file's own guess
 //! stops in a local minimum, LM from the chordal guess reaches SE-Sync's certified optimum.
 
-use faer::Side;
-use faer::linalg::solvers::Solve;
-use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::solvers::Llt;
 use nalgebra::{
     Matrix2, Matrix3, Rotation2, Rotation3, SMatrix, SVector, Translation3, UnitComplex,
     UnitQuaternion, Vector2, Vector3,
@@ -187,10 +183,15 @@ fn solve_linear<P: GraphPose, const B: usize, const K: usize>(
             (None, None) => {}
         }
     }
-    let matrix = SparseColMatRef::new(ne.pattern(), &ne.values);
-    let llt = Llt::try_new_with_symbolic(ne.symbolic.clone(), matrix, Side::Upper)
-        .map_err(|e| OptimizeError::Factorization(format!("chordal relaxation: {e:?}")))?;
-    llt.solve_in_place(rhs.as_mut());
+    let values = std::mem::take(&mut ne.values);
+    let factorized = ne.factorize(&values);
+    ne.values = values;
+    if !factorized {
+        return Err(OptimizeError::Factorization(
+            "chordal relaxation: the normal matrix is not positive definite".into(),
+        ));
+    }
+    ne.solve_in_place(rhs.as_mut());
     let mut out = known.to_vec();
     for (i, x) in out.iter_mut().enumerate() {
         if let Some(v) = ne.variable(i) {

@@ -39,6 +39,7 @@ mod levenberg_marquardt;
 mod linearize;
 mod normal_equations;
 mod solver;
+mod sparse_cholesky;
 pub mod toro;
 
 pub use chordal::{ChordalInitialization, initialize_chordal};

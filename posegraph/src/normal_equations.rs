@@ -2,13 +2,13 @@
 //! diagonal entry present for damping) built once per graph structure, with faer's symbolic
 //! Cholesky computed once and reused for every numeric factorisation.
 
-use faer::Side;
-use faer::sparse::SymbolicSparseColMat;
-use faer::sparse::linalg::solvers::SymbolicLlt;
+use faer::MatMut;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use nalgebra::{SMatrix, SVector};
 use slam_core::{GraphPose, OptimizeError, PoseGraph};
 
 use crate::linearize::{ErrorModel, Linearize};
+use crate::sparse_cholesky::SparseCholesky;
 
 /// Where each edge's blocks go in the value array.
 #[derive(Clone, Copy, Debug)]
@@ -33,7 +33,7 @@ pub(crate) struct NormalEquations<const D: usize> {
     neighbours: Vec<usize>,
     edges: Vec<EdgeSlots>,
     symbolic_pattern: SymbolicSparseColMat<usize>,
-    pub(crate) symbolic: SymbolicLlt<usize>,
+    cholesky: SparseCholesky,
     /// Numeric values (upper triangle, CSC order).
     pub(crate) values: Vec<f64>,
     /// Right-hand side `b = J^T W e`.
@@ -114,8 +114,18 @@ impl<const D: usize> NormalEquations<D> {
         let nnz = row_idx.len();
         let symbolic_pattern =
             SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx);
-        let symbolic = SymbolicLlt::try_new(symbolic_pattern.as_ref(), Side::Upper)
-            .map_err(|e| OptimizeError::Factorization(format!("symbolic Cholesky: {e:?}")))?;
+        // The variables' graph (upper triangle) for the fill-reducing ordering.
+        let mut block_ptr = Vec::with_capacity(n_vars + 1);
+        let mut block_idx = Vec::new();
+        block_ptr.push(0);
+        for (j, l) in lower.iter().enumerate() {
+            block_idx.extend_from_slice(l);
+            block_idx.push(j);
+            block_ptr.push(block_idx.len());
+        }
+        let blocks = SymbolicSparseColMat::new_checked(n_vars, n_vars, block_ptr, None, block_idx);
+        // Up to D right-hand sides (the chordal relaxation solves for D columns at once).
+        let cholesky = SparseCholesky::try_new::<D>(symbolic_pattern.as_ref(), blocks.as_ref(), D)?;
         Ok(Self {
             key: structure_key(graph),
             var_of_node,
@@ -124,7 +134,7 @@ impl<const D: usize> NormalEquations<D> {
             neighbours,
             edges,
             symbolic_pattern,
-            symbolic,
+            cholesky,
             values: vec![0.0; nnz],
             gradient: vec![0.0; n],
         })
@@ -140,9 +150,16 @@ impl<const D: usize> NormalEquations<D> {
         self.var_of_node[node]
     }
 
-    /// The pattern.
-    pub(crate) fn pattern(&self) -> faer::sparse::SymbolicSparseColMatRef<'_, usize> {
-        self.symbolic_pattern.as_ref()
+    /// Factorise the matrix with `values` on this pattern (`values` itself, or a damped copy);
+    /// `false` on a non-positive pivot.
+    pub(crate) fn factorize(&mut self, values: &[f64]) -> bool {
+        let matrix = SparseColMatRef::new(self.symbolic_pattern.as_ref(), values);
+        self.cholesky.factorize(matrix)
+    }
+
+    /// Solve with the last successful factorisation, in place (up to `D` columns).
+    pub(crate) fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) {
+        self.cholesky.solve_in_place(rhs);
     }
 
     /// Position of entry (row `i*D + r`, column `j*D + c`) for `i <= j`, `rank` = rank of `i` in
@@ -207,28 +224,66 @@ impl<const D: usize> NormalEquations<D> {
         }
     }
 
+    /// Add a between-edge `k` whose Jacobians are `-jb` (for `a`) and `jb` (for `b`), with
+    /// (weighted) information `omega` and `oe = omega e`: the three Hessian blocks are `h`, `h`
+    /// and `-h` for `h = jb^T omega jb`, one product instead of three.
+    #[inline]
+    fn add_between(
+        &mut self,
+        k: usize,
+        jb: &SMatrix<f64, D, D>,
+        omega: &SMatrix<f64, D, D>,
+        oe: &SVector<f64, D>,
+    ) {
+        let slots = self.edges[k];
+        let jt = jb.transpose();
+        let g: SVector<f64, D> = jt * oe;
+        let h: SMatrix<f64, D, D> = jt * (omega * jb);
+        for (v, sign) in [(slots.a, -1.0), (slots.b, 1.0)] {
+            if let Some(v) = v {
+                for r in 0..D {
+                    self.gradient[v * D + r] += sign * g[r];
+                }
+                let diag_rank = self.neighbours[v] - 1;
+                for c in 0..D {
+                    let start = self.pos(diag_rank, 0, v, c);
+                    for r in 0..=c {
+                        self.values[start + r] += h[(r, c)];
+                    }
+                }
+            }
+        }
+        if let (Some(va), Some(vb)) = (slots.a, slots.b) {
+            let hi = va.max(vb);
+            for c in 0..D {
+                let start = self.pos(slots.rank_lo, 0, hi, c);
+                for r in 0..D {
+                    self.values[start + r] -= h[(r, c)];
+                }
+            }
+        }
+    }
+
     /// Fill `values` and `gradient` at the current poses for `model` (robust kernels as IRLS
     /// weights).
     pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>, model: ErrorModel) {
         self.clear();
+        let nodes = graph.nodes();
         for (k, e) in graph.edges().iter().enumerate() {
-            let (a, b) = (&graph.nodes()[e.from].pose, &graph.nodes()[e.to].pose);
-            let (err, ja, jb) = P::linearize(model, &e.measurement, a, b);
+            let (err, jb) = P::linearize(
+                model,
+                &e.measurement,
+                &nodes[e.from].pose,
+                &nodes[e.to].pose,
+            );
             let mut omega = P::info(&e.information);
+            let mut oe: SVector<f64, D> = omega * err;
             if let Some(kernel) = e.kernel {
-                omega *= kernel.weight((err.transpose() * omega * err)[0]);
+                let w = kernel.weight(err.dot(&oe));
+                omega *= w;
+                oe *= w;
             }
-            let oe: SVector<f64, D> = omega * err;
-            let (va, vb) = self.edge_variables(k);
-            for (v, j) in [(va, &ja), (vb, &jb)] {
-                if let Some(v) = v {
-                    let g = j.transpose() * oe;
-                    for r in 0..D {
-                        self.gradient[v * D + r] += g[r];
-                    }
-                }
-            }
-            self.add_hessian(k, &ja, &jb, &omega);
+            self.add_between(k, &jb, &omega, &oe);
         }
     }
 }

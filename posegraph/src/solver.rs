@@ -1,10 +1,6 @@
 //! The damped Gauss-Newton loop shared by [`GaussNewton`](crate::GaussNewton) and
 //! [`LevenbergMarquardt`](crate::LevenbergMarquardt).
 
-use faer::Side;
-use faer::linalg::solvers::Solve;
-use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::solvers::Llt;
 use nalgebra::SVector;
 use slam_core::{OptimizationReport, OptimizeError, PoseGraph, StopReason};
 
@@ -93,24 +89,24 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let mut stop = StopReason::MaxIterations;
     let mut relinearize = true;
     let mut diagonal = vec![0.0; n];
+    let mut damped = ne.values.clone();
     'outer: while iterations < config.max_iterations {
         if relinearize {
             ne.assemble(graph, model);
             for (k, d) in diagonal.iter_mut().enumerate() {
-                *d = ne.values[ne.diagonal_position(k)];
+                *d = ne.values[ne.diagonal_position(k)].max(1e-9);
             }
             relinearize = false;
         }
         iterations += 1;
         // Damped system: H + lambda * diag(H) (Marquardt's scaling, floored for empty rows).
-        let mut damped = ne.values.clone();
+        damped.copy_from_slice(&ne.values);
         if lambda > 0.0 {
             for (k, &d) in diagonal.iter().enumerate() {
-                damped[ne.diagonal_position(k)] += lambda * d.max(1e-9);
+                damped[ne.diagonal_position(k)] += lambda * d;
             }
         }
-        let matrix = SparseColMatRef::new(ne.pattern(), &damped);
-        let Ok(llt) = Llt::try_new_with_symbolic(ne.symbolic.clone(), matrix, Side::Upper) else {
+        if !ne.factorize(&damped) {
             // A non-positive pivot: raise the damping instead of failing.
             lambda = if lambda == 0.0 { 1e-9 } else { lambda * nu };
             nu *= 2.0;
@@ -119,11 +115,11 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
                 break;
             }
             continue;
-        };
+        }
         for k in 0..n {
             rhs[(k, 0)] = -ne.gradient[k];
         }
-        llt.solve_in_place(rhs.as_mut());
+        ne.solve_in_place(rhs.as_mut());
         let mut step_max: f64 = 0.0;
         let mut trial = poses.clone();
         for (i, node) in graph.nodes().iter().enumerate() {
