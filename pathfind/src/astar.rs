@@ -3,6 +3,7 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::best_first::best_first;
+use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::movement::octile;
 use crate::open_list::BucketRing;
@@ -14,6 +15,7 @@ pub struct AStar<'g> {
     grid: &'g BitGrid,
     components: Components,
     space: SearchSpace<BucketRing>,
+    closed: ClosedSet,
 }
 
 impl<'g> AStar<'g> {
@@ -24,6 +26,7 @@ impl<'g> AStar<'g> {
             grid,
             components: Components::new(grid),
             space: SearchSpace::new(grid.width(), grid.height()),
+            closed: ClosedSet::new(grid),
         }
     }
 }
@@ -34,6 +37,7 @@ impl Planner for AStar<'_> {
             self.grid,
             &self.components,
             &mut self.space,
+            &mut self.closed,
             start,
             goal,
             |c| octile(c, goal),

@@ -3,6 +3,7 @@
 
 use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
+use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::movement::{DIRECTIONS, SQRT_2, legal_steps};
 use crate::open_list::BucketRing;
@@ -14,6 +15,7 @@ pub(crate) fn best_first(
     grid: &BitGrid,
     components: &Components,
     space: &mut SearchSpace<BucketRing>,
+    closed: &mut ClosedSet,
     start: Cell,
     goal: Cell,
     heuristic: impl Fn(Cell) -> f64,
@@ -23,6 +25,7 @@ pub(crate) fn best_first(
         return Err(PlanError::NoPath);
     }
     space.reset();
+    closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
     space.relax(s, 0.0, heuristic(start), s, NO_DIRECTION);
     let mut expanded = 0;
@@ -32,7 +35,8 @@ pub(crate) fn best_first(
             return Ok(space.path(s, t, expanded));
         }
         let c = space.cell(i);
-        let mut steps = legal_steps(grid, c);
+        closed.insert(c);
+        let mut steps = legal_steps(grid, c) & closed.open_neighbours(c);
         while steps != 0 {
             let d = steps.trailing_zeros() as usize;
             steps &= steps - 1;

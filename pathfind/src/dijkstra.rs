@@ -3,6 +3,7 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::best_first::best_first;
+use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
@@ -13,6 +14,7 @@ pub struct Dijkstra<'g> {
     grid: &'g BitGrid,
     components: Components,
     space: SearchSpace<BucketRing>,
+    closed: ClosedSet,
 }
 
 impl<'g> Dijkstra<'g> {
@@ -23,6 +25,7 @@ impl<'g> Dijkstra<'g> {
             grid,
             components: Components::new(grid),
             space: SearchSpace::new(grid.width(), grid.height()),
+            closed: ClosedSet::new(grid),
         }
     }
 }
@@ -33,6 +36,7 @@ impl Planner for Dijkstra<'_> {
             self.grid,
             &self.components,
             &mut self.space,
+            &mut self.closed,
             start,
             goal,
             |_| 0.0,

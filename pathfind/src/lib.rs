@@ -40,6 +40,7 @@
 mod astar;
 mod best_first;
 mod block_scan;
+mod closed_set;
 mod components;
 mod dijkstra;
 mod error;

@@ -133,3 +133,26 @@ pub fn legal_steps(grid: &BitGrid, c: Cell) -> u8 {
     let sw = w & s & down;
     (e | w << 1 | n << 2 | s << 3 | ne << 4 | se << 5 | nw << 6 | sw << 7) as u8
 }
+
+/// Bit `d` set when the neighbour `c + DIRECTIONS[d]` is a free cell of `grid` (no corner rule;
+/// off-grid neighbours are not free).
+// Hot path of the cell-by-cell searches (see `legal_steps`).
+#[allow(clippy::inline_always)]
+#[inline(always)]
+pub(crate) fn free_neighbours(grid: &BitGrid, c: Cell) -> u8 {
+    let y = i64::from(c.y);
+    let (up, mid, down) = (
+        row_free3(grid, c.x, y + 1),
+        row_free3(grid, c.x, y),
+        row_free3(grid, c.x, y - 1),
+    );
+    let bits = (mid >> 2 & 1)
+        | (mid & 1) << 1
+        | (up >> 1 & 1) << 2
+        | (down >> 1 & 1) << 3
+        | (up >> 2 & 1) << 4
+        | (down >> 2 & 1) << 5
+        | (up & 1) << 6
+        | (down & 1) << 7;
+    bits as u8
+}

@@ -53,23 +53,25 @@ impl OpenList for KeyHeap {
 }
 
 /// Buckets per cell of priority.
-const BUCKETS_PER_UNIT: f64 = 16.0;
-/// Buckets in the ring (one bit each in the occupancy word).
-const RING: usize = 64;
+const BUCKETS_PER_UNIT: f64 = 64.0;
+/// Words of the ring's occupancy bits.
+const RING_WORDS: usize = 4;
+/// Buckets in the ring.
+const RING: usize = RING_WORDS * 64;
 
-/// A monotone bucket queue (Dial 1969, with buckets 1/16 of a cell wide kept in a ring).
+/// A monotone bucket queue (Dial 1969, with buckets 1/64 of a cell wide kept in a ring).
 ///
 /// Precondition: every pushed priority `f` lies in `[f_min, f_min + 3)`, where `f_min` is the
 /// priority last popped. A* with a consistent heuristic meets it on this grid: a successor's `f`
 /// exceeds its parent's by at most twice the step cost, 2 sqrt(2) < 3, so the window spans at
-/// most 48 of the 64 buckets. Within a bucket the entries are sorted by key when the bucket
+/// most 193 of the 256 buckets. Within a bucket the entries are sorted by key when the bucket
 /// becomes the current one (and inserted in order after that), so pops come out in exact key
 /// order: the buckets only spare the heap's logarithmic sifting.
 pub(crate) struct BucketRing {
     buckets: [Vec<Open>; RING],
-    /// Bit `s` set when ring slot `s` holds entries.
-    occupied: u64,
-    /// Absolute number of the current bucket (`floor(f * 16)` of the smallest entries).
+    /// Bit `s % 64` of word `s / 64` set when ring slot `s` holds entries.
+    occupied: [u64; RING_WORDS],
+    /// Absolute number of the current bucket (`floor(f * 64)` of the smallest entries).
     base: u64,
     /// Whether the current bucket is sorted (descending, so that its minimum pops off the end).
     sorted: bool,
@@ -79,7 +81,7 @@ impl Default for BucketRing {
     fn default() -> Self {
         Self {
             buckets: std::array::from_fn(|_| Vec::new()),
-            occupied: 0,
+            occupied: [0; RING_WORDS],
             base: 0,
             sorted: false,
         }
@@ -91,14 +93,41 @@ impl BucketRing {
     fn slot(bucket: u64) -> usize {
         (bucket % RING as u64) as usize
     }
+
+    #[inline]
+    fn is_empty(&self) -> bool {
+        self.occupied.iter().all(|&w| w == 0)
+    }
+
+    /// Buckets from the current one to the next occupied one (the ring is not empty).
+    #[inline]
+    fn distance_to_next(&self) -> u64 {
+        let b = Self::slot(self.base);
+        let (w, bit) = (b / 64, b % 64);
+        let here = self.occupied[w] >> bit;
+        if here != 0 {
+            return u64::from(here.trailing_zeros());
+        }
+        // The following words, wrapping round to the low bits of the current word last.
+        for k in 1..=RING_WORDS {
+            let word = self.occupied[(w + k) % RING_WORDS];
+            if word != 0 {
+                let slot = ((w + k) % RING_WORDS) * 64 + word.trailing_zeros() as usize;
+                return ((slot + RING - b) % RING) as u64;
+            }
+        }
+        0
+    }
 }
 
 impl OpenList for BucketRing {
     fn clear(&mut self) {
-        while self.occupied != 0 {
-            let s = self.occupied.trailing_zeros() as usize;
-            self.occupied &= self.occupied - 1;
-            self.buckets[s].clear();
+        for (w, word) in self.occupied.iter_mut().enumerate() {
+            while *word != 0 {
+                let s = w * 64 + word.trailing_zeros() as usize;
+                *word &= *word - 1;
+                self.buckets[s].clear();
+            }
         }
         self.sorted = false;
     }
@@ -109,7 +138,7 @@ impl OpenList for BucketRing {
     fn push(&mut self, key: u64, f: f64, index: u32) {
         // `f >= 0`; the cast truncates, which is the floor.
         let mut bucket = (f * BUCKETS_PER_UNIT) as u64;
-        if self.occupied == 0 {
+        if self.is_empty() {
             self.base = bucket;
             self.sorted = false;
         }
@@ -126,22 +155,19 @@ impl OpenList for BucketRing {
         } else {
             list.push(open);
         }
-        self.occupied |= 1 << s;
+        self.occupied[s / 64] |= 1 << (s % 64);
     }
 
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
     fn pop(&mut self) -> Option<Open> {
-        if self.occupied == 0 {
+        if self.is_empty() {
             return None;
         }
-        let step = self
-            .occupied
-            .rotate_right(Self::slot(self.base) as u32)
-            .trailing_zeros();
+        let step = self.distance_to_next();
         if step != 0 {
-            self.base += u64::from(step);
+            self.base += step;
             self.sorted = false;
         }
         let s = Self::slot(self.base);
@@ -154,7 +180,7 @@ impl OpenList for BucketRing {
         }
         let open = list.pop();
         if list.is_empty() {
-            self.occupied &= !(1 << s);
+            self.occupied[s / 64] &= !(1 << (s % 64));
             self.sorted = false;
         }
         open

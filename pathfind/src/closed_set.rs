@@ -1,0 +1,50 @@
+//! The cells expanded by the current query, one bit per cell in the grid's own layout, so that the
+//! cell-by-cell searches drop expanded neighbours with a few word operations instead of reading
+//! their search records (which the closed flag in the records would need, with a branch each).
+
+use slam_core::{BitGrid, Cell};
+
+use crate::movement::free_neighbours;
+
+/// Expanded cells as the blocked cells of a grid of the same size.
+pub(crate) struct ClosedSet {
+    bits: BitGrid,
+    /// The cells set in this query, cleared one by one at the next reset.
+    set: Vec<Cell>,
+}
+
+impl ClosedSet {
+    /// An empty set for grids the size of `grid`.
+    pub(crate) fn new(grid: &BitGrid) -> Self {
+        let mut bits = grid.clone();
+        for y in 0..bits.height() {
+            bits.row_words_mut(y).fill(0);
+        }
+        bits.restore_padding();
+        Self {
+            bits,
+            set: Vec::new(),
+        }
+    }
+
+    /// Empty the set (in time proportional to the cells it holds).
+    pub(crate) fn reset(&mut self) {
+        for c in self.set.drain(..) {
+            self.bits.row_words_mut(c.y)[(c.x / 64) as usize] &= !(1u64 << (c.x % 64));
+        }
+    }
+
+    /// Add `c`, a cell on the grid not yet in the set.
+    #[inline]
+    pub(crate) fn insert(&mut self, c: Cell) {
+        self.bits.row_words_mut(c.y)[(c.x / 64) as usize] |= 1u64 << (c.x % 64);
+        self.set.push(c);
+    }
+
+    /// Bit `d` set when the neighbour of `c` in direction `DIRECTIONS[d]` is on the grid and not
+    /// in the set.
+    #[inline]
+    pub(crate) fn open_neighbours(&self, c: Cell) -> u8 {
+        free_neighbours(&self.bits, c)
+    }
+}
