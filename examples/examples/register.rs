@@ -139,6 +139,8 @@ fn main() -> Result<()> {
     };
     let mut loam = LoamConfig::default();
     loam.features.layout = args.layout;
+    // A pair may start far from its answer: begin with a wide robust threshold.
+    loam.initial_tukey_threshold = 1.0;
     let (a, prepare_ms, align_ms) = match args.method.as_str() {
         "p2p" => run(
             &PointToPointIcp { config: icp },

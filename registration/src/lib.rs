@@ -54,7 +54,7 @@ mod target;
 pub use config::IcpConfig;
 pub use kernel::IcpKernel;
 pub use lidar_layout::LidarLayout;
-pub use loam::{LoamConfig, LoamRegistrator, LoamTarget};
+pub use loam::{LoamConfig, LoamPatch, LoamRegistrator, LoamTarget};
 pub use loam_features::{LoamFeatureConfig, LoamFeatures};
 pub use point_to_plane::PointToPlaneIcp;
 pub use point_to_point::PointToPointIcp;

@@ -23,7 +23,7 @@ pub struct LoamFeatureConfig {
     /// standard deviations above what 1.5 cm range noise gives a point on a plane.
     pub edge_min_roughness: f64,
     /// An edge also has sharpness (`|sum|` over the summed neighbour distances: 0 on a straight
-    /// scan line, `cos(a/2)` at a corner of angle `a`) above this: 0.2, corners sharper than
+    /// evenly sampled scan line, `cos(a/2)` at a corner of angle `a`) above this: 0.2, corners sharper than
     /// about 157°, so gently curved far surfaces are not taken for edges.
     pub edge_min_sharpness: f64,
     /// A planar point has roughness below this (m², 0.1 as in LOAM).
@@ -187,12 +187,48 @@ fn rings(cloud: &PointCloud, config: &LoamFeatureConfig) -> Vec<Ring> {
     keyed
         .into_iter()
         .map(|mut v| {
-            v.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            order_by_azimuth(&mut v);
             Ring {
                 points: v.into_iter().map(|(_, p)| p).collect(),
             }
         })
         .collect()
+}
+
+/// Order a ring by ascending azimuth. A sensor's own order is already monotonic from the start
+/// of the sweep (either way round), so a ring that is, up to one wrap, is only rotated (and
+/// reversed when clockwise); any other order is sorted.
+fn order_by_azimuth(v: &mut [(f64, Point3<f64>)]) {
+    let (mut ups, mut downs, mut first_up, mut first_down) = (0usize, 0usize, 0, 0);
+    for i in 1..v.len() {
+        if v[i].0 > v[i - 1].0 {
+            if ups == 0 {
+                first_up = i;
+            }
+            ups += 1;
+        } else if v[i].0 < v[i - 1].0 {
+            if downs == 0 {
+                first_down = i;
+            }
+            downs += 1;
+        }
+        if ups > 1 && downs > 1 {
+            break;
+        }
+    }
+    let (first, last) = (
+        v.first().map_or(0.0, |p| p.0),
+        v.last().map_or(0.0, |p| p.0),
+    );
+    if downs == 0 || (downs == 1 && last <= first) {
+        v.rotate_left(first_down);
+    } else if ups == 0 || (ups == 1 && last >= first) {
+        // Clockwise, as Velodyne sensors turn: the same ascending order as sorting gives.
+        v.rotate_left(first_up);
+        v.reverse();
+    } else {
+        v.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    }
 }
 
 /// Per-point state of a ring while picking.
@@ -240,8 +276,10 @@ impl LoamFeatures {
 }
 
 /// Roughness (thesis eq. 4.3: `|sum_j (x_i - x_j)|²` over `n` neighbours on each side) and
-/// sharpness (`|sum| / sum_j |x_i - x_j|`) of every point with a full neighbourhood.
-fn roughness(points: &[Point3<f64>], n: usize) -> (Vec<f64>, Vec<f64>) {
+/// sharpness (`|sum|` over `sum_j |x_i - x_j|`, that sum estimated as `(n + 1) / 2` times the
+/// window's path length, exact for evenly spaced points on a line) of every point with a full
+/// neighbourhood. `gaps[i]` is `|x_{i+1} - x_i|`.
+fn roughness(points: &[Point3<f64>], gaps: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
     let m = points.len();
     let mut rough = vec![f64::NAN; m];
     let mut sharp = vec![f64::NAN; m];
@@ -249,19 +287,19 @@ fn roughness(points: &[Point3<f64>], n: usize) -> (Vec<f64>, Vec<f64>) {
         return (rough, sharp);
     }
     #[allow(clippy::cast_precision_loss)]
-    let two_n = (2 * n) as f64;
-    // Running sum of the window's points: O(1) per point.
+    let (two_n, half) = ((2 * n) as f64, (n + 1) as f64 / 2.0);
+    // Running sums over the window: O(1) per point.
     let mut window: Vector3<f64> = points[..=2 * n].iter().map(|p| p.coords).sum();
+    let mut path: f64 = gaps[..2 * n].iter().sum();
     for i in n..m - n {
         if i > n {
             window += points[i + n].coords - points[i - n - 1].coords;
+            path += gaps[i + n - 1] - gaps[i - n - 1];
         }
-        let x = points[i].coords;
-        let sum = x * (two_n + 1.0) - window;
-        let spread: f64 = (i - n..=i + n).map(|j| (x - points[j].coords).norm()).sum();
+        let sum = points[i].coords * (two_n + 1.0) - window;
         rough[i] = sum.norm_squared();
-        sharp[i] = if spread > 0.0 {
-            sum.norm() / spread
+        sharp[i] = if path > 0.0 {
+            sum.norm() / (half * path)
         } else {
             0.0
         };
@@ -271,20 +309,24 @@ fn roughness(points: &[Point3<f64>], n: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// Mark points whose neighbourhood LOAM deems unreliable: the far side of an occlusion boundary,
 /// both sides of other ring breaks, and surfaces nearly parallel to the beam.
-fn unreliable(points: &[Point3<f64>], config: &LoamFeatureConfig, state: &mut [Pick]) {
+fn unreliable(
+    points: &[Point3<f64>],
+    gaps: &[f64],
+    config: &LoamFeatureConfig,
+    state: &mut [Pick],
+) {
     let n = config.neighbours;
     let m = points.len();
-    let break2 = config.break_distance * config.break_distance;
     let mark = |range: std::ops::Range<usize>, state: &mut [Pick]| {
         for s in &mut state[range] {
             *s = Pick::Unreliable;
         }
     };
     for i in 0..m.saturating_sub(1) {
-        let (a, b) = (points[i].coords, points[i + 1].coords);
-        if (b - a).norm_squared() <= break2 {
+        if gaps[i] <= config.break_distance {
             continue;
         }
+        let (a, b) = (points[i].coords, points[i + 1].coords);
         let (da, db) = (a.norm(), b.norm());
         // Nearly the same bearing at different depths: the farther side is occluded and its
         // edge moves with the viewpoint.
@@ -296,23 +338,21 @@ fn unreliable(points: &[Point3<f64>], config: &LoamFeatureConfig, state: &mut [P
             mark(i.saturating_sub(n - 1)..(i + n + 1).min(m), state);
         }
     }
-    let ratio2 = config.parallel_gap_ratio * config.parallel_gap_ratio;
     for i in 1..m.saturating_sub(1) {
-        let r2 = points[i].coords.norm_squared() * ratio2;
-        let prev = (points[i] - points[i - 1]).norm_squared();
-        let next = (points[i + 1] - points[i]).norm_squared();
-        if prev > r2 && next > r2 {
+        let limit = points[i].coords.norm() * config.parallel_gap_ratio;
+        if gaps[i - 1] > limit && gaps[i] > limit {
             state[i] = Pick::Unreliable;
         }
     }
 }
 
 /// After picking `i`, its neighbours up to the next ring break may not be picked.
-fn take_neighbours(points: &[Point3<f64>], i: usize, n: usize, state: &mut [Pick]) {
-    const CONTIGUOUS2: f64 = 0.05;
+fn take_neighbours(gaps: &[f64], i: usize, n: usize, state: &mut [Pick]) {
+    // LOAM's 0.05 m² between ring neighbours.
+    const CONTIGUOUS: f64 = 0.223_606_797_749_979;
     state[i] = Pick::Taken;
-    for j in i + 1..=(i + n).min(points.len() - 1) {
-        if (points[j] - points[j - 1]).norm_squared() > CONTIGUOUS2 {
+    for j in i + 1..=(i + n).min(state.len() - 1) {
+        if gaps[j - 1] > CONTIGUOUS {
             break;
         }
         if state[j] == Pick::Free {
@@ -320,7 +360,7 @@ fn take_neighbours(points: &[Point3<f64>], i: usize, n: usize, state: &mut [Pick
         }
     }
     for j in (i.saturating_sub(n)..i).rev() {
-        if (points[j + 1] - points[j]).norm_squared() > CONTIGUOUS2 {
+        if gaps[j] > CONTIGUOUS {
             break;
         }
         if state[j] == Pick::Free {
@@ -335,9 +375,10 @@ fn extract_ring(points: &[Point3<f64>], config: &LoamFeatureConfig, out: &mut Lo
     if m < 2 * n + 1 {
         return;
     }
-    let (rough, sharp) = roughness(points, n);
+    let gaps: Vec<f64> = points.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let (rough, sharp) = roughness(points, &gaps, n);
     let mut state = vec![Pick::Free; m];
-    unreliable(points, config, &mut state);
+    unreliable(points, &gaps, config, &mut state);
     let (first, end) = (n, m - n);
     for i in first..end {
         if state[i] == Pick::Unreliable {
@@ -350,32 +391,40 @@ fn extract_ring(points: &[Point3<f64>], config: &LoamFeatureConfig, out: &mut Lo
         }
     }
     let sectors = config.sectors.min(end - first);
-    let mut order: Vec<usize> = Vec::new();
+    // Sector members keyed by roughness (as f32 bits, which order like the non-negative
+    // values) above their index: one integer sort per sector.
+    let mut order: Vec<u64> = Vec::new();
+    #[allow(clippy::cast_possible_truncation)]
+    let key = |i: usize| (u64::from((rough[i] as f32).to_bits()) << 32) | i as u64;
+    #[allow(clippy::cast_possible_truncation)]
+    let index = |k: u64| (k & 0xFFFF_FFFF) as usize;
     for s in 0..sectors {
         let lo = first + (end - first) * s / sectors;
         let hi = first + (end - first) * (s + 1) / sectors;
         order.clear();
-        order.extend(lo..hi);
-        order.sort_unstable_by(|&a, &b| rough[b].total_cmp(&rough[a]));
+        order.extend((lo..hi).map(key));
+        order.sort_unstable();
         let mut edges = 0;
-        for &i in &order {
+        for &k in order.iter().rev() {
+            let i = index(k);
             if edges == config.max_edges_per_sector || rough[i] <= config.edge_min_roughness {
                 break;
             }
             if state[i] == Pick::Free && sharp[i] >= config.edge_min_sharpness {
                 out.edges.push(points[i]);
-                take_neighbours(points, i, n, &mut state);
+                take_neighbours(&gaps, i, n, &mut state);
                 edges += 1;
             }
         }
         let mut planes = 0;
-        for &i in order.iter().rev() {
+        for &k in &order {
+            let i = index(k);
             if planes == config.max_planes_per_sector || rough[i] >= config.plane_max_roughness {
                 break;
             }
             if state[i] == Pick::Free {
                 out.planes.push(points[i]);
-                take_neighbours(points, i, n, &mut state);
+                take_neighbours(&gaps, i, n, &mut state);
                 planes += 1;
             }
         }
@@ -394,16 +443,31 @@ mod tests {
                 Point3::new(t, (t * 3.0).sin(), t * t)
             })
             .collect();
-        let (rough, sharp) = roughness(&pts, 5);
+        let gaps: Vec<f64> = pts.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+        let (rough, sharp) = roughness(&pts, &gaps, 5);
         for i in 5..15 {
             let sum: Vector3<f64> = (i - 5..=i + 5)
                 .filter(|&j| j != i)
                 .map(|j| pts[i] - pts[j])
                 .sum();
-            let spread: f64 = (i - 5..=i + 5).map(|j| (pts[i] - pts[j]).norm()).sum();
+            let path: f64 = gaps[i - 5..i + 5].iter().sum();
             assert!((rough[i] - sum.norm_squared()).abs() < 1e-12);
-            assert!((sharp[i] - sum.norm() / spread).abs() < 1e-12);
+            assert!((sharp[i] - sum.norm() / (3.0 * path)).abs() < 1e-12);
         }
+        // On evenly spaced points the estimate is exact: a right-angle corner gives cos(45°).
+        let corner: Vec<Point3<f64>> = (0..11)
+            .map(|i: i32| {
+                let t = f64::from(i - 5);
+                if t < 0.0 {
+                    Point3::new(-t, 0.0, 0.0)
+                } else {
+                    Point3::new(0.0, t, 0.0)
+                }
+            })
+            .collect();
+        let gaps: Vec<f64> = corner.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+        let (_, sharp) = roughness(&corner, &gaps, 5);
+        assert!((sharp[5] - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12);
         assert!(rough[4].is_nan() && rough[15].is_nan());
     }
 

@@ -14,6 +14,8 @@ use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xy
 fn hdl32e() -> LoamRegistrator {
     let mut config = LoamConfig::default();
     config.features.layout = LidarLayout::HDL32E;
+    // Starts up to a metre and 10 degrees off.
+    config.initial_tukey_threshold = 1.0;
     LoamRegistrator { config }
 }
 
