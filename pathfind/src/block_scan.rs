@@ -196,10 +196,11 @@ impl<'g> BlockJumper<'g> {
                 return None;
             }
             (x, y) = (nx, ny);
-            if (x == goal.x && y == goal.y)
-                || self.horizontal::<EAST>(x, y, goal).is_some()
-                || self.vertical::<NORTH>(x, y, goal).is_some()
-            {
+            // Both scans without a short cut: most steps find nothing in either, and two
+            // independent scans overlap in the pipeline.
+            let across = self.horizontal::<EAST>(x, y, goal).is_some();
+            let along = self.vertical::<NORTH>(x, y, goal).is_some();
+            if (x == goal.x && y == goal.y) | across | along {
                 return Some(Cell::new(x, y));
             }
         }
