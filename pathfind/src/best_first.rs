@@ -27,7 +27,7 @@ pub(crate) fn best_first(
     space.reset();
     closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0.0, heuristic(start), s, NO_DIRECTION);
+    space.relax(s, 0.0, || heuristic(start), s, NO_DIRECTION);
     let mut expanded = 0;
     while let Some((i, g, _)) = space.pop() {
         expanded += 1;
@@ -43,7 +43,7 @@ pub(crate) fn best_first(
             let (dx, dy) = DIRECTIONS[d];
             let n = Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
             let cost = if d >= 4 { SQRT_2 } else { 1.0 };
-            space.relax(space.index(n), g + cost, heuristic(n), i, d as u8);
+            space.relax(space.index(n), g + cost, || heuristic(n), i, d as u8);
         }
     }
     Err(PlanError::NoPath)

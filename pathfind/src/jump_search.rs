@@ -109,7 +109,7 @@ pub(crate) fn jump_search(
     }
     space.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0.0, octile(start, goal), s, NO_DIRECTION);
+    space.relax(s, 0.0, || octile(start, goal), s, NO_DIRECTION);
     let mut expanded = 0;
     while let Some((i, g, arrive)) = space.pop() {
         expanded += 1;
@@ -122,7 +122,7 @@ pub(crate) fn jump_search(
             let d = dirs.trailing_zeros() as u8;
             dirs &= dirs - 1;
             if let Some(n) = jumper.jump(c, d, goal) {
-                space.relax(space.index(n), g + octile(c, n), octile(n, goal), i, d);
+                space.relax(space.index(n), g + octile(c, n), || octile(n, goal), i, d);
             }
         }
     }

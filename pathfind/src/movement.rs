@@ -102,7 +102,10 @@ fn row_free3(grid: &BitGrid, x: u32, y: i64) -> u32 {
         return 0;
     }
     let y = y as u32;
-    let blocked = if x >= 1 {
+    let blocked = if x >= 1 && (x - 1) % 64 <= 61 {
+        // The three cells share a word (the usual case).
+        grid.row_words(y)[((x - 1) / 64) as usize] >> ((x - 1) % 64)
+    } else if x >= 1 {
         grid.word_at(x - 1, y)
     } else {
         (grid.word_at(0, y) << 1) | 1

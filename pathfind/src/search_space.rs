@@ -116,11 +116,18 @@ impl<Q: OpenList> SearchSpace<Q> {
     }
 
     /// Offer `g` as the cost of reaching cell `i` from `parent`, arriving in `direction`; queue it
-    /// with priority `g + h` when it improves.
+    /// with priority `g + h()` when it improves (the heuristic is evaluated only then).
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
-    pub(crate) fn relax(&mut self, i: u32, g: f64, h: f64, parent: u32, direction: u8) {
+    pub(crate) fn relax(
+        &mut self,
+        i: u32,
+        g: f64,
+        h: impl FnOnce() -> f64,
+        parent: u32,
+        direction: u8,
+    ) {
         let generation = self.generation;
         let n = &mut self.nodes[i as usize];
         if n.stamp >> STAMP_SHIFT == generation && (n.g <= g || n.stamp & CLOSED_BIT != 0) {
@@ -131,7 +138,7 @@ impl<Q: OpenList> SearchSpace<Q> {
             parent,
             stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
-        let f = g + h;
+        let f = g + h();
         let key = self.key(f, g);
         if self.quantised && key >> 16 <= self.current_f {
             self.same_f.push(i);
