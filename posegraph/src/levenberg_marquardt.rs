@@ -5,13 +5,16 @@ use slam_core::{OptimizationReport, OptimizeError, Optimizer, Pose2, Pose3, Pose
 use crate::solver::{Cache, SolverConfig, optimize};
 
 /// Levenberg-Marquardt: Gauss-Newton steps on `H + lambda diag(H)`; a step that raises the cost is
-/// rejected and the damping raised (times 2, 4, 8, ...), an accepted one lowers it (divided by 3).
+/// rejected and the damping raised (times 2, 4, 8, ...), an accepted one lowers it (divided by 10).
+/// The small initial damping makes the first steps nearly Gauss-Newton steps; rejections raise it
+/// where the start is poor.
 /// The sparse pattern and the symbolic Cholesky are kept between calls while the graph's structure
 /// is unchanged.
 pub struct LevenbergMarquardt {
     /// Stopping rules.
     pub config: SolverConfig,
-    /// Initial damping (relative to the diagonal), default 1e-5.
+    /// Initial damping (relative to the diagonal), default 1e-8 (1e-5 took 8 iterations instead
+    /// of 5 on parking-garage and `input_M3500_g2o`, the same optimum).
     pub initial_lambda: f64,
     cache3: Cache<6>,
     cache2: Cache<3>,
@@ -29,7 +32,7 @@ impl LevenbergMarquardt {
     pub fn new(config: SolverConfig) -> Self {
         Self {
             config,
-            initial_lambda: 1e-5,
+            initial_lambda: 1e-8,
             cache3: None,
             cache2: None,
         }

@@ -12,7 +12,8 @@ use crate::normal_equations::NormalEquations;
 pub struct SolverConfig {
     /// Stop after this many iterations (accepted or rejected steps).
     pub max_iterations: usize,
-    /// Stop when an accepted step lowers the cost by less than this fraction.
+    /// Stop when an accepted step lowers the cost by less than this fraction; default 1e-6
+    /// (GTSAM's default is 1e-5).
     pub relative_cost_tolerance: f64,
     /// Stop when the step's largest component is below this (metres or radians).
     pub step_tolerance: f64,
@@ -24,7 +25,7 @@ impl Default for SolverConfig {
     fn default() -> Self {
         Self {
             max_iterations: 100,
-            relative_cost_tolerance: 1e-10,
+            relative_cost_tolerance: 1e-6,
             step_tolerance: 1e-10,
             error_model: ErrorModel::LogMap,
         }
