@@ -106,7 +106,10 @@ fn loam_odometry_step(c: &mut Criterion) {
         .iter()
         .step_by(2)
         .take(40)
-        .filter_map(|s| Some((loam.prepare_source(&s.cloud).ok()?, world_t_lidar(s))))
+        .filter_map(|s| {
+            let f = loam.prepare_source(&s.cloud).ok()?;
+            Some((loam.keyframe_source(f), world_t_lidar(s)))
+        })
         .collect();
     let parts: Vec<_> = keyframes.iter().map(|(f, p)| (f, *p)).collect();
     let Ok(map) = loam.target_from_sources(&parts) else {

@@ -1,24 +1,24 @@
-//! Graph-SLAM on a simulated Spot (or a recording): point-to-plane ICP odometry against the local
-//! map, loop closure (point-to-point check, point-to-plane refinement), Levenberg-Marquardt.
-//! Prints scans, keyframes, loop closures, ATE, drift, loop end-point error and per-scan times,
-//! and writes the map (PLY), the trajectory (TUM) and the pose graph (g2o) with `--out`.
+//! Graph-SLAM on a simulated Spot (or a recording): point-to-plane ICP (or LOAM) odometry against
+//! the local map, loop closure (point-to-point check, point-to-plane or LOAM refinement),
+//! Levenberg-Marquardt. Prints scans, keyframes, loop closures, ATE, drift, loop end-point error
+//! and per-scan times, and writes the map (PLY), the trajectory (TUM) and the pose graph (g2o)
+//! with `--out`.
 //!
-//! `cargo run --release --example slam -- [RECORDING_DIR] [--seed N] [--out DIR]`
+//! `cargo run --release --example slam -- [RECORDING_DIR] [--seed N] [--registration p2plane|loam] [--out DIR]`
 
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use posegraph::LevenbergMarquardt;
 use posegraph::g2o::{G2oGraph, write_g2o};
-use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
-use slam_core::{GraphSlam, GraphSlamConfig, Pose3, ScanOutcome};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, ScanOutcome};
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, Recording, Sample, SimulatedSpot,
-    SimulationConfig, TrajectoryEvaluation,
+    SimulationConfig, TrajectoryEvaluation, loam_slam, point_to_plane_slam,
 };
 
-const USAGE: &str = "usage: slam [RECORDING_DIR] [--seed N] [--out DIR]";
+const USAGE: &str =
+    "usage: slam [RECORDING_DIR] [--seed N] [--registration p2plane|loam] [--out DIR]";
 
 /// Samples to feed the engine.
 type Samples = Box<dyn Iterator<Item = Result<Sample>>>;
@@ -44,15 +44,15 @@ fn open(recording: Option<&str>, seed: u64) -> Result<(Samples, Pose3, Option<Ve
     }
 }
 
-// Argument parsing, the run and the report in reading order.
-#[allow(clippy::too_many_lines)]
 fn main() -> Result<()> {
-    let (mut recording, mut seed, mut out) = (None, 1u64, None);
+    let (mut recording, mut seed, mut out, mut method) =
+        (None, 1u64, None, String::from("p2plane"));
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--seed" => seed = args.next().context(USAGE)?.parse()?,
             "--out" => out = Some(std::path::PathBuf::from(args.next().context(USAGE)?)),
+            "--registration" => method = args.next().context(USAGE)?,
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
@@ -62,39 +62,27 @@ fn main() -> Result<()> {
         }
     }
     let (samples, body_t_lidar, truth) = open(recording.as_deref(), seed)?;
-    let odometry = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.1 },
-            max_correspondence_distance: 0.5,
-            ..IcpConfig::default()
-        },
-    };
-    let coarse = PointToPointIcp {
-        config: IcpConfig {
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    };
-    let refine = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.10 },
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    };
-    // Voxel centroids of two different scans sit a few centimetres apart, so the coarse check
-    // accepts an RMS distance up to 0.2 m.
-    let config = GraphSlamConfig {
-        loop_max_mean_squared_error: 0.04,
-        ..GraphSlamConfig::default()
-    };
-    let mut slam = GraphSlam::new(
-        config,
-        odometry,
-        coarse,
-        refine,
-        LevenbergMarquardt::default(),
-    );
+    match method.as_str() {
+        "p2plane" => run(
+            point_to_plane_slam(),
+            samples,
+            body_t_lidar,
+            truth.as_deref(),
+            out,
+        ),
+        "loam" => run(loam_slam(), samples, body_t_lidar, truth.as_deref(), out),
+        other => bail!("unknown registration {other:?}; {USAGE}"),
+    }
+}
+
+/// Feed every sample, then report and write the outputs.
+fn run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    mut slam: GraphSlam<R, C, O>,
+    samples: Samples,
+    body_t_lidar: Pose3,
+    truth: Option<&[StampedPose]>,
+    out: Option<std::path::PathBuf>,
+) -> Result<()> {
     let started = Instant::now();
     let mut n = 0usize;
     for sample in samples {
@@ -144,7 +132,7 @@ fn main() -> Result<()> {
             pose: p * lidar_t_body,
         })
         .collect();
-    if let Some(truth) = &truth {
+    if let Some(truth) = truth {
         let e = TrajectoryEvaluation::compute(
             &estimate,
             truth,

@@ -551,4 +551,14 @@ impl MapRegistrator for LoamRegistrator {
         merged.plane_map = voxel_thin(merged.plane_map, c.local_map_plane_voxel);
         self.config.target(merged)
     }
+
+    /// Thins the map points to the local-map voxels in the sensor frame (the picks to align stay
+    /// whole): a 40-keyframe map then merges a few thousand points per keyframe, not every
+    /// reliable point of every scan.
+    fn keyframe_source(&self, mut source: Self::Source) -> Self::Source {
+        let c = &self.config;
+        source.edge_map = voxel_thin(source.edge_map, c.local_map_edge_voxel);
+        source.plane_map = voxel_thin(source.plane_map, c.local_map_plane_voxel);
+        source
+    }
 }

@@ -130,14 +130,11 @@ pub(crate) fn voxel_thin(points: Vec<Point3<f64>>, voxel: f32) -> Vec<Point3<f64
     points
         .into_iter()
         .filter(|p| {
-            // Saturating casts: points beyond i32 voxels share the outermost voxels.
-            #[allow(clippy::cast_possible_truncation)]
-            let key = [
-                (p.x * inv).floor() as i32,
-                (p.y * inv).floor() as i32,
-                (p.z * inv).floor() as i32,
-            ];
-            seen.insert(key)
+            // 21 bits per axis: voxel indices wrap beyond ±10^6 voxels (±50 km at 5 cm), far
+            // outside any local map. Saturating casts keep absurd coordinates finite.
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let axis = |v: f64| u64::from(((v * inv).floor() as i32 as u32) & 0x1F_FFFF);
+            seen.insert(axis(p.x) | (axis(p.y) << 21) | (axis(p.z) << 42))
         })
         .collect()
 }

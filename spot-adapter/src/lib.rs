@@ -67,6 +67,7 @@ mod route;
 mod route_planner;
 mod sample;
 mod simulator;
+mod slam_backends;
 
 pub use alignment::align_rigid;
 pub use ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
@@ -89,3 +90,4 @@ pub use route::Route;
 pub use route_planner::RouteConfig;
 pub use sample::Sample;
 pub use simulator::{SimulatedSpot, SimulationConfig};
+pub use slam_backends::{LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_slam};

@@ -1,56 +1,26 @@
-//! The Graph-SLAM engine with the real backends (point-to-plane ICP odometry, point-to-point
-//! loop check, point-to-plane refinement, Levenberg-Marquardt) on a simulated lap of a generated
+//! The Graph-SLAM engine with the real backends (point-to-plane ICP or LOAM odometry and loop
+//! refinement, point-to-point loop check, Levenberg-Marquardt) on a simulated lap of a generated
 //! building, against the simulator's ground truth.
 #![allow(clippy::unwrap_used)]
 
-use posegraph::LevenbergMarquardt;
-use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::StampedPose;
-use slam_core::{GraphSlam, GraphSlamConfig};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, SimulatedSpot, SimulationConfig,
-    TrajectoryEvaluation,
+    TrajectoryEvaluation, loam_slam, point_to_plane_slam,
 };
 
-#[test]
-fn simulated_loop_meets_the_accuracy_targets() {
+/// Run `slam` over the seed-3 lap and assert the accuracy targets against the
+/// simulator's ground truth.
+fn meets_the_accuracy_targets<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    mut slam: GraphSlam<R, C, O>,
+) {
     let seed = 3;
     let mut config = SimulationConfig::default();
     config.seed = seed;
     let sim = SimulatedSpot::corridor_loop(seed, &config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
-    let odometry = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.1 },
-            max_correspondence_distance: 0.5,
-            ..IcpConfig::default()
-        },
-    };
-    let coarse = PointToPointIcp {
-        config: IcpConfig {
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    };
-    let refine = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.10 },
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    };
-    let slam_config = GraphSlamConfig {
-        loop_max_mean_squared_error: 0.04,
-        ..GraphSlamConfig::default()
-    };
-    let mut slam = GraphSlam::new(
-        slam_config,
-        odometry,
-        coarse,
-        refine,
-        LevenbergMarquardt::default(),
-    );
     let mut odom = Vec::new();
     for sample in sim {
         odom.push(StampedPose {
@@ -99,4 +69,14 @@ fn simulated_loop_meets_the_accuracy_targets() {
     );
     // Spot's own odometry drifts about 1.9 %: SLAM must be far better.
     assert!(o.loop_end_point_error > 10.0 * e.loop_end_point_error.max(0.01));
+}
+
+#[test]
+fn point_to_plane_slam_meets_the_accuracy_targets() {
+    meets_the_accuracy_targets(point_to_plane_slam());
+}
+
+#[test]
+fn loam_slam_meets_the_accuracy_targets() {
+    meets_the_accuracy_targets(loam_slam());
 }

@@ -318,8 +318,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         self.keyframes.push(Keyframe {
             stamp: scan.stamp,
             odom_t_lidar,
-            source,
-            coarse,
+            source: self.odometry.keyframe_source(source),
+            coarse: self.loop_coarse.keyframe_source(coarse),
             cloud: map_cloud,
         });
         self.report.keyframes += 1;

@@ -109,4 +109,12 @@ pub trait MapRegistrator: Registrator {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError>;
+
+    /// The form in which a keyframe keeps a prepared source for the maps it will be part of: a
+    /// backend may thin here what [`MapRegistrator::target_from_sources`] would thin anyway, so
+    /// that each map rebuild touches fewer points. The result must still align as a source. The
+    /// default keeps the source whole.
+    fn keyframe_source(&self, source: Self::Source) -> Self::Source {
+        source
+    }
 }
