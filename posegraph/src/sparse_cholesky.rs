@@ -1,15 +1,16 @@
 //! faer's sparse Cholesky with everything that does not depend on the values kept between
 //! factorisations: the fill-reducing ordering (approximate minimum degree on the graph of
-//! variables, expanded to their `D` scalar unknowns), the symbolic factorisation, the factor's
-//! value array and the scratch memory. A numeric factorisation then allocates nothing.
+//! variables, expanded to their `D` scalar unknowns), the symbolic factorisation (supernodal),
+//! the factor's value array and the scratch memory. A numeric factorisation then allocates
+//! nothing.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
+use faer::sparse::linalg::{SupernodalThreshold, amd};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use slam_core::OptimizeError;
@@ -62,7 +63,13 @@ impl SparseCholesky {
             pattern,
             Side::Upper,
             SymmetricOrdering::Custom(perm),
-            CholeskySymbolicParams::default(),
+            // Supernodal always: each variable's D columns share one pattern, so supernodes are
+            // at least D wide. faer's automatic choice picked the simplicial code for
+            // parking-garage, which was then 2x slower (it recomputes row patterns each time).
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..CholeskySymbolicParams::default()
+            },
         )
         .map_err(|e| factorization_error("symbolic Cholesky", e))?;
         let scratch = MemBuffer::try_new(StackReq::or(
