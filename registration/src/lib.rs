@@ -7,6 +7,10 @@
 //!   et al. 1987).
 //! - [`PointToPlaneIcp`]: Gauss-Newton on SE(3) against target normals from PCA (Chen & Medioni
 //!   1992), with Huber or Tukey weights (thesis eq. 4.7).
+//! - [`LoamFeatures`] + [`LoamRegistrator`]: LOAM (Zhang & Singh 2014, thesis section 4.1.1):
+//!   edge and planar points picked per laser ring by roughness (eq. 4.3), the ring from the
+//!   cloud's ring field or from a [`LidarLayout`]; edges matched to lines and planar points to
+//!   planes fitted to their nearest target features, Tukey-weighted Gauss-Newton (eq. 4.7).
 //!
 //! Correspondences come from `kiddo`'s immutable k-d tree, built once per target. Every result
 //! reports convergence, iterations, inliers, RMSE and the 6x6 information `J^T W J` with its
@@ -37,8 +41,9 @@
 //! ```
 //!
 //! When not to use it: without a rough initial guess (more than about 1 m or 20 degrees off) ICP
-//! converges to the nearest local minimum; use a global registration first. LOAM edge/planar
-//! features are not implemented yet.
+//! and LOAM converge to the nearest local minimum; use a global registration first. LOAM needs a
+//! spinning LiDAR's ring structure (a ring field, or clouds in the sensor frame with a known
+//! layout); for other clouds use the ICP backends.
 
 mod config;
 mod icp;
