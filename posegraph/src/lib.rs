@@ -5,7 +5,10 @@
 //! (`e = log(z^-1 a^-1 b)`, as GTSAM's `BetweenFactor`), the sparse normal equations assembled
 //! straight into a CSC pattern built once per graph structure, and faer's sparse Cholesky with the
 //! symbolic factorisation reused for every numeric one. Robust kernels enter as IRLS weights.
-//! [`g2o`] reads and writes g2o files and evaluates g2o's own chi2 convention.
+//! [`ErrorModel::G2o`] minimises g2o's error convention instead. [`initialize_chordal`] gives a
+//! global initial guess (chordal relaxation for rotations, then linear least squares for
+//! translations; Carlone et al., ICRA 2015). [`g2o`] reads and writes g2o files and evaluates
+//! g2o's own chi2 convention.
 //!
 //! ```
 //! use posegraph::LevenbergMarquardt;
@@ -27,9 +30,9 @@
 //! # Ok::<(), slam_core::OptimizeError>(())
 //! ```
 //!
-//! When not to use it: for graphs that need a certified global optimum from a poor start (use a
-//! chordal or SE-Sync initialisation first), or for landmark-based factor graphs (this crate
-//! handles between-pose constraints only).
+//! When not to use it: for graphs that need a certified global optimum (the chordal guess usually
+//! leads LM to it, as on torus3D, but nothing certifies it: use SE-Sync), or for landmark-based
+//! factor graphs (this crate handles between-pose constraints only).
 
 mod chordal;
 mod error;
