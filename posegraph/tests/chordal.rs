@@ -212,3 +212,70 @@ fn torus3d_reaches_the_global_optimum() {
     );
     assert!(r.final_cost <= 24_240.0, "chi2 {}", r.final_cost);
 }
+
+#[test]
+fn two_fixed_nodes_anchor_the_solution_and_bad_graphs_are_errors() {
+    // A ring whose nodes 0 and 20 are both fixed at the truth, everything else random.
+    let mut r = rng(21);
+    let n = 40;
+    let truth: Vec<Pose2> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            Pose2::new(Vector2::new(3.0 * a.cos(), 3.0 * a.sin()), a - 0.5)
+        })
+        .collect();
+    let mut g = PoseGraph::new();
+    for (i, t) in truth.iter().enumerate() {
+        let fixed = i == 0 || i == 20;
+        let guess = Pose2::new(Vector2::new(5.0 * r(), 5.0 * r()), 6.0 * r());
+        g.add_node(i as u64, if fixed { *t } else { guess })
+            .unwrap();
+    }
+    g.fix(0).unwrap();
+    g.fix(20).unwrap();
+    let info = Matrix3::identity();
+    for i in 0..n as usize {
+        let j = (i + 1) % n as usize;
+        g.add_edge(
+            i as u64,
+            j as u64,
+            truth[i].inverse() * truth[j],
+            info,
+            None,
+        )
+        .unwrap();
+    }
+    // An edge between the two fixed nodes changes nothing.
+    g.add_edge(0, 20, truth[0].inverse() * truth[20], info, None)
+        .unwrap();
+    initialize_chordal(&mut g).unwrap();
+    for (t, nd) in truth.iter().zip(g.nodes()) {
+        let d = t.inverse() * nd.pose;
+        assert!(d.translation.vector.norm() < 1e-9 && d.rotation.angle().abs() < 1e-9);
+    }
+    // Every node fixed: nothing to do.
+    let mut all_fixed = g.clone();
+    for i in 0..n as u64 {
+        all_fixed.fix(i).unwrap();
+    }
+    initialize_chordal(&mut all_fixed).unwrap();
+    let report = LevenbergMarquardt::default()
+        .optimize(&mut all_fixed)
+        .unwrap();
+    assert_eq!(report.stop_reason, slam_core::StopReason::NothingToDo);
+    // No fixed node, and a node connected to nothing: errors.
+    let mut free = PoseGraph::<Pose2>::new();
+    free.add_node(0, Pose2::identity()).unwrap();
+    free.add_node(1, Pose2::identity()).unwrap();
+    free.add_edge(0, 1, Pose2::identity(), info, None).unwrap();
+    assert!(matches!(
+        initialize_chordal(&mut free),
+        Err(slam_core::OptimizeError::NoFixedNode)
+    ));
+    free.add_node(2, Pose2::identity()).unwrap();
+    free.fix(0).unwrap();
+    assert!(matches!(
+        initialize_chordal(&mut free),
+        Err(slam_core::OptimizeError::Disconnected { .. })
+    ));
+}
