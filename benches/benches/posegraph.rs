@@ -200,6 +200,12 @@ fn incremental(c: &mut Criterion) {
         last,
         pose3_from_xyz_rpy(0.05, -0.05, 0.02, 0.01, 0.0, -0.01) * pose,
     );
+    if let Ok(r) = lm.optimize(&mut nudged.clone()) {
+        eprintln!(
+            "posegraph_incremental: one pose nudged: {} iterations, {:.3} -> {:.3}",
+            r.iterations, r.initial_cost, r.final_cost
+        );
+    }
     group.bench_function(BenchmarkId::new("ValuesOnlyCached", &name), |b| {
         b.iter_batched(
             || nudged.clone(),
