@@ -120,6 +120,16 @@ fn prefix(
     g
 }
 
+/// Optimise a copy of `graph` once and print the iterations (the bench does not report them).
+fn print_iterations(what: &str, lm: &mut LevenbergMarquardt, graph: &PoseGraph<Pose3>) {
+    if let Ok(r) = lm.optimize(&mut graph.clone()) {
+        eprintln!(
+            "posegraph_incremental: {what}: {} iterations, {:.3} -> {:.3}",
+            r.iterations, r.initial_cost, r.final_cost
+        );
+    }
+}
+
 fn incremental(c: &mut Criterion) {
     let Some(root) = data_root_or_notice("posegraph_incremental") else {
         return;
@@ -156,14 +166,8 @@ fn incremental(c: &mut Criterion) {
         before.edge_count(),
         warm.edge_count() - before.edge_count()
     );
-    for (what, graph) in [("from scratch", &cold), ("warm start", &warm)] {
-        if let Ok(r) = LevenbergMarquardt::default().optimize(&mut graph.clone()) {
-            eprintln!(
-                "posegraph_incremental: {what}: {} iterations, {:.3} -> {:.3}",
-                r.iterations, r.initial_cost, r.final_cost
-            );
-        }
-    }
+    print_iterations("from scratch", &mut LevenbergMarquardt::default(), &cold);
+    print_iterations("warm start", &mut LevenbergMarquardt::default(), &warm);
     let mut group = c.benchmark_group("posegraph_incremental");
     group.sample_size(10);
     let name = format!("{n}+{added}");
@@ -200,12 +204,7 @@ fn incremental(c: &mut Criterion) {
         last,
         pose3_from_xyz_rpy(0.05, -0.05, 0.02, 0.01, 0.0, -0.01) * pose,
     );
-    if let Ok(r) = lm.optimize(&mut nudged.clone()) {
-        eprintln!(
-            "posegraph_incremental: one pose nudged: {} iterations, {:.3} -> {:.3}",
-            r.iterations, r.initial_cost, r.final_cost
-        );
-    }
+    print_iterations("one pose nudged", &mut lm, &nudged);
     group.bench_function(BenchmarkId::new("ValuesOnlyCached", &name), |b| {
         b.iter_batched(
             || nudged.clone(),
