@@ -14,17 +14,21 @@ use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply,
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, ScanOutcome};
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, Recording, Sample, SimulatedSpot,
-    SimulationConfig, TrajectoryEvaluation, loam_slam, point_to_plane_slam,
+    SimulationConfig, TrajectoryEvaluation, loam_slam, point_to_plane_slam, slam_config,
 };
 
-const USAGE: &str =
-    "usage: slam [RECORDING_DIR] [--seed N] [--registration p2plane|loam] [--out DIR]";
+const USAGE: &str = "usage: slam [RECORDING_DIR] [--seed N] [--registration p2plane|loam] \
+                     [--skewed] [--no-deskew] [--out DIR]";
 
 /// Samples to feed the engine.
 type Samples = Box<dyn Iterator<Item = Result<Sample>>>;
 
 /// Samples, the LiDAR mounting and (when known) the ground truth of a recording or a simulation.
-fn open(recording: Option<&str>, seed: u64) -> Result<(Samples, Pose3, Option<Vec<StampedPose>>)> {
+fn open(
+    recording: Option<&str>,
+    seed: u64,
+    skewed: bool,
+) -> Result<(Samples, Pose3, Option<Vec<StampedPose>>)> {
     if let Some(dir) = recording {
         let rec = Recording::open(dir)?;
         let body_t_lidar = rec.body_t_lidar();
@@ -37,6 +41,7 @@ fn open(recording: Option<&str>, seed: u64) -> Result<(Samples, Pose3, Option<Ve
     } else {
         let mut config = SimulationConfig::default();
         config.seed = seed;
+        config.motion_distortion = skewed;
         let sim = SimulatedSpot::corridor_loop(seed, &config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = Some(sim.ground_truth());
@@ -47,12 +52,15 @@ fn open(recording: Option<&str>, seed: u64) -> Result<(Samples, Pose3, Option<Ve
 fn main() -> Result<()> {
     let (mut recording, mut seed, mut out, mut method) =
         (None, 1u64, None, String::from("p2plane"));
+    let (mut skewed, mut config) = (false, slam_config());
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--seed" => seed = args.next().context(USAGE)?.parse()?,
             "--out" => out = Some(std::path::PathBuf::from(args.next().context(USAGE)?)),
             "--registration" => method = args.next().context(USAGE)?,
+            "--skewed" => skewed = true,
+            "--no-deskew" => config.deskew = false,
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
@@ -61,16 +69,22 @@ fn main() -> Result<()> {
             _ => bail!("unexpected argument {a:?}; {USAGE}"),
         }
     }
-    let (samples, body_t_lidar, truth) = open(recording.as_deref(), seed)?;
+    let (samples, body_t_lidar, truth) = open(recording.as_deref(), seed, skewed)?;
     match method.as_str() {
         "p2plane" => run(
-            point_to_plane_slam(),
+            point_to_plane_slam(config),
             samples,
             body_t_lidar,
             truth.as_deref(),
             out,
         ),
-        "loam" => run(loam_slam(), samples, body_t_lidar, truth.as_deref(), out),
+        "loam" => run(
+            loam_slam(config),
+            samples,
+            body_t_lidar,
+            truth.as_deref(),
+            out,
+        ),
         other => bail!("unknown registration {other:?}; {USAGE}"),
     }
 }
@@ -111,6 +125,7 @@ fn run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             + report.skipped_non_finite_odometry
             + report.skipped_too_few_points
             + report.skipped_preparation
+            + report.skipped_awaiting_velocity
     );
     println!(
         "loops       {} closed of {} tried; {} odometry fallbacks",

@@ -50,7 +50,7 @@ pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
     EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, ScanInput, ScanOutcome, SkipReason,
-    SlamReport,
+    SlamReport, deskew,
 };
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};

@@ -14,27 +14,32 @@ pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, Levenber
 /// Graph-SLAM with LOAM odometry and loop refinement.
 pub type LoamSlam = GraphSlam<LoamRegistrator, PointToPointIcp, LevenbergMarquardt>;
 
-/// The thesis' loop check: point-to-point ICP on voxelised keyframes, and the engine settings
-/// that go with it. Voxel centroids of two different scans sit a few centimetres apart, so the
-/// check accepts an RMS distance up to 0.2 m.
-fn loop_check() -> (PointToPointIcp, GraphSlamConfig) {
-    let coarse = PointToPointIcp {
+/// The engine settings that go with [`point_to_plane_slam`] and [`loam_slam`]: the defaults,
+/// except that the point-to-point loop check accepts an RMS distance up to 0.2 m (voxel
+/// centroids of two different scans sit a few centimetres apart).
+#[must_use]
+pub fn slam_config() -> GraphSlamConfig {
+    GraphSlamConfig {
+        loop_max_mean_squared_error: 0.04,
+        ..GraphSlamConfig::default()
+    }
+}
+
+/// The thesis' loop check: point-to-point ICP on voxelised keyframes.
+fn loop_check() -> PointToPointIcp {
+    PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
             ..IcpConfig::default()
         },
-    };
-    let config = GraphSlamConfig {
-        loop_max_mean_squared_error: 0.04,
-        ..GraphSlamConfig::default()
-    };
-    (coarse, config)
+    }
 }
 
 /// Point-to-plane odometry (Tukey 10 cm, pairs within 0.5 m) against the local map, and
-/// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m).
+/// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m), with `config` (usually
+/// [`slam_config`]).
 #[must_use]
-pub fn point_to_plane_slam() -> PointToPlaneSlam {
+pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
     let odometry = PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.1 },
@@ -49,7 +54,7 @@ pub fn point_to_plane_slam() -> PointToPlaneSlam {
             ..IcpConfig::default()
         },
     };
-    let (coarse, config) = loop_check();
+    let coarse = loop_check();
     GraphSlam::new(
         config,
         odometry,
@@ -60,9 +65,10 @@ pub fn point_to_plane_slam() -> PointToPlaneSlam {
 }
 
 /// LOAM odometry against a local map of edge and planar features (5 cm and 10 cm voxels,
-/// Tukey 5 cm, as the thesis), and LOAM loop refinement with Tukey 10 cm.
+/// Tukey 5 cm, as the thesis), and LOAM loop refinement with Tukey 10 cm, with `config` (usually
+/// [`slam_config`]).
 #[must_use]
-pub fn loam_slam() -> LoamSlam {
+pub fn loam_slam(config: GraphSlamConfig) -> LoamSlam {
     let odometry = LoamRegistrator {
         config: LoamConfig::default(),
     };
@@ -73,7 +79,7 @@ pub fn loam_slam() -> LoamSlam {
             ..LoamConfig::default()
         },
     };
-    let (coarse, config) = loop_check();
+    let coarse = loop_check();
     GraphSlam::new(
         config,
         odometry,

@@ -54,6 +54,11 @@ pub struct GraphSlamConfig {
     pub map_voxel_size: f32,
     /// Scans with fewer finite points are skipped.
     pub min_scan_points: usize,
+    /// Deskew keyframe scans that carry a per-point `time` channel, with the LiDAR velocity the
+    /// odometry showed between the previous scan and this one (constant over the sweep). Scans
+    /// without times, and scans more than a second after the previous one, are used as they
+    /// are.
+    pub deskew: bool,
     /// Run one loop-closure step inside [`GraphSlam::process`](super::GraphSlam::process) after
     /// each new keyframe. When false the caller schedules
     /// [`GraphSlam::loop_closure_step`](super::GraphSlam::loop_closure_step) itself.
@@ -83,6 +88,7 @@ impl Default for GraphSlamConfig {
             },
             map_voxel_size: 0.05,
             min_scan_points: 100,
+            deskew: true,
             inline_loop_closure: true,
         }
     }

@@ -2,14 +2,15 @@
 
 use std::time::Instant;
 
-use nalgebra::Matrix6;
+use nalgebra::{Matrix6, Vector6};
 
 use super::config::{EdgeInformation, GraphSlamConfig};
+use super::deskew::deskew;
 use super::node_index::NodeIndex;
 use super::report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
 use crate::cloud::PointCloud;
 use crate::error::CloudError;
-use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint};
+use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_log};
 use crate::pose_graph::PoseGraph;
 use crate::traits::optimizer::Optimizer;
 use crate::traits::registrator::MapRegistrator;
@@ -62,6 +63,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Every accepted scan: stamp, its keyframe, and the LiDAR pose relative to that keyframe.
     scan_poses: Vec<(f64, usize, Pose3)>,
     last_stamp: f64,
+    /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
+    last_odometry: Option<(f64, Pose3)>,
     report: SlamReport,
 }
 
@@ -90,6 +93,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             last_loop_attempt: None,
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
+            last_odometry: None,
             report: SlamReport::default(),
         }
     }
@@ -170,6 +174,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             SkipReason::NonFiniteOdometry => self.report.skipped_non_finite_odometry += 1,
             SkipReason::TooFewPoints => self.report.skipped_too_few_points += 1,
             SkipReason::PreparationFailed => self.report.skipped_preparation += 1,
+            SkipReason::AwaitingVelocity => self.report.skipped_awaiting_velocity += 1,
         }
         self.report
             .scan_ms
@@ -189,9 +194,22 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             return self.skip(SkipReason::NonFiniteOdometry, started);
         }
         let odom_t_lidar = scan.odom_t_body * scan.body_t_lidar;
+        // Constant velocity over the sweep, from the odometry since the previous scan.
+        let velocity = self
+            .last_odometry
+            .replace((scan.stamp, odom_t_lidar))
+            .and_then(|(stamp, pose)| {
+                let dt = scan.stamp - stamp;
+                (self.config.deskew && dt > 0.0 && dt <= 1.0)
+                    .then(|| se3_log(&(pose.inverse() * odom_t_lidar)) / dt)
+            });
         let Some(last) = self.keyframes.len().checked_sub(1) else {
+            if self.config.deskew && velocity.is_none() && scan.cloud.time().is_some() {
+                self.last_stamp = scan.stamp;
+                return self.skip(SkipReason::AwaitingVelocity, started);
+            }
             // The first keyframe defines the map frame: the odometry frame at the first scan.
-            let outcome = self.add_keyframe(scan, odom_t_lidar, odom_t_lidar, started);
+            let outcome = self.add_keyframe(scan, velocity, odom_t_lidar, odom_t_lidar, started);
             return outcome;
         };
         let kf = &self.keyframes[last];
@@ -207,7 +225,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .push(started.elapsed().as_secs_f64() * 1e3);
             return ScanOutcome::Tracked;
         }
-        self.add_keyframe(scan, odom_t_lidar, predicted, started)
+        self.add_keyframe(scan, velocity, odom_t_lidar, predicted, started)
     }
 
     fn information(
@@ -256,11 +274,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     fn add_keyframe(
         &mut self,
         scan: &ScanInput<'_>,
+        velocity: Option<Vector6<f64>>,
         odom_t_lidar: Pose3,
         predicted: Pose3,
         started: Instant,
     ) -> ScanOutcome {
-        let mut cloud = scan.cloud.clone();
+        let mut cloud = velocity
+            .and_then(|v| deskew(scan.cloud, &v))
+            .unwrap_or_else(|| scan.cloud.clone());
         let dropped = cloud.remove_non_finite();
         if cloud.len() < self.config.min_scan_points {
             return self.skip(SkipReason::TooFewPoints, started);

@@ -6,13 +6,16 @@
 //! against a local map of the last [`GraphSlamConfig::local_map_keyframes`] keyframes and add a
 //! node. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
 //! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
-//! optimises the graph.
+//! optimises the graph. Keyframe scans with a per-point `time` channel are deskewed first, with
+//! the velocity the odometry showed since the previous scan.
 
 mod config;
+mod deskew;
 mod engine;
 mod node_index;
 mod report;
 
 pub use config::{EdgeInformation, GraphSlamConfig};
+pub use deskew::deskew;
 pub use engine::{GraphSlam, ScanInput};
 pub use report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};

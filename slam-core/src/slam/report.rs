@@ -13,6 +13,10 @@ pub enum SkipReason {
     TooFewPoints,
     /// The registrator could not prepare the scan (for example no features).
     PreparationFailed,
+    /// The first scan with per-point times waits for a second one: deskewing needs the
+    /// velocity, and an unskewed first keyframe would anchor the map (and every loop closure
+    /// back to it) on a distorted scan.
+    AwaitingVelocity,
 }
 
 /// What happened to one scan.
@@ -70,6 +74,8 @@ pub struct SlamReport {
     pub skipped_too_few_points: usize,
     /// Skipped scans: preparation failed.
     pub skipped_preparation: usize,
+    /// Skipped scans: a first timed scan waiting for the velocity to deskew it.
+    pub skipped_awaiting_velocity: usize,
     /// Non-finite points dropped from otherwise usable scans.
     pub dropped_points: usize,
     /// Keyframes where the registration was rejected and odometry kept.
