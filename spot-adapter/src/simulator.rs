@@ -32,7 +32,7 @@ pub struct SimulationConfig {
     pub gait_sway: GaitSway,
     /// Cast each column from the pose at its firing time (the robot walks 12 cm during a
     /// sweep), as a real spinning LiDAR sees it; `false` (the default) casts the whole turn from
-    /// the pose at the sample's stamp, so no deskewing is needed.
+    /// the pose at the sample's stamp, so no deskewing is needed, and every point's `time` is 0.
     pub motion_distortion: bool,
 }
 
@@ -198,7 +198,13 @@ impl Iterator for SimulatedSpot {
                 &mut self.noise,
             ),
             // The last sample of a run has no later pose: the robot has stopped.
-            _ => self.lidar.scan(&self.building, &start, &mut self.noise),
+            _ => {
+                // Cast from one pose: every point was measured at the stamp, and its time says
+                // so (a deskewing consumer must leave it alone).
+                let scan = self.lidar.scan(&self.building, &start, &mut self.noise);
+                let n = scan.len();
+                scan.clone().with_time(vec![0.0; n]).unwrap_or(scan)
+            }
         };
         Some(Sample {
             stamp,

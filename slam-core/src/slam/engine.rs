@@ -204,7 +204,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                     .then(|| se3_log(&(pose.inverse() * odom_t_lidar)) / dt)
             });
         let Some(last) = self.keyframes.len().checked_sub(1) else {
-            if self.config.deskew && velocity.is_none() && scan.cloud.time().is_some() {
+            // Only a sweep whose points have different times needs its velocity.
+            let swept = scan.cloud.time().is_some_and(|t| {
+                t.iter()
+                    .any(|&x| x.to_bits() != t.first().map_or(0, |f| f.to_bits()))
+            });
+            if self.config.deskew && velocity.is_none() && swept {
                 self.last_stamp = scan.stamp;
                 return self.skip(SkipReason::AwaitingVelocity, started);
             }

@@ -13,7 +13,7 @@ pub enum SkipReason {
     TooFewPoints,
     /// The registrator could not prepare the scan (for example no features).
     PreparationFailed,
-    /// The first scan with per-point times waits for a second one: deskewing needs the
+    /// The first scan whose points have different times waits for a second one: deskewing needs the
     /// velocity, and an unskewed first keyframe would anchor the map (and every loop closure
     /// back to it) on a distorted scan.
     AwaitingVelocity,
