@@ -195,20 +195,20 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         let odom_t_lidar = scan.odom_t_body * scan.body_t_lidar;
         // Constant velocity over the sweep, from the odometry since the previous scan.
+        // Only a sweep whose points have different times is skewed.
+        let swept = scan.cloud.time().is_some_and(|t| {
+            t.iter()
+                .any(|&x| x.to_bits() != t.first().map_or(0, |f| f.to_bits()))
+        });
         let velocity = self
             .last_odometry
             .replace((scan.stamp, odom_t_lidar))
             .and_then(|(stamp, pose)| {
                 let dt = scan.stamp - stamp;
-                (self.config.deskew && dt > 0.0 && dt <= 1.0)
+                (self.config.deskew && swept && dt > 0.0 && dt <= 1.0)
                     .then(|| se3_log(&(pose.inverse() * odom_t_lidar)) / dt)
             });
         let Some(last) = self.keyframes.len().checked_sub(1) else {
-            // Only a sweep whose points have different times needs its velocity.
-            let swept = scan.cloud.time().is_some_and(|t| {
-                t.iter()
-                    .any(|&x| x.to_bits() != t.first().map_or(0, |f| f.to_bits()))
-            });
             if self.config.deskew && velocity.is_none() && swept {
                 self.last_stamp = scan.stamp;
                 return self.skip(SkipReason::AwaitingVelocity, started);
