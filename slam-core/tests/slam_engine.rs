@@ -11,9 +11,10 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, GraphPose, GraphSlam, GraphSlamConfig, MapRegistrator, OptimizationReport,
-    OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph, RegistrationError, Registrator,
-    ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy, se3_exp, se3_left_jacobian, se3_log,
+    Alignment, EdgeInformation, GraphPose, GraphSlam, GraphSlamConfig, MapRegistrator,
+    OptimizationReport, OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph, RegistrationError,
+    Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy, se3_exp,
+    se3_left_jacobian, se3_log,
 };
 
 /// Point-to-point ICP with brute-force nearest neighbours (Arun/Umeyama step).
@@ -307,6 +308,12 @@ fn loop_closure_removes_odometry_drift() {
         loop_search_radius: 1.0,
         loop_max_mean_squared_error: 0.02,
         min_scan_points: 50,
+        // The test-only registrator reports no real information (identity), so loop edges take
+        // fixed sigmas here rather than the default registration information.
+        loop_information: EdgeInformation::Fixed {
+            translation_sigma: 0.02,
+            rotation_sigma: 0.3f64.to_radians(),
+        },
         ..GraphSlamConfig::default()
     };
     let mut slam = GraphSlam::new(
