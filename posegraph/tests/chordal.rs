@@ -3,32 +3,15 @@
 //! the file's own guess stops in a local minimum.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-use std::path::PathBuf;
+mod common;
+
+use common::{rng, shared};
 use std::time::Instant;
 
 use nalgebra::{Matrix3, Matrix6, Vector2, Vector3, Vector6};
 use posegraph::g2o::{G2oGraph, read_g2o};
 use posegraph::{LevenbergMarquardt, initialize_chordal};
 use slam_core::{Optimizer, Pose2, Pose3, PoseGraph, pose3_from_xyz_rpy, se2_exp, se3_exp};
-
-fn rng(seed: u64) -> impl FnMut() -> f64 {
-    let mut s = seed | 1;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
-
-fn shared(name: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("SPOT_NAV_DATA").map_or_else(
-        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
-        PathBuf::from,
-    );
-    let p = root.join("posegraph").join(name);
-    p.exists().then_some(p)
-}
 
 /// A 4 x 4 x 3 grid of poses with random headings, odometry along a snake path and every grid
 /// neighbour as a loop edge; measurements with noise of `sigma_t` metres and `sigma_r` radians.

@@ -2,6 +2,9 @@
 //! (GTSAM 4.3 LM, log-map error; our cost is `sum e^T Omega e` = 2 x GTSAM's error).
 #![allow(clippy::unwrap_used, clippy::panic)]
 
+mod common;
+
+use common::shared;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -13,15 +16,6 @@ fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
         .join(name)
-}
-
-fn shared(name: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("SPOT_NAV_DATA").map_or_else(
-        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
-        PathBuf::from,
-    );
-    let p = root.join("posegraph").join(name);
-    p.exists().then_some(p)
 }
 
 fn fix_first<P: GraphPose>(g: &mut PoseGraph<P>) {

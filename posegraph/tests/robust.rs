@@ -2,19 +2,12 @@
 //! loops every pose ends within 5 cm of the truth.
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
+use common::rng;
 use nalgebra::{Matrix6, Vector6};
 use posegraph::LevenbergMarquardt;
 use slam_core::{Optimizer, Pose3, PoseGraph, RobustKernel, pose3_from_xyz_rpy, se3_exp};
-
-fn rng(seed: u64) -> impl FnMut() -> f64 {
-    let mut s = seed | 1;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
 
 #[test]
 fn wrong_loops_are_ignored_with_a_robust_kernel() {

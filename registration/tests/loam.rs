@@ -6,7 +6,6 @@
 mod common;
 
 use common::{error, garage_frames, here, os1_128, random_halves, reference, target_scan};
-use nalgebra::Point3;
 use registration::{LidarLayout, LoamConfig, LoamFeatures, LoamRegistrator};
 use slam_core::io::read_ply;
 use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
@@ -130,15 +129,7 @@ fn static_garage_sequence_does_not_drift() {
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
     let loam = LoamRegistrator::default();
-    assert!(matches!(
-        loam.prepare_source(&PointCloud::new()),
-        Err(RegistrationError::TooFewPoints { .. })
-    ));
-    let nan = PointCloud::from_points(vec![Point3::new(f32::NAN, 0.0, 0.0); 5000]);
-    assert!(matches!(
-        loam.prepare_target(&nan),
-        Err(RegistrationError::TooFewPoints { .. })
-    ));
+    common::rejects_empty_and_nan(&loam);
     let mut bad = loam;
     bad.config.tukey_threshold = -1.0;
     assert!(matches!(

@@ -122,15 +122,7 @@ fn hdl32e_pair_matches_the_reference() {
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
     let icp = PointToPlaneIcp::default();
-    assert!(matches!(
-        icp.prepare_source(&PointCloud::new()),
-        Err(RegistrationError::TooFewPoints { .. })
-    ));
-    let nan = PointCloud::from_points(vec![Point3::new(f32::NAN, 0.0, 0.0); 500]);
-    assert!(matches!(
-        icp.prepare_target(&nan),
-        Err(RegistrationError::TooFewPoints { .. })
-    ));
+    common::rejects_empty_and_nan(&icp);
     // A single plane: translation along it and rotation about its normal are unobservable.
     let plane: Vec<Point3<f32>> = (0..4000)
         .map(|i| Point3::new((i % 80) as f32 * 0.1, (i / 80) as f32 * 0.1, 0.0))

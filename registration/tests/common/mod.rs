@@ -100,3 +100,17 @@ pub fn garage_frames() -> Vec<PointCloud> {
         .map(|p| slam_core::io::read_pcd(p).unwrap())
         .collect()
 }
+
+/// An empty source and an all-NaN target are `TooFewPoints` errors, never a panic.
+pub fn rejects_empty_and_nan<R: slam_core::Registrator>(r: &R) {
+    use slam_core::RegistrationError;
+    assert!(matches!(
+        r.prepare_source(&PointCloud::new()),
+        Err(RegistrationError::TooFewPoints { .. })
+    ));
+    let nan = PointCloud::from_points(vec![nalgebra::Point3::new(f32::NAN, 0.0, 0.0); 5000]);
+    assert!(matches!(
+        r.prepare_target(&nan),
+        Err(RegistrationError::TooFewPoints { .. })
+    ));
+}
