@@ -5,7 +5,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 use crate::best_first::best_first;
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
-use crate::movement::octile;
+use crate::cost::octile;
 use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
 

@@ -5,7 +5,8 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
-use crate::movement::{DIRECTIONS, SQRT_2, legal_steps};
+use crate::cost::{Cost, STEP};
+use crate::movement::{DIRECTIONS, legal_steps};
 use crate::open_list::BucketRing;
 use crate::search_space::{NO_DIRECTION, SearchSpace};
 
@@ -18,7 +19,7 @@ pub(crate) fn best_first(
     closed: &mut ClosedSet,
     start: Cell,
     goal: Cell,
-    heuristic: impl Fn(Cell) -> f64,
+    heuristic: impl Fn(Cell) -> Cost,
 ) -> Result<GridPath, PlanError> {
     validate_endpoints(grid, start, goal)?;
     if !components.connected(start, goal) {
@@ -27,7 +28,7 @@ pub(crate) fn best_first(
     space.reset();
     closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0.0, || heuristic(start), s, NO_DIRECTION);
+    space.relax(s, 0, || heuristic(start), s, NO_DIRECTION);
     let mut expanded = 0;
     while let Some((i, g, _)) = space.pop() {
         expanded += 1;
@@ -42,8 +43,7 @@ pub(crate) fn best_first(
             steps &= steps - 1;
             let (dx, dy) = DIRECTIONS[d];
             let n = Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
-            let cost = if d >= 4 { SQRT_2 } else { 1.0 };
-            space.relax(space.index(n), g + cost, || heuristic(n), i, d as u8);
+            space.relax(space.index(n), g + STEP[d], || heuristic(n), i, d as u8);
         }
     }
     Err(PlanError::NoPath)

@@ -39,7 +39,7 @@ impl Planner for Dijkstra<'_> {
             &mut self.closed,
             start,
             goal,
-            |_| 0.0,
+            |_| 0,
         )
     }
 }

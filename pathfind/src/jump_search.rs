@@ -14,7 +14,8 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
 use crate::components::Components;
-use crate::movement::{DIRECTIONS, can_step, free, octile};
+use crate::cost::octile;
+use crate::movement::{DIRECTIONS, can_step, free};
 use crate::search_space::{NO_DIRECTION, SearchSpace};
 
 /// Direction index of `(dx, dy)` in [`DIRECTIONS`].
@@ -109,7 +110,7 @@ pub(crate) fn jump_search(
     }
     space.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0.0, || octile(start, goal), s, NO_DIRECTION);
+    space.relax(s, 0, || octile(start, goal), s, NO_DIRECTION);
     let mut expanded = 0;
     while let Some((i, g, arrive)) = space.pop() {
         expanded += 1;

@@ -42,6 +42,7 @@ mod best_first;
 mod block_scan;
 mod closed_set;
 mod components;
+mod cost;
 mod dijkstra;
 mod error;
 mod jps;

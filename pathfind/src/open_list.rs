@@ -5,11 +5,25 @@
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 
-/// An open-list entry: the smallest key pops first.
+use crate::cost::{Cost, FRACTION_BITS};
+
+/// An open-list entry: the smallest `(f, tie)` pops first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Open {
-    pub(crate) key: u64,
+    /// Priority `g + h`.
+    pub(crate) f: Cost,
+    /// Tie-break among equal `f` (smaller first).
+    pub(crate) tie: u32,
+    /// The cell.
     pub(crate) index: u32,
+}
+
+impl Open {
+    /// The order of the entries (smaller pops first): `f`, then `tie`.
+    #[inline]
+    fn key(&self) -> u128 {
+        u128::from(self.f) << 32 | u128::from(self.tie)
+    }
 }
 
 impl PartialOrd for Open {
@@ -19,17 +33,17 @@ impl PartialOrd for Open {
 }
 impl Ord for Open {
     fn cmp(&self, other: &Self) -> Ordering {
-        other.key.cmp(&self.key)
+        other.key().cmp(&self.key())
     }
 }
 
-/// A priority queue of cells keyed by `u64` (smallest first).
+/// A priority queue of cells (smallest `(f, tie)` first).
 pub(crate) trait OpenList: Default {
     /// Drop every entry.
     fn clear(&mut self);
-    /// Queue `index` with `key`; `f` is the priority the key encodes (same order).
-    fn push(&mut self, key: u64, f: f64, index: u32);
-    /// The entry with the smallest key.
+    /// Queue an entry.
+    fn push(&mut self, open: Open);
+    /// The entry with the smallest `(f, tie)`.
     fn pop(&mut self) -> Option<Open>;
 }
 
@@ -43,8 +57,8 @@ impl OpenList for KeyHeap {
         self.0.clear();
     }
     #[inline]
-    fn push(&mut self, key: u64, _f: f64, index: u32) {
-        self.0.push(Open { key, index });
+    fn push(&mut self, open: Open) {
+        self.0.push(open);
     }
     #[inline]
     fn pop(&mut self) -> Option<Open> {
@@ -52,8 +66,8 @@ impl OpenList for KeyHeap {
     }
 }
 
-/// Buckets per cell of priority.
-const BUCKETS_PER_UNIT: f64 = 64.0;
+/// Bucket of priority `f`: 64 buckets per cell (`f >> BUCKET_SHIFT`).
+const BUCKET_SHIFT: u32 = FRACTION_BITS - 6;
 /// Words of the ring's occupancy bits.
 const RING_WORDS: usize = 4;
 /// Buckets in the ring.
@@ -135,22 +149,22 @@ impl OpenList for BucketRing {
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
-    fn push(&mut self, key: u64, f: f64, index: u32) {
-        // `f >= 0`; the cast truncates, which is the floor.
-        let mut bucket = (f * BUCKETS_PER_UNIT) as u64;
+    fn push(&mut self, open: Open) {
+        let mut bucket = open.f >> BUCKET_SHIFT;
         if self.is_empty() {
             self.base = bucket;
             self.sorted = false;
         }
-        // A rounding of `g + h` a hair below the current bucket's floor belongs to it.
+        // A priority below the current bucket (the first push into an empty ring set it, and a
+        // smaller one followed) joins the current bucket, sorted in with the rest.
         bucket = bucket.max(self.base);
         debug_assert!(bucket - self.base < RING as u64, "priority beyond the ring");
         let s = Self::slot(bucket);
-        let open = Open { key, index };
         let list = &mut self.buckets[s];
         if self.sorted && bucket == self.base {
             // Descending order: insert after every larger key.
-            let at = list.partition_point(|o| o.key > key);
+            let key = open.key();
+            let at = list.partition_point(|o| o.key() > key);
             list.insert(at, open);
         } else {
             list.push(open);
@@ -174,7 +188,7 @@ impl OpenList for BucketRing {
         let list = &mut self.buckets[s];
         if !self.sorted {
             if list.len() > 1 {
-                list.sort_unstable_by_key(|o| Reverse(o.key));
+                list.sort_unstable_by_key(|o| Reverse(o.key()));
             }
             self.sorted = true;
         }

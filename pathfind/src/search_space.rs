@@ -1,28 +1,27 @@
 //! Per-cell search state reused across queries: one packed record per cell (cost, parent,
 //! arrival direction, generation stamps), reset in O(1) by a generation counter, and an open list
-//! of 64-bit keys with lazy deletion (a binary heap, or a ring of buckets for the cell-by-cell
-//! searches; see [`crate::open_list`]), plus a stack for cells whose `f` equals the `f` being
-//! expanded.
+//! of fixed-point priorities ([`crate::cost`]) with lazy deletion (a binary heap, or a ring of
+//! buckets for the cell-by-cell searches; see [`crate::open_list`]), plus a stack for cells whose
+//! `f` equals the `f` being expanded.
 //!
 //! The stack is sound because the heuristics used here are consistent: `f` never decreases along
 //! an expansion order, so any open cell with the current minimum `f` may be expanded next, and a
-//! successor with that same `f` has the larger `g` (the preferred tie-break). On open maps most
-//! successors are such cells (walking straight at the goal), and they skip the open list entirely.
+//! successor with that same `f` has the larger `g` (the preferred tie-break). Such successors (a
+//! walk straight at the goal) skip the open list entirely.
 
 use slam_core::{Cell, GridPath};
 
-use crate::open_list::{KeyHeap, OpenList};
+use crate::cost::{Cost, whole_cells};
+use crate::movement::path_cost;
+use crate::open_list::{KeyHeap, Open, OpenList};
 
 /// No arrival direction (the start).
 pub(crate) const NO_DIRECTION: u8 = 8;
 
-/// Path costs below 2^22 cells get quantised keys with a tie-break; see [`SearchSpace::key`].
-const QUANTISED_LIMIT: f64 = (1u64 << 22) as f64;
-
 /// One cell's search record, 16 bytes so that four share a cache line.
 #[derive(Clone, Copy, Debug)]
 struct NodeState {
-    g: f64,
+    g: Cost,
     parent: u32,
     /// `generation << STAMP_SHIFT | closed << 4 | direction`: `g`, `parent` and `direction` are
     /// valid when the generation is the current one; `closed` says the cell was expanded then.
@@ -43,18 +42,15 @@ pub(crate) struct SearchSpace<Q = KeyHeap> {
     open: Q,
     /// Cells queued with `f` equal to `current_f`; expanded before anything on the open list.
     same_f: Vec<u32>,
-    /// Quantised `f` (the key without its tie-break bits) of the last cell taken off the open list.
-    /// A key at or below it (below only by a rounding of `g + h`) joins `same_f`.
-    current_f: u64,
-    /// Whether every path cost on this grid stays below [`QUANTISED_LIMIT`].
-    quantised: bool,
+    /// `f` of the last cell taken off the open list.
+    current_f: Cost,
 }
 
 impl<Q: OpenList> SearchSpace<Q> {
     pub(crate) fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
         let empty = NodeState {
-            g: 0.0,
+            g: 0,
             parent: 0,
             stamp: 0,
         };
@@ -65,28 +61,6 @@ impl<Q: OpenList> SearchSpace<Q> {
             open: Q::default(),
             same_f: Vec::new(),
             current_f: 0,
-            // No shortest path visits a cell twice, so costs stay below cells * sqrt(2).
-            quantised: (n as f64) * std::f64::consts::SQRT_2 < QUANTISED_LIMIT,
-        }
-    }
-
-    /// The open-list key of priority `f` for a node of cost `g`: smaller pops first.
-    ///
-    /// On grids whose costs stay below 2^22, `f` is fixed point with 26 fractional bits in the top
-    /// 48 bits, and the low 16 bits prefer the larger `g` among equal `f`. Distinct costs
-    /// `a + b sqrt(2)` below 2^22 differ by far more than 2^-26, so the order of `f` is exact.
-    /// On larger grids the key is the bit pattern of `f` (monotone for non-negative floats).
-    // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
-    #[allow(clippy::inline_always)]
-    #[inline(always)]
-    fn key(&self, f: f64, g: f64) -> u64 {
-        if self.quantised {
-            // `f >= 0`, so adding one half and truncating rounds (and avoids a libm call).
-            let fq = (f * (1u64 << 26) as f64 + 0.5) as u64;
-            let tie = 0xFFFF - (g as u64).min(0xFFFF);
-            (fq << 16) | tie
-        } else {
-            f.to_bits()
         }
     }
 
@@ -123,8 +97,8 @@ impl<Q: OpenList> SearchSpace<Q> {
     pub(crate) fn relax(
         &mut self,
         i: u32,
-        g: f64,
-        h: impl FnOnce() -> f64,
+        g: Cost,
+        h: impl FnOnce() -> Cost,
         parent: u32,
         direction: u8,
     ) {
@@ -139,11 +113,17 @@ impl<Q: OpenList> SearchSpace<Q> {
             stamp: generation << STAMP_SHIFT | u32::from(direction),
         };
         let f = g + h();
-        let key = self.key(f, g);
-        if self.quantised && key >> 16 <= self.current_f {
+        // `f` never decreases along the expansions (consistent heuristic, exact integer costs),
+        // so `f <= current_f` means equal.
+        if f <= self.current_f {
             self.same_f.push(i);
         } else {
-            self.open.push(key, f, i);
+            self.open.push(Open {
+                f,
+                // Among equal `f`, the larger `g` first.
+                tie: u32::MAX - whole_cells(g),
+                index: i,
+            });
         }
     }
 
@@ -152,7 +132,7 @@ impl<Q: OpenList> SearchSpace<Q> {
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
-    fn close(&mut self, i: u32) -> Option<(f64, u8)> {
+    fn close(&mut self, i: u32) -> Option<(Cost, u8)> {
         let n = &mut self.nodes[i as usize];
         if n.stamp & CLOSED_BIT != 0 {
             return None;
@@ -165,7 +145,7 @@ impl<Q: OpenList> SearchSpace<Q> {
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
-    pub(crate) fn pop(&mut self) -> Option<(u32, f64, u8)> {
+    pub(crate) fn pop(&mut self) -> Option<(u32, Cost, u8)> {
         // Every queued cell was stamped in this generation, so only the closed bit needs a look.
         while let Some(i) = self.same_f.pop() {
             if let Some((g, d)) = self.close(i) {
@@ -174,7 +154,7 @@ impl<Q: OpenList> SearchSpace<Q> {
         }
         while let Some(o) = self.open.pop() {
             if let Some((g, d)) = self.close(o.index) {
-                self.current_f = o.key >> 16;
+                self.current_f = o.f;
                 return Some((o.index, g, d));
             }
         }
@@ -191,7 +171,8 @@ impl<Q: OpenList> SearchSpace<Q> {
         }
         cells.reverse();
         GridPath {
-            length: self.nodes[goal as usize].g,
+            // Summed in floating point step by step (the costs above are fixed point).
+            length: path_cost(&cells),
             cells,
             expanded,
         }
