@@ -132,8 +132,20 @@ fn run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         report.loops_closed, report.loops_attempted, report.odometry_fallbacks
     );
     let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);
+    let mut sorted = report.scan_ms.clone();
+    sorted.sort_by(f64::total_cmp);
+    let p99 = sorted
+        .get((sorted.len() * 99 / 100).min(sorted.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0);
+    let slowest = report
+        .scan_ms
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(0, |(i, _)| i + 1);
     println!(
-        "time        {:.2} ms mean, {:.2} ms max per scan (odometry path); loop steps max {loop_max:.1} ms; {wall:.1} s in all",
+        "time        {:.2} ms mean, {p99:.2} ms p99, {:.2} ms max (scan {slowest}) per scan (odometry path); loop steps max {loop_max:.1} ms; {wall:.1} s in all",
         report.mean_scan_ms(),
         report.max_scan_ms()
     );

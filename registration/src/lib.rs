@@ -55,12 +55,14 @@ mod point_to_plane;
 mod point_to_point;
 mod sym3;
 mod target;
+mod voxel_hash_map;
 
 pub use config::IcpConfig;
 pub use kernel::IcpKernel;
 pub use lidar_layout::LidarLayout;
-pub use loam::{LoamConfig, LoamPatch, LoamRegistrator, LoamTarget};
+pub use loam::{LoamConfig, LoamRegistrator, LoamTarget};
 pub use loam_features::{LoamFeatureConfig, LoamFeatures};
 pub use point_to_plane::PointToPlaneIcp;
 pub use point_to_point::PointToPointIcp;
 pub use target::PreparedTarget;
+pub use voxel_hash_map::VoxelHashMap;

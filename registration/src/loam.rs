@@ -2,9 +2,6 @@
 //! lines through the nearest target edge points, planar points to planes fitted to the nearest
 //! target planar points, Tukey-weighted Gauss-Newton on SE(3).
 
-use std::cell::OnceCell;
-
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
     Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, pose3_is_finite,
@@ -15,25 +12,28 @@ use crate::icp::min_eigenvalue_ratio;
 use crate::kernel::IcpKernel;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
 use crate::sym3::{Eigen3, symmetric_eigen3};
+use crate::voxel_hash_map::VoxelHashMap;
 
 /// Settings of [`LoamRegistrator`]. Lengths in metres, angles in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LoamConfig {
     /// Feature extraction.
     pub features: LoamFeatureConfig,
-    /// Voxel of a local map's edge points (thesis: 5 cm): the map of many scans built by
-    /// [`MapRegistrator::target_from_sources`] keeps one point per voxel.
+    /// Voxel of a local map's edge points (thesis: 5 cm): a map of many scans
+    /// ([`MapRegistrator::target_from_sources`], [`MapRegistrator::empty_map`]) keeps one point
+    /// per voxel, the newest.
     pub local_map_edge_voxel: f32,
     /// Voxel of a local map's planar points (thesis: 10 cm).
     pub local_map_plane_voxel: f32,
-    /// Which patch a source feature's line or plane is fitted to.
-    pub patch: LoamPatch,
+    /// Side of the cells the target's points are hashed into for neighbour search (0.4 m;
+    /// rounded to a whole number of local-map voxels). Answers do not depend on it, only speed.
+    pub search_cell: f64,
     /// Target points looked up per source feature (5, as LeGO-LOAM).
     pub neighbours: usize,
     /// The farthest of those neighbours must lie within this distance (1 m).
     pub max_neighbour_distance: f64,
     /// A patch is a line when its largest covariance eigenvalue exceeds the middle one this many
-    /// times (3, as LOAM).
+    /// times (10).
     pub line_eigenvalue_ratio: f64,
     /// A patch is a plane when each of its points lies within this distance of the fitted plane
     /// (0.1 m).
@@ -63,7 +63,7 @@ impl Default for LoamConfig {
             features: LoamFeatureConfig::default(),
             local_map_edge_voxel: 0.05,
             local_map_plane_voxel: 0.1,
-            patch: LoamPatch::AroundQuery,
+            search_cell: 0.4,
             neighbours: 5,
             max_neighbour_distance: 1.0,
             line_eigenvalue_ratio: 10.0,
@@ -79,121 +79,33 @@ impl Default for LoamConfig {
     }
 }
 
-/// Where the patch a source feature is matched to comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LoamPatch {
-    /// The `neighbours` target points nearest the moved source point, refitted at every
-    /// matching (LOAM's own rule). The default.
-    AroundQuery,
-    /// The nearest target point and its `neighbours` nearest points, fitted once per target
-    /// point and kept: one nearest-point query per match, and a local map shared by several
-    /// scans fits each patch once. Less accurate: a patch centred off the query point bends
-    /// with the surface (0.49° and 4 cm from the HDL-32E pair's reference, against 0.20° and
-    /// 2.1 cm).
-    AroundNearest,
-}
-
 /// LOAM registration behind [`Registrator`]: sources are [`LoamFeatures`], targets their edge
-/// and planar points in two k-d trees.
+/// and planar points hashed into voxels for neighbour search.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LoamRegistrator {
     /// Settings.
     pub config: LoamConfig,
 }
 
-/// A target prepared for LOAM: edge and planar points, each in its own k-d tree.
+/// A target prepared for LOAM: edge and planar points, each in its own [`VoxelHashMap`]. A local
+/// map ([`MapRegistrator::empty_map`]) is updated in place as keyframes enter and leave it.
+#[derive(Clone, Debug)]
 pub struct LoamTarget {
-    edges: FeatureTree,
-    planes: FeatureTree,
-}
-
-impl std::fmt::Debug for LoamTarget {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("LoamTarget")
-            .field("edges", &self.edges.points.len())
-            .field("planes", &self.planes.points.len())
-            .finish()
-    }
+    edges: VoxelHashMap,
+    planes: VoxelHashMap,
 }
 
 impl LoamTarget {
     /// Edge points of the target.
     #[must_use]
-    pub fn edges(&self) -> &[Point3<f64>] {
-        &self.edges.points
+    pub fn edges(&self) -> &VoxelHashMap {
+        &self.edges
     }
 
     /// Planar points of the target.
     #[must_use]
-    pub fn planes(&self) -> &[Point3<f64>] {
-        &self.planes.points
-    }
-}
-
-struct FeatureTree {
-    points: Vec<Point3<f64>>,
-    /// In f32: half the memory traffic of f64 per query, and a local map spans far less than
-    /// the kilometres where f32 would lose millimetres.
-    tree: Option<ImmutableKdTree<f32, 3>>,
-    /// The line or plane around each point, fitted on first use ([`LoamPatch::AroundNearest`]).
-    fits: Vec<OnceCell<Option<Fit>>>,
-}
-
-impl FeatureTree {
-    fn new(points: Vec<Point3<f64>>) -> Result<Self, RegistrationError> {
-        let tree = if points.is_empty() {
-            None
-        } else {
-            #[allow(clippy::cast_possible_truncation)]
-            let coords: Vec<[f32; 3]> = points
-                .iter()
-                .map(|p| [p.x as f32, p.y as f32, p.z as f32])
-                .collect();
-            Some(
-                ImmutableKdTree::new_from_slice(&coords)
-                    .map_err(|e| RegistrationError::Degenerate(format!("k-d tree: {e:?}")))?,
-            )
-        };
-        let fits = (0..points.len()).map(|_| OnceCell::new()).collect();
-        Ok(Self { points, tree, fits })
-    }
-
-    /// The `k` nearest points to `q` when the farthest of them lies within `max_d2`.
-    #[allow(clippy::cast_possible_truncation)]
-    fn patch(
-        &self,
-        q: &Point3<f64>,
-        k: std::num::NonZero<usize>,
-        max_d2: f64,
-        out: &mut Vec<Point3<f64>>,
-    ) -> bool {
-        out.clear();
-        let Some(tree) = &self.tree else {
-            return false;
-        };
-        let nn = tree
-            .query(&[q.x as f32, q.y as f32, q.z as f32])
-            .nearest_n::<SquaredEuclidean<f32>>(k)
-            .within::<SquaredEuclidean<f32>>(max_d2 as f32)
-            .unsorted()
-            .execute();
-        if nn.len() < k.get() {
-            return false;
-        }
-        out.extend(nn.iter().map(|r| self.points[r.item as usize]));
-        true
-    }
-
-    /// The nearest point to `q` when it lies within `max_d2`.
-    #[allow(clippy::cast_possible_truncation)]
-    fn nearest(&self, q: &Point3<f64>, max_d2: f64) -> Option<usize> {
-        let r = self
-            .tree
-            .as_ref()?
-            .query(&[q.x as f32, q.y as f32, q.z as f32])
-            .nearest_one::<SquaredEuclidean<f32>>()
-            .execute();
-        (f64::from(r.distance) <= max_d2).then_some(r.item as usize)
+    pub fn planes(&self) -> &VoxelHashMap {
+        &self.planes
     }
 }
 
@@ -281,64 +193,43 @@ impl Correspondence {
 struct Matcher<'a> {
     config: &'a LoamConfig,
     target: &'a LoamTarget,
-    k: std::num::NonZero<usize>,
-    max_d2: f64,
+    found: Vec<(f32, [f32; 3])>,
     patch: Vec<Point3<f64>>,
 }
 
 impl Matcher<'_> {
-    /// The line or plane matched to the moved source point `p` in `tree`.
-    fn fit(&mut self, tree: &FeatureTree, p: &Point3<f64>, edge: bool) -> Option<Fit> {
-        let (ratio, tol) = (
-            self.config.line_eigenvalue_ratio,
-            self.config.plane_fit_tolerance,
-        );
-        let fit = |patch: &[Point3<f64>]| {
-            if edge {
-                Fit::line(patch, ratio)
-            } else {
-                Fit::plane(patch, tol)
-            }
-        };
-        match self.config.patch {
-            LoamPatch::AroundQuery => {
-                if !tree.patch(p, self.k, self.max_d2, &mut self.patch) {
-                    return None;
-                }
-                fit(&self.patch)
-            }
-            LoamPatch::AroundNearest => {
-                let i = tree.nearest(p, self.max_d2)?;
-                *tree.fits[i].get_or_init(|| {
-                    let mut patch = Vec::with_capacity(self.k.get());
-                    tree.patch(&tree.points[i], self.k, self.max_d2, &mut patch)
-                        .then(|| fit(&patch))
-                        .flatten()
-                })
-            }
+    /// The line (`edge`) or plane through the target points of `map` nearest the moved source
+    /// point `p`, when there are enough of them within reach and they fit one.
+    fn fit(&mut self, map: &VoxelHashMap, p: &Point3<f64>, edge: bool) -> Option<Fit> {
+        let c = self.config;
+        map.search(p, c.neighbours, c.max_neighbour_distance, &mut self.found);
+        if self.found.len() < c.neighbours {
+            return None;
         }
-    }
-
-    fn edge(&mut self, source: Point3<f64>, p: &Point3<f64>) -> Option<Correspondence> {
-        let fit = self.fit(&self.target.edges, p, true)?;
-        Some(Correspondence { source, fit })
-    }
-
-    fn plane(&mut self, source: Point3<f64>, p: &Point3<f64>) -> Option<Correspondence> {
-        let fit = self.fit(&self.target.planes, p, false)?;
-        Some(Correspondence { source, fit })
+        self.patch.clear();
+        self.patch.extend(
+            self.found
+                .iter()
+                .map(|(_, q)| Point3::new(f64::from(q[0]), f64::from(q[1]), f64::from(q[2]))),
+        );
+        if edge {
+            Fit::line(&self.patch, c.line_eigenvalue_ratio)
+        } else {
+            Fit::plane(&self.patch, c.plane_fit_tolerance)
+        }
     }
 
     fn all(&mut self, source: &LoamFeatures, pose: &Pose3, out: &mut Vec<Correspondence>) {
         out.clear();
-        for &e in &source.edges {
-            if let Some(c) = self.edge(e, &(pose * e)) {
-                out.push(c);
-            }
-        }
-        for &q in &source.planes {
-            if let Some(c) = self.plane(q, &(pose * q)) {
-                out.push(c);
+        let target = self.target;
+        for (points, map, edge) in [
+            (&source.edges, &target.edges, true),
+            (&source.planes, &target.planes, false),
+        ] {
+            for &s in points {
+                if let Some(fit) = self.fit(map, &(pose * s), edge) {
+                    out.push(Correspondence { source: s, fit });
+                }
             }
         }
     }
@@ -382,6 +273,7 @@ impl LoamConfig {
             self.plane_fit_tolerance,
             self.tukey_threshold,
             self.initial_tukey_threshold,
+            self.search_cell,
         ];
         if !(self.rematch_motion.is_finite() && self.rematch_motion >= 0.0) {
             return Err(RegistrationError::InvalidConfig(
@@ -400,12 +292,22 @@ impl LoamConfig {
         Ok(())
     }
 
-    /// A target from the map points of `features`.
-    fn target(&self, features: LoamFeatures) -> Result<LoamTarget, RegistrationError> {
+    /// An empty target whose maps thin to `edge_voxel` and `plane_voxel` (0: keep all).
+    fn empty_target(
+        &self,
+        edge_voxel: f32,
+        plane_voxel: f32,
+    ) -> Result<LoamTarget, RegistrationError> {
         self.validate()?;
-        let edges = FeatureTree::new(features.edge_map)?;
-        let planes = FeatureTree::new(features.plane_map)?;
-        let points = edges.points.len() + planes.points.len();
+        Ok(LoamTarget {
+            edges: VoxelHashMap::new(self.search_cell, f64::from(edge_voxel))?,
+            planes: VoxelHashMap::new(self.search_cell, f64::from(plane_voxel))?,
+        })
+    }
+
+    /// `target` unless it holds fewer points than a registration needs.
+    fn enough(&self, target: LoamTarget) -> Result<LoamTarget, RegistrationError> {
+        let points = target.edges.len() + target.planes.len();
         if points < self.min_correspondences {
             return Err(RegistrationError::TooFewPoints {
                 what: "target",
@@ -413,7 +315,17 @@ impl LoamConfig {
                 required: self.min_correspondences,
             });
         }
-        Ok(LoamTarget { edges, planes })
+        Ok(target)
+    }
+}
+
+/// Adds the map points of `features`, moved by `pose`, to `target` under `owner`.
+fn add_features(target: &mut LoamTarget, owner: u32, features: &LoamFeatures, pose: &Pose3) {
+    for p in &features.edge_map {
+        target.edges.insert(owner, &(pose * p));
+    }
+    for p in &features.plane_map {
+        target.planes.insert(owner, &(pose * p));
     }
 }
 
@@ -433,9 +345,13 @@ impl Registrator for LoamRegistrator {
         Ok(features)
     }
 
+    /// A single scan's target keeps every reliable feature point: thinning one scan biases
+    /// every frame of an odometry the same way, through per-laser range offsets.
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
-        self.config
-            .target(LoamFeatures::extract(cloud, &self.config.features)?)
+        let features = LoamFeatures::extract(cloud, &self.config.features)?;
+        let mut target = self.config.empty_target(0.0, 0.0)?;
+        add_features(&mut target, 0, &features, &Pose3::identity());
+        self.config.enough(target)
     }
 
     fn align(
@@ -452,8 +368,7 @@ impl Registrator for LoamRegistrator {
         let mut matcher = Matcher {
             config,
             target,
-            k: std::num::NonZero::new(config.neighbours).unwrap_or(std::num::NonZero::<usize>::MIN),
-            max_d2: config.max_neighbour_distance.powi(2),
+            found: Vec::with_capacity(config.neighbours + 1),
             patch: Vec::with_capacity(config.neighbours),
         };
         let mut pose = *initial;
@@ -533,23 +448,17 @@ fn motion(a: &Pose3, b: &Pose3) -> f64 {
 }
 
 impl MapRegistrator for LoamRegistrator {
+    /// Parts added in order: where two parts share a voxel, the later one's point stays.
     fn target_from_sources(
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
-        let mut merged = LoamFeatures::default();
-        for (features, pose) in parts {
-            merged
-                .edge_map
-                .extend(features.edge_map.iter().map(|p| pose * p));
-            merged
-                .plane_map
-                .extend(features.plane_map.iter().map(|p| pose * p));
-        }
         let c = &self.config;
-        merged.edge_map = voxel_thin(merged.edge_map, c.local_map_edge_voxel);
-        merged.plane_map = voxel_thin(merged.plane_map, c.local_map_plane_voxel);
-        self.config.target(merged)
+        let mut target = c.empty_target(c.local_map_edge_voxel, c.local_map_plane_voxel)?;
+        for (owner, (features, pose)) in (0u32..).zip(parts) {
+            add_features(&mut target, owner, features, pose);
+        }
+        c.enough(target)
     }
 
     /// Thins the map points to the local-map voxels in the sensor frame (the picks to align stay
@@ -560,5 +469,21 @@ impl MapRegistrator for LoamRegistrator {
         source.edge_map = voxel_thin(source.edge_map, c.local_map_edge_voxel);
         source.plane_map = voxel_thin(source.plane_map, c.local_map_plane_voxel);
         source
+    }
+
+    /// A local map with the local-map voxels, updated in place as keyframes enter and leave.
+    fn empty_map(&self) -> Option<Self::Target> {
+        let c = &self.config;
+        c.empty_target(c.local_map_edge_voxel, c.local_map_plane_voxel)
+            .ok()
+    }
+
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
+        add_features(map, key, source, pose);
+    }
+
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
+        map.edges.remove_owner(key);
+        map.planes.remove_owner(key);
     }
 }

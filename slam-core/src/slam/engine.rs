@@ -1,5 +1,6 @@
 //! `GraphSlam`: keyframes, LiDAR odometry against a local map, loop closure and map assembly.
 
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use nalgebra::{Matrix6, Vector6};
@@ -40,6 +41,14 @@ struct Keyframe<S, C> {
     cloud: PointCloud,
 }
 
+/// The target the odometry registers against: the last keyframes placed at their poses.
+struct LocalMap<T> {
+    target: T,
+    /// The keyframes in it, oldest first, when the backend updates it in place
+    /// ([`MapRegistrator::empty_map`]); `None` when it is rebuilt whole after every keyframe.
+    members: Option<VecDeque<u32>>,
+}
+
 /// Graph-SLAM over any [`MapRegistrator`] (odometry and loop refinement), a second one for coarse
 /// loop checks (the thesis uses point-to-point ICP), and any [`Optimizer`].
 ///
@@ -56,7 +65,7 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     optimizer: O,
     graph: PoseGraph<Pose3>,
     keyframes: Vec<Keyframe<R::Source, C::Source>>,
-    local_map: Option<R::Target>,
+    local_map: Option<LocalMap<R::Target>>,
     node_index: NodeIndex,
     pending_loops: Vec<(usize, usize)>,
     last_loop_attempt: Option<usize>,
@@ -263,17 +272,66 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
     }
 
+    /// Builds the local map if there is none (at the start, and after a loop closure moved the
+    /// keyframes): in place when the backend supports it, else whole.
     fn ensure_local_map(&mut self) -> bool {
         if self.local_map.is_some() {
             return true;
         }
         let n = self.keyframes.len();
         let first = n.saturating_sub(self.config.local_map_keyframes);
-        let parts: Vec<(&R::Source, Pose3)> = (first..n)
-            .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
-            .collect();
-        self.local_map = self.odometry.target_from_sources(&parts).ok();
+        let keys: Option<VecDeque<u32>> = (first..n).map(|i| u32::try_from(i).ok()).collect();
+        if let (Some(mut target), Some(keys)) = (self.odometry.empty_map(), keys) {
+            for (&key, i) in keys.iter().zip(first..n) {
+                let pose = self.keyframe_pose(i);
+                self.odometry
+                    .add_to_map(&mut target, key, &self.keyframes[i].source, &pose);
+            }
+            self.local_map = Some(LocalMap {
+                target,
+                members: Some(keys),
+            });
+        } else {
+            let parts: Vec<(&R::Source, Pose3)> = (first..n)
+                .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
+                .collect();
+            self.local_map = self
+                .odometry
+                .target_from_sources(&parts)
+                .ok()
+                .map(|target| LocalMap {
+                    target,
+                    members: None,
+                });
+        }
         self.local_map.is_some()
+    }
+
+    /// Adds keyframe `index` (the newest) to an in-place local map and drops the keyframes that
+    /// left the window; a map built whole is dropped, to be rebuilt when next needed.
+    fn slide_local_map(&mut self, index: usize) {
+        let window = self.config.local_map_keyframes;
+        let key = u32::try_from(index).ok();
+        let pose = self.keyframe_pose(index);
+        match (&mut self.local_map, key) {
+            (
+                Some(LocalMap {
+                    target,
+                    members: Some(members),
+                }),
+                Some(key),
+            ) => {
+                self.odometry
+                    .add_to_map(target, key, &self.keyframes[index].source, &pose);
+                members.push_back(key);
+                while members.len() > window {
+                    if let Some(old) = members.pop_front() {
+                        self.odometry.remove_from_map(target, old);
+                    }
+                }
+            }
+            _ => self.local_map = None,
+        }
     }
 
     fn add_keyframe(
@@ -307,8 +365,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let mut registered = false;
         let mut reg_info = None;
         if index > 0 && self.ensure_local_map() {
-            if let Some(target) = &self.local_map
-                && let Ok(a) = self.odometry.align(&source, target, &predicted)
+            if let Some(map) = &self.local_map
+                && let Ok(a) = self.odometry.align(&source, &map.target, &predicted)
             {
                 let shift = (a.pose.translation.vector - predicted.translation.vector).norm();
                 if a.converged
@@ -349,7 +407,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             cloud: map_cloud,
         });
         self.report.keyframes += 1;
-        self.local_map = None;
+        self.slide_local_map(index);
         self.last_stamp = scan.stamp;
         self.scan_poses.push((scan.stamp, index, Pose3::identity()));
 

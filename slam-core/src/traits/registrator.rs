@@ -117,4 +117,24 @@ pub trait MapRegistrator: Registrator {
     fn keyframe_source(&self, source: Self::Source) -> Self::Source {
         source
     }
+
+    /// An empty map that parts can be added to ([`MapRegistrator::add_to_map`]) and removed from
+    /// ([`MapRegistrator::remove_from_map`]) one at a time, so that a sliding window of keyframes
+    /// is updated in place; or `None`, the default, when this backend builds maps only whole with
+    /// [`MapRegistrator::target_from_sources`] (then a caller rebuilds the map instead).
+    fn empty_map(&self) -> Option<Self::Target> {
+        None
+    }
+
+    /// Adds `source` placed at `pose` (`world_T_source`) to `map`, a map from
+    /// [`MapRegistrator::empty_map`], under `key`. The default, for backends without
+    /// `empty_map`, does nothing.
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
+        let _ = (map, key, source, pose);
+    }
+
+    /// Removes from `map` what was added under `key`. The default does nothing.
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
+        let _ = (map, key);
+    }
 }

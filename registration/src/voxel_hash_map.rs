@@ -1,0 +1,387 @@
+//! `VoxelHashMap`: points hashed into cubic cells for exact k-nearest queries, grown and shrunk
+//! one owner (a keyframe) at a time. The spatial index of LOAM's local map: a sliding window of
+//! keyframes is updated in place instead of rebuilding a k-d tree per keyframe, and a query near
+//! the map reads one or a few small cells instead of descending a tree.
+
+use nalgebra::Point3;
+use rustc_hash::FxHashMap;
+use slam_core::RegistrationError;
+
+/// One stored point: f32 coordinates (half the memory traffic of f64; a local map spans far less
+/// than the kilometres where f32 would lose millimetres), the owner that added it and its
+/// thinning voxel, named by the low 10 bits of each voxel coordinate (unique within a cell,
+/// which spans far fewer than 1024 voxels).
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    p: [f32; 3],
+    owner: u32,
+    voxel: u32,
+}
+
+/// Points in cubic cells of a hash map, for exact k-nearest-neighbour queries within a radius.
+///
+/// Points may be thinned on insertion to one per `thin` voxel, and removed by owner. A voxel
+/// keeps the point of the oldest owner that saw it, so that a sliding window of scans stays
+/// anchored to its oldest scan instead of chaining each scan to the previous one; when that
+/// owner is removed, the newest other owner that saw the voxel takes over, so the voxels held
+/// are always those some remaining owner saw. A query searches the query's cell and
+/// then rings of cells around it, skipping every cell farther than the current k-th neighbour, and
+/// stops as soon as no unsearched cell can hold a nearer point: the answer equals a brute-force
+/// search's (ties aside).
+///
+/// ```
+/// use nalgebra::Point3;
+/// use registration::VoxelHashMap;
+///
+/// let mut map = VoxelHashMap::new(0.25, 0.0)?;
+/// for i in 0..10 {
+///     map.insert(7, &Point3::new(f64::from(i) * 0.1, 0.0, 0.0));
+/// }
+/// let mut near = Vec::new();
+/// map.nearest_k(&Point3::new(0.42, 0.0, 0.0), 2, 1.0, &mut near);
+/// assert_eq!(near.len(), 2);
+/// assert!((near[0].1.x - 0.4).abs() < 1e-6 && (near[1].1.x - 0.5).abs() < 1e-6);
+/// assert_eq!(map.remove_owner(7), 10);
+/// assert!(map.is_empty());
+/// # Ok::<(), slam_core::RegistrationError>(())
+/// ```
+#[derive(Clone)]
+pub struct VoxelHashMap {
+    cell: f64,
+    inv_cell: f64,
+    thin: f64,
+    cells: FxHashMap<u64, Vec<Entry>>,
+    /// Per cell, for voxels held by an older owner: the newest other owner's point.
+    standins: FxHashMap<u64, Vec<Entry>>,
+    /// The cells each owner has put points in (possibly since overwritten by a newer owner).
+    owners: FxHashMap<u32, Vec<u64>>,
+    len: usize,
+}
+
+impl std::fmt::Debug for VoxelHashMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VoxelHashMap")
+            .field("cell", &self.cell)
+            .field("thin", &self.thin)
+            .field("cells", &self.cells.len())
+            .field("owners", &self.owners.len())
+            .field("len", &self.len)
+            .finish_non_exhaustive()
+    }
+}
+
+/// 21 bits per axis: cell indices wrap beyond ±10^6 cells (±250 km at 25 cm). A wrapped key only
+/// shares a cell with far points, which the distance test then rejects.
+#[allow(clippy::cast_sign_loss)]
+fn pack(c: [i32; 3]) -> u64 {
+    let axis = |v: i32| u64::from(v as u32 & 0x1F_FFFF);
+    axis(c[0]) | (axis(c[1]) << 21) | (axis(c[2]) << 42)
+}
+
+/// Integer cell of `v` at `inv` cells per metre; saturating, so absurd coordinates stay finite.
+#[allow(clippy::cast_possible_truncation)]
+fn cell_of(v: f64, inv: f64) -> i32 {
+    // Truncate, then step down for negatives: `f64::floor` is a library call on baseline x86-64.
+    let x = v * inv;
+    let t = x as i32;
+    if f64::from(t) > x { t - 1 } else { t }
+}
+
+/// The `k` best (smallest squared distance) candidates seen so far, sorted ascending.
+struct Best<'a> {
+    k: usize,
+    items: &'a mut Vec<(f32, [f32; 3])>,
+}
+
+impl Best<'_> {
+    fn full(&self) -> bool {
+        self.items.len() == self.k
+    }
+
+    /// The squared distance a candidate must beat.
+    fn bound(&self, max_d2: f32) -> f32 {
+        if self.full() {
+            self.items.last().map_or(max_d2, |l| l.0.min(max_d2))
+        } else {
+            max_d2
+        }
+    }
+
+    fn offer(&mut self, d2: f32, p: [f32; 3]) {
+        if self.full() {
+            self.items.pop();
+        }
+        let at = self.items.partition_point(|e| e.0 <= d2);
+        self.items.insert(at, (d2, p));
+    }
+}
+
+impl VoxelHashMap {
+    /// An empty map with search cells of `cell` metres, thinning to one point per `thin` metres
+    /// (0 keeps every point). With thinning on, the cell is rounded to a whole number of thinning
+    /// voxels so each voxel lies in one cell. A cell of two to five times the typical distance to
+    /// the k-th neighbour is fastest.
+    ///
+    /// # Errors
+    /// [`RegistrationError::InvalidConfig`] when `cell` is not positive and finite or `thin` is
+    /// negative or not finite.
+    pub fn new(cell: f64, thin: f64) -> Result<Self, RegistrationError> {
+        if !(cell.is_finite() && cell > 0.0 && thin.is_finite() && thin >= 0.0) {
+            return Err(RegistrationError::InvalidConfig(format!(
+                "voxel hash map: cell {cell} must be positive and thin {thin} non-negative"
+            )));
+        }
+        let cell = if thin > 0.0 {
+            thin * (cell / thin).round().max(1.0)
+        } else {
+            cell
+        };
+        Ok(Self {
+            cell,
+            inv_cell: 1.0 / cell,
+            thin,
+            cells: FxHashMap::default(),
+            standins: FxHashMap::default(),
+            owners: FxHashMap::default(),
+            len: 0,
+        })
+    }
+
+    /// Side of a search cell (metres), after rounding to the thinning voxel.
+    #[must_use]
+    pub fn cell_size(&self) -> f64 {
+        self.cell
+    }
+
+    /// Points stored.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether no point is stored.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Every stored point, in no particular order.
+    pub fn points(&self) -> impl Iterator<Item = Point3<f64>> + '_ {
+        self.cells.values().flatten().map(|e| widen(e.p))
+    }
+
+    /// Adds `p` for `owner`. With thinning, a voxel keeps the point of the oldest owner that
+    /// saw it (the first point within one owner) and remembers the newest other owner's point
+    /// as a stand-in for when the oldest is removed. Non-finite points are skipped; returns
+    /// whether `p` was kept (searchable or as a stand-in).
+    pub fn insert(&mut self, owner: u32, p: &Point3<f64>) -> bool {
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return false;
+        }
+        #[allow(clippy::cast_possible_truncation)]
+        let q = [p.x as f32, p.y as f32, p.z as f32];
+        let key = self.cell_key(q);
+        let voxel = if self.thin > 0.0 {
+            voxel_id(q, 1.0 / self.thin)
+        } else {
+            0
+        };
+        let entry = Entry { p: q, owner, voxel };
+        let entries = self.cells.entry(key).or_default();
+        if self.thin > 0.0
+            && let Some(held) = entries.iter().find(|e| e.voxel == voxel)
+        {
+            if held.owner == owner {
+                return false;
+            }
+            let standins = self.standins.entry(key).or_default();
+            match standins.iter_mut().find(|e| e.voxel == voxel) {
+                Some(e) => *e = entry,
+                None => standins.push(entry),
+            }
+            self.touch(owner, key);
+            return true;
+        }
+        entries.push(entry);
+        self.len += 1;
+        self.touch(owner, key);
+        true
+    }
+
+    fn touch(&mut self, owner: u32, key: u64) {
+        let touched = self.owners.entry(owner).or_default();
+        if touched.last() != Some(&key) {
+            touched.push(key);
+        }
+    }
+
+    /// The key of the cell holding `p`.
+    fn cell_key(&self, p: [f32; 3]) -> u64 {
+        let w = widen(p);
+        pack([
+            cell_of(w.x, self.inv_cell),
+            cell_of(w.y, self.inv_cell),
+            cell_of(w.z, self.inv_cell),
+        ])
+    }
+
+    /// Removes every point `owner` added; a voxel it held passes to its stand-in, the newest
+    /// other owner that saw it. Returns how many searchable points were removed, net of
+    /// stand-ins that took their place.
+    pub fn remove_owner(&mut self, owner: u32) -> usize {
+        let Some(mut keys) = self.owners.remove(&owner) else {
+            return 0;
+        };
+        keys.sort_unstable();
+        keys.dedup();
+        let before = self.len;
+        for key in keys {
+            let mut removed = 0;
+            let mut standins = self.standins.remove(&key).unwrap_or_default();
+            standins.retain(|e| e.owner != owner);
+            let Some(mut entries) = self.cells.remove(&key) else {
+                continue;
+            };
+            entries.retain_mut(|e| {
+                if e.owner != owner {
+                    return true;
+                }
+                if let Some(i) = standins.iter().position(|s| s.voxel == e.voxel) {
+                    *e = standins.swap_remove(i);
+                    return true;
+                }
+                removed += 1;
+                false
+            });
+            self.len -= removed;
+            if !entries.is_empty() {
+                self.cells.insert(key, entries);
+            }
+            if !standins.is_empty() {
+                self.standins.insert(key, standins);
+            }
+        }
+        before - self.len
+    }
+
+    /// The `k` points nearest `q` within `max_distance`, nearest first, as (squared distance,
+    /// point) in `out` (cleared first; fewer than `k` when fewer lie within reach).
+    #[allow(clippy::cast_possible_truncation)]
+    pub fn nearest_k(
+        &self,
+        q: &Point3<f64>,
+        k: usize,
+        max_distance: f64,
+        out: &mut Vec<(f64, Point3<f64>)>,
+    ) {
+        out.clear();
+        if k == 0 || self.len == 0 || max_distance.is_nan() || max_distance <= 0.0 {
+            return;
+        }
+        let mut items = Vec::with_capacity(k + 1);
+        self.search(q, k, max_distance, &mut items);
+        out.extend(items.iter().map(|&(d2, p)| (f64::from(d2), widen(p))));
+    }
+
+    /// The point nearest `q` within `max_distance`, with its squared distance.
+    #[must_use]
+    pub fn nearest(&self, q: &Point3<f64>, max_distance: f64) -> Option<(f64, Point3<f64>)> {
+        let mut out = Vec::with_capacity(1);
+        self.nearest_k(q, 1, max_distance, &mut out);
+        out.first().copied()
+    }
+
+    /// The search behind [`VoxelHashMap::nearest_k`], into a caller's buffer.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
+    pub(crate) fn search(
+        &self,
+        q: &Point3<f64>,
+        k: usize,
+        max_distance: f64,
+        items: &mut Vec<(f32, [f32; 3])>,
+    ) {
+        items.clear();
+        if k == 0
+            || self.len == 0
+            || max_distance.is_nan()
+            || max_distance <= 0.0
+            || !q.coords.iter().all(|v| v.is_finite())
+        {
+            return;
+        }
+        let qf = [q.x as f32, q.y as f32, q.z as f32];
+        let w = widen(qf);
+        let base = [
+            cell_of(w.x, self.inv_cell),
+            cell_of(w.y, self.inv_cell),
+            cell_of(w.z, self.inv_cell),
+        ];
+        // The query's offset inside its cell, in metres from the low and the high face.
+        let lo: [f64; 3] = std::array::from_fn(|a| w[a] - f64::from(base[a]) * self.cell);
+        let hi: [f64; 3] = std::array::from_fn(|a| self.cell - lo[a]);
+        let max_d2 = (max_distance * max_distance) as f32;
+        let mut best = Best { k, items };
+        let scan = |best: &mut Best<'_>, key: u64| {
+            if let Some(entries) = self.cells.get(&key) {
+                for e in entries {
+                    let d = [e.p[0] - qf[0], e.p[1] - qf[1], e.p[2] - qf[2]];
+                    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    // Full: only a strictly nearer point enters. Not full: any within reach.
+                    let enters = if best.full() {
+                        d2 < best.bound(max_d2)
+                    } else {
+                        d2 <= max_d2
+                    };
+                    if enters {
+                        best.offer(d2, e.p);
+                    }
+                }
+            }
+        };
+        scan(&mut best, pack(base));
+        // Squared distance from the query to the cell at offset `o` along one axis.
+        let gap = |a: usize, o: i32| -> f64 {
+            match o {
+                0 => 0.0,
+                o if o > 0 => f64::from(o - 1) * self.cell + hi[a],
+                o => f64::from(-o - 1) * self.cell + lo[a],
+            }
+        };
+        let nearest_face = lo.iter().chain(&hi).fold(f64::INFINITY, |m, &v| m.min(v));
+        let reach = (max_distance * self.inv_cell).ceil() as i32 + 1;
+        for ring in 1..=reach {
+            // Every cell outside the rings searched so far is at least this far.
+            let outside = f64::from(ring - 1) * self.cell + nearest_face;
+            if outside * outside > f64::from(best.bound(max_d2)) {
+                break;
+            }
+            for dz in -ring..=ring {
+                for dy in -ring..=ring {
+                    let on_shell = dz.abs() == ring || dy.abs() == ring;
+                    // Inside the shell only the two cells at dx = ±ring are new.
+                    let step = if on_shell { 1 } else { (2 * ring) as usize };
+                    for dx in (-ring..=ring).step_by(step) {
+                        let (gx, gy, gz) = (gap(0, dx), gap(1, dy), gap(2, dz));
+                        let d2 = gx * gx + gy * gy + gz * gz;
+                        if d2 as f32 > best.bound(max_d2) {
+                            continue;
+                        }
+                        scan(&mut best, pack([base[0] + dx, base[1] + dy, base[2] + dz]));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The thinning voxel of `p` at `inv` voxels per metre, as [`Entry::voxel`].
+#[allow(clippy::cast_sign_loss)]
+fn voxel_id(p: [f32; 3], inv: f64) -> u32 {
+    let w = widen(p);
+    let axis = |v: f64| cell_of(v, inv) as u32 & 0x3FF;
+    (axis(w.x) << 20) | (axis(w.y) << 10) | axis(w.z)
+}
+
+fn widen(p: [f32; 3]) -> Point3<f64> {
+    Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}

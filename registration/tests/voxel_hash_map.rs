@@ -1,0 +1,182 @@
+//! `VoxelHashMap` against a brute-force search: the same k nearest points (by distance) for
+//! random clouds of several shapes, cell sizes and radii, before and after removing owners.
+
+use nalgebra::{Point3, Vector3};
+use proptest::prelude::*;
+use registration::VoxelHashMap;
+
+/// Squared distances of the `k` nearest points within `r`, by brute force, in f32 as the map
+/// computes them.
+fn brute(points: &[Point3<f64>], q: &Point3<f64>, k: usize, r: f64) -> Vec<f32> {
+    let f = |v: f64| v as f32;
+    let mut d: Vec<f32> = points
+        .iter()
+        .map(|p| {
+            let (x, y, z) = (f(p.x) - f(q.x), f(p.y) - f(q.y), f(p.z) - f(q.z));
+            x * x + y * y + z * z
+        })
+        .filter(|&d2| d2 <= (r * r) as f32)
+        .collect();
+    d.sort_by(f32::total_cmp);
+    d.truncate(k);
+    d
+}
+
+/// Points of one of three shapes from unit samples: a 4 m cube; two walls and a floor, as a
+/// corridor; a small cluster far from the origin at negative coordinates.
+fn shaped(shape: usize, (a, b, c): (f64, f64, f64)) -> Point3<f64> {
+    match shape {
+        0 => Point3::new(4.0 * a, 4.0 * b, 4.0 * c),
+        1 => match (c * 3.0) as usize {
+            0 => Point3::new(10.0 * a, 0.0, 3.0 * b),
+            1 => Point3::new(10.0 * a, 2.0, 3.0 * b),
+            _ => Point3::new(10.0 * a, 2.0 * b, 0.0),
+        },
+        _ => Point3::new(-5000.0 + 0.5 * a, 3000.0 + 0.5 * b, -20.0 + 0.1 * c),
+    }
+}
+
+fn unit3() -> impl Strategy<Value = (f64, f64, f64)> {
+    (0.0..1.0f64, 0.0..1.0f64, 0.0..1.0f64)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Every query (near the points and away from them, several k and radii) returns the
+    /// brute-force answer, before and after one owner's points are removed.
+    #[test]
+    fn nearest_k_equals_brute_force(
+        shape in 0..3usize,
+        cell in prop::sample::select(vec![0.05, 0.25, 1.0]),
+        samples in prop::collection::vec(unit3(), 1..1500),
+        queries in prop::collection::vec(unit3(), 40),
+    ) {
+        let points: Vec<Point3<f64>> = samples.iter().map(|&u| shaped(shape, u)).collect();
+        let mut map = VoxelHashMap::new(cell, 0.0).unwrap();
+        for (i, p) in points.iter().enumerate() {
+            prop_assert!(map.insert((i % 4) as u32, p));
+        }
+        prop_assert_eq!(map.len(), points.len());
+        let lo = points[0];
+        let mut remaining = points.clone();
+        let mut out = Vec::new();
+        for round in 0..2 {
+            for &(a, b, c) in &queries {
+                let q = lo + Vector3::new(a, b, c) * 5.0 - Vector3::new(0.5, 0.5, 0.5);
+                for (k, r) in [(1, 0.3), (5, 1.0), (8, 0.5), (20, 2.5)] {
+                    map.nearest_k(&q, k, r, &mut out);
+                    let got: Vec<f32> = out.iter().map(|(d2, _)| *d2 as f32).collect();
+                    prop_assert_eq!(got, brute(&remaining, &q, k, r), "k {} r {} round {}", k, r, round);
+                    for (d2, p) in &out {
+                        prop_assert!(((p - q).norm_squared() - d2).abs() < 1e-3 * (1.0 + d2));
+                    }
+                }
+            }
+            let removed = map.remove_owner(1);
+            let before = remaining.len();
+            remaining = points.iter().enumerate().filter(|(i, _)| i % 4 != 1).map(|(_, p)| *p).collect();
+            if round == 0 {
+                prop_assert_eq!(removed, before - remaining.len());
+            }
+            prop_assert_eq!(map.len(), remaining.len());
+        }
+    }
+}
+
+#[test]
+fn thinning_keeps_the_oldest_point_and_hands_over_to_the_newest() {
+    let mut map = VoxelHashMap::new(0.25, 0.1).unwrap();
+    assert!(
+        (map.cell_size() - 0.3).abs() < 1e-12,
+        "cell rounds to whole voxels"
+    );
+    let a = Point3::new(0.01, 0.01, 0.01);
+    map.insert(1, &a);
+    assert!(
+        !map.insert(1, &Point3::new(0.02, 0.01, 0.01)),
+        "one point per voxel and owner"
+    );
+    map.insert(2, &Point3::new(0.05, 0.05, 0.05));
+    map.insert(3, &Point3::new(0.07, 0.05, 0.05));
+    map.insert(2, &Point3::new(0.15, 0.05, 0.05));
+    assert_eq!(map.len(), 2);
+    let (_, p) = map.nearest(&Point3::origin(), 1.0).unwrap();
+    assert!(
+        (p - a).norm() < 1e-6,
+        "the oldest owner holds the voxel: {p}"
+    );
+    // Owner 1 leaves: the newest other owner (3) takes its voxel over.
+    assert_eq!(map.remove_owner(1), 0, "the voxel stays held");
+    let (_, p) = map.nearest(&Point3::origin(), 1.0).unwrap();
+    assert!((p.x - 0.07).abs() < 1e-6, "owner 3 took over: {p}");
+    assert_eq!(map.remove_owner(2), 1);
+    assert_eq!(map.remove_owner(3), 1);
+    assert!(map.is_empty());
+    assert!(map.nearest(&Point3::origin(), 1.0).is_none());
+}
+
+/// A sliding window built in place holds the same voxels as the window built whole.
+#[test]
+fn sliding_window_holds_the_voxels_of_its_owners() {
+    // Scattered points (a golden-ratio sequence per axis), each scan 0.3 m further along x.
+    let frac = |v: f64| v - v.floor();
+    let scans: Vec<Vec<Point3<f64>>> = (0..12)
+        .map(|i| {
+            (0..400)
+                .map(|j| {
+                    let t = f64::from(j + 400 * i);
+                    Point3::new(
+                        0.3 * f64::from(i) + 2.0 * frac(t * 0.618_034),
+                        2.0 * frac(t * 0.754_878),
+                        0.5 * frac(t * 0.569_840),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let window = 4;
+    let mut map = VoxelHashMap::new(0.3, 0.1).unwrap();
+    let voxels = |points: &mut dyn Iterator<Item = Point3<f64>>| {
+        let mut v: Vec<[i64; 3]> = points
+            .map(|p| {
+                let f = |x: f64| (f64::from(x as f32) / 0.1).floor() as i64;
+                [f(p.x), f(p.y), f(p.z)]
+            })
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    for (i, scan) in scans.iter().enumerate() {
+        for p in scan {
+            map.insert(i as u32, p);
+        }
+        if i >= window {
+            map.remove_owner((i - window) as u32);
+        }
+        let first = i.saturating_sub(window - 1);
+        let expected = voxels(&mut scans[first..=i].iter().flatten().copied());
+        assert_eq!(voxels(&mut map.points()), expected, "window ending at {i}");
+        assert_eq!(map.len(), expected.len());
+    }
+}
+
+#[test]
+fn bad_input_is_refused_or_skipped() {
+    assert!(VoxelHashMap::new(0.0, 0.0).is_err());
+    assert!(VoxelHashMap::new(f64::NAN, 0.0).is_err());
+    assert!(VoxelHashMap::new(0.25, -1.0).is_err());
+    let mut map = VoxelHashMap::new(0.25, 0.0).unwrap();
+    assert!(!map.insert(0, &Point3::new(f64::NAN, 0.0, 0.0)));
+    assert!(!map.insert(0, &Point3::new(0.0, f64::INFINITY, 0.0)));
+    assert!(map.is_empty());
+    map.insert(0, &Point3::new(0.0, 0.0, 0.0));
+    let mut out = Vec::new();
+    map.nearest_k(&Point3::new(f64::NAN, 0.0, 0.0), 3, 1.0, &mut out);
+    assert!(out.is_empty());
+    map.nearest_k(&Point3::origin(), 0, 1.0, &mut out);
+    assert!(out.is_empty());
+    map.nearest_k(&Point3::origin(), 3, -1.0, &mut out);
+    assert!(out.is_empty());
+}
