@@ -16,19 +16,30 @@ pub(crate) struct ClosedSet {
 impl ClosedSet {
     /// An empty set for grids the size of `grid`.
     pub(crate) fn new(grid: &BitGrid) -> Self {
-        let mut bits = grid.clone();
-        for y in 0..bits.height() {
-            bits.row_words_mut(y).fill(0);
-        }
-        bits.restore_padding();
-        Self {
-            bits,
+        let mut set = Self {
+            bits: grid.clone(),
             set: Vec::new(),
-        }
+        };
+        set.clear_all();
+        set
     }
 
-    /// Empty the set (in time proportional to the cells it holds).
+    /// Clear every word (keeping the padding bits past the east edge set).
+    fn clear_all(&mut self) {
+        for y in 0..self.bits.height() {
+            self.bits.row_words_mut(y).fill(0);
+        }
+        self.bits.restore_padding();
+    }
+
+    /// Empty the set: cell by cell when it holds few cells, else every word at once (a cell costs a
+    /// read-modify-write of its word, a word of a plain fill far less).
     pub(crate) fn reset(&mut self) {
+        if self.set.len() * 8 >= self.bits.words().len() {
+            self.set.clear();
+            self.clear_all();
+            return;
+        }
         for c in self.set.drain(..) {
             self.bits.row_words_mut(c.y)[(c.x / 64) as usize] &= !(1u64 << (c.x % 64));
         }
