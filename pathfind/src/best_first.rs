@@ -8,7 +8,7 @@ use crate::components::Components;
 use crate::cost::{Cost, STEP};
 use crate::movement::{DIRECTIONS, legal_steps};
 use crate::open_list::BucketRing;
-use crate::search_space::{NO_DIRECTION, SearchSpace};
+use crate::search_space::SearchSpace;
 
 /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
 /// `g + heuristic(cell)`.
@@ -25,10 +25,9 @@ pub(crate) fn best_first(
     if !components.connected(start, goal) {
         return Err(PlanError::NoPath);
     }
-    space.reset();
     closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0, || heuristic(start), s, NO_DIRECTION);
+    space.start(s, heuristic(start));
     let mut expanded = 0;
     while let Some((i, g, _)) = space.pop() {
         expanded += 1;

@@ -108,9 +108,8 @@ pub(crate) fn jump_search(
     if !components.connected(start, goal) {
         return Err(PlanError::NoPath);
     }
-    space.reset();
     let (s, t) = (space.index(start), space.index(goal));
-    space.relax(s, 0, || octile(start, goal), s, NO_DIRECTION);
+    space.start(s, octile(start, goal));
     let mut expanded = 0;
     while let Some((i, g, arrive)) = space.pop() {
         expanded += 1;

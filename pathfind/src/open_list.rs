@@ -68,6 +68,16 @@ impl OpenList for KeyHeap {
 
 /// Bucket of priority `f`: 64 buckets per cell (`f >> BUCKET_SHIFT`).
 const BUCKET_SHIFT: u32 = FRACTION_BITS - 6;
+/// The bits of `f` below its bucket.
+const IN_BUCKET: Cost = (1 << BUCKET_SHIFT) - 1;
+
+/// An entry of a ring bucket: the order within the bucket in one word (the bits of `f` below the
+/// bucket, then the tie-break), so the sorting compares a single `u64`.
+#[derive(Clone, Copy, Debug)]
+struct Queued {
+    key: u64,
+    index: u32,
+}
 /// Words of the ring's occupancy bits.
 const RING_WORDS: usize = 4;
 /// Buckets in the ring.
@@ -76,19 +86,22 @@ const RING: usize = RING_WORDS * 64;
 /// A monotone bucket queue (Dial 1969, with buckets 1/64 of a cell wide kept in a ring).
 ///
 /// Precondition: every pushed priority `f` lies in `[f_min, f_min + 3)`, where `f_min` is the
-/// priority last popped. A* with a consistent heuristic meets it on this grid: a successor's `f`
+/// priority last popped, or the first one pushed after a clear (the start, whose `f` is the
+/// smallest of the search). A* with a consistent heuristic meets it on this grid: a successor's `f`
 /// exceeds its parent's by at most twice the step cost, 2 sqrt(2) < 3, so the window spans at
 /// most 193 of the 256 buckets. Within a bucket the entries are sorted by key when the bucket
 /// becomes the current one (and inserted in order after that), so pops come out in exact key
 /// order: the buckets only spare the heap's logarithmic sifting.
 pub(crate) struct BucketRing {
-    buckets: [Vec<Open>; RING],
+    buckets: [Vec<Queued>; RING],
     /// Bit `s % 64` of word `s / 64` set when ring slot `s` holds entries.
     occupied: [u64; RING_WORDS],
     /// Absolute number of the current bucket (`floor(f * 64)` of the smallest entries).
     base: u64,
     /// Whether the current bucket is sorted (descending, so that its minimum pops off the end).
     sorted: bool,
+    /// Whether nothing was pushed since the last clear (the next push sets `base`).
+    fresh: bool,
 }
 
 impl Default for BucketRing {
@@ -98,6 +111,7 @@ impl Default for BucketRing {
             occupied: [0; RING_WORDS],
             base: 0,
             sorted: false,
+            fresh: true,
         }
     }
 }
@@ -144,30 +158,34 @@ impl OpenList for BucketRing {
             }
         }
         self.sorted = false;
+        self.fresh = true;
     }
 
     // Hot path: LLVM outlines it with plain `#[inline]` (measured; a call per neighbour).
     #[allow(clippy::inline_always)]
     #[inline(always)]
     fn push(&mut self, open: Open) {
-        let mut bucket = open.f >> BUCKET_SHIFT;
-        if self.is_empty() {
+        let bucket = open.f >> BUCKET_SHIFT;
+        if self.fresh {
+            self.fresh = false;
             self.base = bucket;
-            self.sorted = false;
         }
-        // A priority below the current bucket (the first push into an empty ring set it, and a
-        // smaller one followed) joins the current bucket, sorted in with the rest.
-        bucket = bucket.max(self.base);
-        debug_assert!(bucket - self.base < RING as u64, "priority beyond the ring");
+        debug_assert!(
+            bucket >= self.base && bucket - self.base < RING as u64,
+            "priority outside the ring's window"
+        );
         let s = Self::slot(bucket);
         let list = &mut self.buckets[s];
+        let entry = Queued {
+            key: (open.f & IN_BUCKET) << 32 | u64::from(open.tie),
+            index: open.index,
+        };
         if self.sorted && bucket == self.base {
             // Descending order: insert after every larger key.
-            let key = open.key();
-            let at = list.partition_point(|o| o.key() > key);
-            list.insert(at, open);
+            let at = list.partition_point(|q| q.key > entry.key);
+            list.insert(at, entry);
         } else {
-            list.push(open);
+            list.push(entry);
         }
         self.occupied[s / 64] |= 1 << (s % 64);
     }
@@ -188,15 +206,19 @@ impl OpenList for BucketRing {
         let list = &mut self.buckets[s];
         if !self.sorted {
             if list.len() > 1 {
-                list.sort_unstable_by_key(|o| Reverse(o.key()));
+                list.sort_unstable_by_key(|q| Reverse(q.key));
             }
             self.sorted = true;
         }
-        let open = list.pop();
+        let q = list.pop()?;
         if list.is_empty() {
             self.occupied[s / 64] &= !(1 << (s % 64));
             self.sorted = false;
         }
-        open
+        Some(Open {
+            f: self.base << BUCKET_SHIFT | q.key >> 32,
+            tie: q.key as u32,
+            index: q.index,
+        })
     }
 }

@@ -74,8 +74,24 @@ impl<Q: OpenList> SearchSpace<Q> {
         Cell::new(i % self.width, i / self.width)
     }
 
-    /// Start a new query.
-    pub(crate) fn reset(&mut self) {
+    /// Start a new query at cell `start`, whose heuristic is `h`: its `f`, the smallest of the
+    /// search, is the first on the open list.
+    pub(crate) fn start(&mut self, start: u32, h: Cost) {
+        self.reset();
+        self.nodes[start as usize] = NodeState {
+            g: 0,
+            parent: start,
+            stamp: self.generation << STAMP_SHIFT | u32::from(NO_DIRECTION),
+        };
+        self.open.push(Open {
+            f: h,
+            tie: u32::MAX,
+            index: start,
+        });
+    }
+
+    /// Forget the last query.
+    fn reset(&mut self) {
         self.open.clear();
         self.same_f.clear();
         self.current_f = 0;
