@@ -102,7 +102,10 @@ fn loam_odometry_step(c: &mut Criterion) {
     let samples: Vec<Sample> = sim.take(2 * 41 + 1).collect();
     let world_t_lidar =
         |s: &Sample| s.ground_truth.unwrap_or_else(Pose3::identity) * s.body_t_lidar;
-    let loam = LoamRegistrator::default();
+    let loam = LoamRegistrator {
+        config: LoamConfig::local_map_odometry(),
+    };
+    let all_picks = LoamRegistrator::default();
     let keyframes: Vec<_> = samples
         .iter()
         .step_by(2)
@@ -130,14 +133,32 @@ fn loam_odometry_step(c: &mut Criterion) {
     group.bench_function("local_map_40_keyframes", |b| {
         b.iter(|| loam.target_from_sources(&parts).map(|m| m.planes().len()));
     });
-    for (name, guess) in [
-        ("features_and_align", near),
-        ("features_and_align_far_guess", far),
+    group.bench_function("slide_local_map_by_one_keyframe", |b| {
+        // The engine's per-keyframe update: the newest keyframe in, the oldest out.
+        let (newest, pose) = (&keyframes[39], keyframes[39].1);
+        let Some(mut slid) = loam.empty_map() else {
+            return;
+        };
+        for (i, (f, p)) in (0u32..).zip(&keyframes[..39]) {
+            loam.add_to_map(&mut slid, i, f, p);
+        }
+        let mut next = 39u32;
+        b.iter(|| {
+            loam.add_to_map(&mut slid, next, &newest.0, &pose);
+            loam.remove_from_map(&mut slid, next - 39);
+            next += 1;
+            slid.planes().len()
+        });
+    });
+    for (name, r, guess) in [
+        ("features_and_align", &loam, near),
+        ("features_and_align_far_guess", &loam, far),
+        ("features_and_align_all_planar_picks", &all_picks, near),
     ] {
         group.bench_function(name, |b| {
             b.iter(|| {
-                loam.prepare_source(&scan.cloud)
-                    .and_then(|f| loam.align(&f, &map, &guess))
+                r.prepare_source(&scan.cloud)
+                    .and_then(|f| r.align(&f, &map, &guess))
                     .map(|a| a.rmse)
             });
         });

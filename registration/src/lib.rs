@@ -51,6 +51,7 @@ mod kernel;
 mod lidar_layout;
 mod loam;
 mod loam_features;
+mod neighbour_cache;
 mod point_to_plane;
 mod point_to_point;
 mod sym3;

@@ -11,6 +11,7 @@ use slam_core::{
 use crate::icp::min_eigenvalue_ratio;
 use crate::kernel::IcpKernel;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
+use crate::neighbour_cache::{NeighbourCache, Neighbours};
 use crate::sym3::{Eigen3, symmetric_eigen3};
 use crate::voxel_hash_map::VoxelHashMap;
 
@@ -25,6 +26,10 @@ pub struct LoamConfig {
     pub local_map_edge_voxel: f32,
     /// Voxel of a local map's planar points (thesis: 10 cm).
     pub local_map_plane_voxel: f32,
+    /// Voxel the source's edge picks are thinned to before aligning (0: keep all).
+    pub source_edge_voxel: f32,
+    /// Voxel the source's planar picks are thinned to before aligning (0: keep all).
+    pub source_plane_voxel: f32,
     /// Side of the cells the target's points are hashed into for neighbour search (0.4 m;
     /// rounded to a whole number of local-map voxels). Answers do not depend on it, only speed.
     pub search_cell: f64,
@@ -63,6 +68,8 @@ impl Default for LoamConfig {
             features: LoamFeatureConfig::default(),
             local_map_edge_voxel: 0.05,
             local_map_plane_voxel: 0.1,
+            source_edge_voxel: 0.0,
+            source_plane_voxel: 0.0,
             search_cell: 0.4,
             neighbours: 5,
             max_neighbour_distance: 1.0,
@@ -75,6 +82,22 @@ impl Default for LoamConfig {
             translation_tolerance: 5e-4,
             rotation_tolerance: 5e-5,
             min_correspondences: 20,
+        }
+    }
+}
+
+impl LoamConfig {
+    /// Settings for odometry against a local map of many keyframes (what the SLAM engine does):
+    /// the defaults, with the source's planar picks thinned to one per 0.2 m, as A-LOAM thins a
+    /// scan before matching it to its map. The dense local map keeps the accuracy (on the
+    /// simulated Spot's loops the drift stays within 0.02 percentage points of keeping every
+    /// pick) and the step takes about two thirds of the time. Scan-to-scan pairs keep every pick
+    /// (the default): against a single scan, thinning the source costs accuracy.
+    #[must_use]
+    pub fn local_map_odometry() -> Self {
+        Self {
+            source_plane_voxel: 0.2,
+            ..Self::default()
         }
     }
 }
@@ -193,43 +216,58 @@ impl Correspondence {
 struct Matcher<'a> {
     config: &'a LoamConfig,
     target: &'a LoamTarget,
-    found: Vec<(f32, [f32; 3])>,
+    /// Slots: the source's edges, then its planar points.
+    cache: NeighbourCache,
+    /// The fit of each slot's latest neighbours, reused while they stay the same.
+    fits: Vec<Option<Fit>>,
     patch: Vec<Point3<f64>>,
 }
 
-impl Matcher<'_> {
+impl<'a> Matcher<'a> {
+    fn new(config: &'a LoamConfig, target: &'a LoamTarget, source: &LoamFeatures) -> Self {
+        let slots = source.edges.len() + source.planes.len();
+        Self {
+            config,
+            target,
+            // Twice the neighbours asked for: the margin that lets later matchings reuse them.
+            cache: NeighbourCache::new(
+                slots,
+                config.neighbours,
+                2 * config.neighbours,
+                config.max_neighbour_distance,
+            ),
+            fits: vec![None; slots],
+            patch: Vec::with_capacity(config.neighbours),
+        }
+    }
+
     /// The line (`edge`) or plane through the target points of `map` nearest the moved source
     /// point `p`, when there are enough of them within reach and they fit one.
-    fn fit(&mut self, map: &VoxelHashMap, p: &Point3<f64>, edge: bool) -> Option<Fit> {
+    fn fit(&mut self, slot: usize, map: &VoxelHashMap, p: &Point3<f64>, edge: bool) -> Option<Fit> {
         let c = self.config;
-        map.search(p, c.neighbours, c.max_neighbour_distance, &mut self.found);
-        if self.found.len() < c.neighbours {
-            return None;
-        }
-        self.patch.clear();
-        self.patch.extend(
-            self.found
-                .iter()
-                .map(|(_, q)| Point3::new(f64::from(q[0]), f64::from(q[1]), f64::from(q[2]))),
-        );
-        if edge {
-            Fit::line(&self.patch, c.line_eigenvalue_ratio)
-        } else {
-            Fit::plane(&self.patch, c.plane_fit_tolerance)
-        }
+        let fit = match self.cache.nearest(slot, map, p, &mut self.patch) {
+            Neighbours::TooFew => None,
+            Neighbours::Unchanged => return self.fits[slot],
+            Neighbours::Found if edge => Fit::line(&self.patch, c.line_eigenvalue_ratio),
+            Neighbours::Found => Fit::plane(&self.patch, c.plane_fit_tolerance),
+        };
+        self.fits[slot] = fit;
+        fit
     }
 
     fn all(&mut self, source: &LoamFeatures, pose: &Pose3, out: &mut Vec<Correspondence>) {
         out.clear();
         let target = self.target;
+        let mut slot = 0;
         for (points, map, edge) in [
             (&source.edges, &target.edges, true),
             (&source.planes, &target.planes, false),
         ] {
             for &s in points {
-                if let Some(fit) = self.fit(map, &(pose * s), edge) {
+                if let Some(fit) = self.fit(slot, map, &(pose * s), edge) {
                     out.push(Correspondence { source: s, fit });
                 }
+                slot += 1;
             }
         }
     }
@@ -334,7 +372,10 @@ impl Registrator for LoamRegistrator {
     type Target = LoamTarget;
 
     fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
-        let features = LoamFeatures::extract(cloud, &self.config.features)?;
+        let mut features = LoamFeatures::extract(cloud, &self.config.features)?;
+        let c = &self.config;
+        features.edges = voxel_thin(std::mem::take(&mut features.edges), c.source_edge_voxel);
+        features.planes = voxel_thin(std::mem::take(&mut features.planes), c.source_plane_voxel);
         if features.len() < self.config.min_correspondences {
             return Err(RegistrationError::TooFewPoints {
                 what: "source",
@@ -365,12 +406,7 @@ impl Registrator for LoamRegistrator {
         if !pose3_is_finite(initial) {
             return Err(RegistrationError::NonFiniteInitialGuess);
         }
-        let mut matcher = Matcher {
-            config,
-            target,
-            found: Vec::with_capacity(config.neighbours + 1),
-            patch: Vec::with_capacity(config.neighbours),
-        };
+        let mut matcher = Matcher::new(config, target, source);
         let mut pose = *initial;
         let mut k = config.initial_tukey_threshold.max(config.tukey_threshold);
         let (mut converged, mut iterations) = (false, 0);

@@ -111,8 +111,13 @@ impl Best<'_> {
         if self.full() {
             self.items.pop();
         }
-        let at = self.items.partition_point(|e| e.0 <= d2);
-        self.items.insert(at, (d2, p));
+        // Insertion by swaps: k is small, and a `Vec::insert` would call memmove.
+        self.items.push((d2, p));
+        let mut i = self.items.len() - 1;
+        while i > 0 && self.items[i - 1].0 > d2 {
+            self.items.swap(i - 1, i);
+            i -= 1;
+        }
     }
 }
 
@@ -348,8 +353,25 @@ impl VoxelHashMap {
             }
         };
         let nearest_face = lo.iter().chain(&hi).fold(f64::INFINITY, |m, &v| m.min(v));
+        if nearest_face * nearest_face > f64::from(best.bound(max_d2)) {
+            return;
+        }
+        // Ring 1, nearest cells first so that the bound tightens before the far ones: offsets
+        // are listed towards the query's nearer face (+1) or the farther one (-1) per axis.
+        let near: [i32; 3] = std::array::from_fn(|a| if lo[a] < hi[a] { -1 } else { 1 });
+        for rel in RING_ONE_NEAR_FIRST {
+            let o: [i32; 3] = std::array::from_fn(|a| rel[a] * near[a]);
+            let (gx, gy, gz) = (gap(0, o[0]), gap(1, o[1]), gap(2, o[2]));
+            if (gx * gx + gy * gy + gz * gz) as f32 > best.bound(max_d2) {
+                continue;
+            }
+            scan(
+                &mut best,
+                pack([base[0] + o[0], base[1] + o[1], base[2] + o[2]]),
+            );
+        }
         let reach = (max_distance * self.inv_cell).ceil() as i32 + 1;
-        for ring in 1..=reach {
+        for ring in 2..=reach {
             // Every cell outside the rings searched so far is at least this far.
             let outside = f64::from(ring - 1) * self.cell + nearest_face;
             if outside * outside > f64::from(best.bound(max_d2)) {
@@ -373,6 +395,39 @@ impl VoxelHashMap {
         }
     }
 }
+
+/// The 26 neighbours of a cell, relative to the query (+1: towards its nearer face on that axis,
+/// -1: the farther), roughly nearest first (the order only affects speed): cells touching only nearer
+/// faces (faces, then edges, then the corner) first, then those across a farther face (at least
+/// half a cell away).
+const RING_ONE_NEAR_FIRST: [[i32; 3]; 26] = [
+    [1, 0, 0],
+    [0, 1, 0],
+    [0, 0, 1],
+    [1, 1, 0],
+    [1, 0, 1],
+    [0, 1, 1],
+    [1, 1, 1],
+    [-1, 0, 0],
+    [0, -1, 0],
+    [0, 0, -1],
+    [-1, 1, 0],
+    [-1, 0, 1],
+    [1, -1, 0],
+    [0, -1, 1],
+    [1, 0, -1],
+    [0, 1, -1],
+    [-1, 1, 1],
+    [1, -1, 1],
+    [1, 1, -1],
+    [-1, -1, 0],
+    [-1, 0, -1],
+    [0, -1, -1],
+    [-1, -1, 1],
+    [-1, 1, -1],
+    [1, -1, -1],
+    [-1, -1, -1],
+];
 
 /// The thinning voxel of `p` at `inv` voxels per metre, as [`Entry::voxel`].
 #[allow(clippy::cast_sign_loss)]

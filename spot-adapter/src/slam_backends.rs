@@ -70,7 +70,7 @@ pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
 #[must_use]
 pub fn loam_slam(config: GraphSlamConfig) -> LoamSlam {
     let odometry = LoamRegistrator {
-        config: LoamConfig::default(),
+        config: LoamConfig::local_map_odometry(),
     };
     let refine = LoamRegistrator {
         config: LoamConfig {
