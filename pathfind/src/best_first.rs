@@ -6,7 +6,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::cost::{Cost, STEP};
-use crate::movement::{DIRECTIONS, legal_steps};
+use crate::movement::DIRECTIONS;
 use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
 
@@ -36,7 +36,7 @@ pub(crate) fn best_first(
         }
         let c = space.cell(i);
         closed.insert(c);
-        let mut steps = legal_steps(grid, c) & closed.open_neighbours(c);
+        let mut steps = closed.legal_open_steps(grid, c);
         while steps != 0 {
             let d = steps.trailing_zeros() as usize;
             steps &= steps - 1;

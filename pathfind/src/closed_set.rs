@@ -4,7 +4,7 @@
 
 use slam_core::{BitGrid, Cell};
 
-use crate::movement::free_neighbours;
+use crate::movement::legal_steps_avoiding;
 
 /// Expanded cells as the blocked cells of a grid of the same size.
 pub(crate) struct ClosedSet {
@@ -52,10 +52,10 @@ impl ClosedSet {
         self.set.push(c);
     }
 
-    /// Bit `d` set when the neighbour of `c` in direction `DIRECTIONS[d]` is on the grid and not
-    /// in the set.
+    /// The legal steps from free cell `c` of `grid` (bits as in
+    /// [`legal_steps`](crate::movement::legal_steps)) into cells not in the set.
     #[inline]
-    pub(crate) fn open_neighbours(&self, c: Cell) -> u8 {
-        free_neighbours(&self.bits, c)
+    pub(crate) fn legal_open_steps(&self, grid: &BitGrid, c: Cell) -> u8 {
+        legal_steps_avoiding(grid, &self.bits, c)
     }
 }
