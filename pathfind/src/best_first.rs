@@ -28,6 +28,12 @@ pub(crate) fn best_first(
     closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
     space.start(s, heuristic(start));
+    // Index offset of the neighbour in each direction (row-major, rows `width` apart), modulo 2^32.
+    let offset = DIRECTIONS.map(|(dx, dy)| {
+        dy.cast_unsigned()
+            .wrapping_mul(grid.width())
+            .wrapping_add(dx.cast_unsigned())
+    });
     let mut expanded = 0;
     while let Some((i, g, _)) = space.pop() {
         expanded += 1;
@@ -41,8 +47,9 @@ pub(crate) fn best_first(
             let d = steps.trailing_zeros() as usize;
             steps &= steps - 1;
             let (dx, dy) = DIRECTIONS[d];
-            let n = Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
-            space.relax(space.index(n), g + STEP[d], || heuristic(n), i, d as u8);
+            let n = || Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
+            let j = i.wrapping_add(offset[d]);
+            space.relax(j, g + STEP[d], || heuristic(n()), i, d as u8);
         }
     }
     Err(PlanError::NoPath)
