@@ -5,6 +5,7 @@ use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
 use slam_core::{Alignment, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat};
 
 use crate::config::IcpConfig;
+use crate::neighbour_cache::{NeighbourCache, Neighbours};
 use crate::target::PreparedTarget;
 
 /// One correspondence: source point moved by the current pose, its target point, and the target
@@ -35,24 +36,31 @@ pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
     j
 }
 
+/// Each source point moved by `pose` and its nearest target point within reach, through
+/// `cache` (slot = source index), into `pairs`.
 fn correspondences(
     source: &[Point3<f64>],
     target: &PreparedTarget,
     pose: &Pose3,
-    max_d2: f64,
-) -> Vec<Pair> {
-    source
-        .iter()
-        .filter_map(|s| {
-            let p = pose * s;
-            let (i, d2) = target.nearest(&p);
-            (d2 <= max_d2).then(|| Pair {
-                p,
-                q: target.points[i],
-                n: target.normal(i),
-            })
-        })
-        .collect()
+    cache: &mut NeighbourCache,
+    pairs: &mut Vec<Pair>,
+) {
+    pairs.clear();
+    let mut nearest = Vec::with_capacity(1);
+    for (slot, s) in source.iter().enumerate() {
+        let p = pose * s;
+        if cache.nearest(slot, target, &p, &mut nearest) == Neighbours::TooFew {
+            continue;
+        }
+        let Some(i) = nearest.first().map(|c| c.id as usize) else {
+            continue;
+        };
+        pairs.push(Pair {
+            p,
+            q: target.points[i],
+            n: target.normal(i),
+        });
+    }
 }
 
 pub(crate) fn align<S: IcpStep>(
@@ -64,14 +72,17 @@ pub(crate) fn align<S: IcpStep>(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
-    let max_d2 = config.max_correspondence_distance * config.max_correspondence_distance;
+    // The nearest target point of each source point, and three more: later iterations reuse
+    // them while they provably stay nearest.
+    let mut cache = NeighbourCache::new(source.len(), 1, 4, config.max_correspondence_distance);
+    let mut pairs = Vec::with_capacity(source.len());
     let mut pose = *initial;
     let mut converged = false;
     let mut iterations = 0;
     let mut weights = Vec::new();
     for _ in 0..config.max_iterations {
         iterations += 1;
-        let pairs = correspondences(source, target, &pose, max_d2);
+        correspondences(source, target, &pose, &mut cache, &mut pairs);
         if pairs.len() < config.min_correspondences {
             return Err(RegistrationError::TooFewCorrespondences {
                 found: pairs.len(),
@@ -99,7 +110,7 @@ pub(crate) fn align<S: IcpStep>(
         }
     }
     // Report at the final pose.
-    let pairs = correspondences(source, target, &pose, max_d2);
+    correspondences(source, target, &pose, &mut cache, &mut pairs);
     if pairs.len() < config.min_correspondences {
         return Err(RegistrationError::TooFewCorrespondences {
             found: pairs.len(),

@@ -11,7 +11,7 @@ use slam_core::{
 use crate::icp::min_eigenvalue_ratio;
 use crate::kernel::IcpKernel;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
-use crate::neighbour_cache::{NeighbourCache, Neighbours};
+use crate::neighbour_cache::{Candidate, NeighbourCache, Neighbours};
 use crate::sym3::{Eigen3, symmetric_eigen3};
 use crate::voxel_hash_map::VoxelHashMap;
 
@@ -220,6 +220,7 @@ struct Matcher<'a> {
     cache: NeighbourCache,
     /// The fit of each slot's latest neighbours, reused while they stay the same.
     fits: Vec<Option<Fit>>,
+    found: Vec<Candidate>,
     patch: Vec<Point3<f64>>,
 }
 
@@ -237,6 +238,7 @@ impl<'a> Matcher<'a> {
                 config.max_neighbour_distance,
             ),
             fits: vec![None; slots],
+            found: Vec::with_capacity(config.neighbours),
             patch: Vec::with_capacity(config.neighbours),
         }
     }
@@ -245,11 +247,20 @@ impl<'a> Matcher<'a> {
     /// point `p`, when there are enough of them within reach and they fit one.
     fn fit(&mut self, slot: usize, map: &VoxelHashMap, p: &Point3<f64>, edge: bool) -> Option<Fit> {
         let c = self.config;
-        let fit = match self.cache.nearest(slot, map, p, &mut self.patch) {
+        let answer = self.cache.nearest(slot, map, p, &mut self.found);
+        if answer == Neighbours::Unchanged {
+            return self.fits[slot];
+        }
+        self.patch.clear();
+        self.patch.extend(
+            self.found
+                .iter()
+                .map(|c| Point3::new(f64::from(c.p[0]), f64::from(c.p[1]), f64::from(c.p[2]))),
+        );
+        let fit = match answer {
             Neighbours::TooFew => None,
-            Neighbours::Unchanged => return self.fits[slot],
-            Neighbours::Found if edge => Fit::line(&self.patch, c.line_eigenvalue_ratio),
-            Neighbours::Found => Fit::plane(&self.patch, c.plane_fit_tolerance),
+            _ if edge => Fit::line(&self.patch, c.line_eigenvalue_ratio),
+            _ => Fit::plane(&self.patch, c.plane_fit_tolerance),
         };
         self.fits[slot] = fit;
         fit

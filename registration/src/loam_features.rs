@@ -165,7 +165,9 @@ fn rings(cloud: &PointCloud, config: &LoamFeatureConfig) -> Vec<Ring> {
     let count = field.map_or(usize::from(config.layout.rings), |r| {
         r.iter().copied().max().map_or(0, |m| usize::from(m) + 1)
     });
-    let mut keyed: Vec<Vec<(f64, Point3<f64>)>> = (0..count).map(|_| Vec::new()).collect();
+    let per_ring = cloud.len() / count.max(1) + cloud.len() / 8;
+    let mut keyed: Vec<Vec<(f64, Point3<f64>)>> =
+        (0..count).map(|_| Vec::with_capacity(per_ring)).collect();
     let (lo, hi) = (config.min_range, config.max_range);
     for (i, p) in cloud.points().iter().enumerate() {
         let range = p.coords.norm();
@@ -250,7 +252,11 @@ impl LoamFeatures {
         config: &LoamFeatureConfig,
     ) -> Result<Self, RegistrationError> {
         config.validate()?;
-        let mut out = Self::default();
+        // Most points of a scan are reliable planar points: room for all of them up front.
+        let mut out = Self {
+            plane_map: Vec::with_capacity(cloud.len()),
+            ..Self::default()
+        };
         for ring in rings(cloud, config) {
             extract_ring(&ring.points, config, &mut out);
         }

@@ -3,10 +3,12 @@
 use std::cell::OnceCell;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use nalgebra::{Matrix3, Point3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Point3, Vector3};
 use slam_core::{PointCloud, Pose3, RegistrationError};
 
 use crate::config::IcpConfig;
+use crate::neighbour_cache::{Candidate, NearestSearch};
+use crate::sym3::symmetric_eigen3;
 
 /// Target points, their k-d tree and (optionally) unit normals.
 pub struct PreparedTarget {
@@ -97,25 +99,37 @@ impl PreparedTarget {
             let cov = pts.iter().fold(Matrix3::zeros(), |m, q| {
                 m + (q - mean) * (q - mean).transpose()
             });
-            let eig = SymmetricEigen::new(cov);
-            eig.eigenvectors.column(eig.eigenvalues.imin()).into_owned()
+            // Eigenvalues ascending: the first vector is the normal.
+            symmetric_eigen3(&cov).vectors.column(0).into_owned()
         }))
     }
+}
 
-    /// Nearest target point to `q`: (index, squared distance).
-    #[inline]
-    pub(crate) fn nearest(&self, q: &Point3<f64>) -> (usize, f64) {
-        #[allow(clippy::cast_possible_truncation)]
-        let r = self
+impl NearestSearch for PreparedTarget {
+    #[allow(clippy::cast_possible_truncation)]
+    fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
+        out.clear();
+        let Some(n) = std::num::NonZero::new(n) else {
+            return;
+        };
+        let nn = self
             .tree
             .query(&[q.x as f32, q.y as f32, q.z as f32])
-            .nearest_one::<SquaredEuclidean<f32>>()
+            .nearest_n::<SquaredEuclidean<f32>>(n)
+            .within::<SquaredEuclidean<f32>>((max_distance * max_distance) as f32)
             .execute();
-        let i = r.item as usize;
-        // The distance in f64, from the stored point.
-        (i, (self.points[i] - q).norm_squared())
+        out.extend(nn.iter().map(|r| {
+            let p = self.points[r.item as usize];
+            Candidate {
+                d2: r.distance,
+                p: [p.x as f32, p.y as f32, p.z as f32],
+                id: r.item,
+            }
+        }));
     }
+}
 
+impl PreparedTarget {
     /// Number of target points.
     #[must_use]
     pub fn len(&self) -> usize {

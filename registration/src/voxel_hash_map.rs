@@ -7,6 +7,8 @@ use nalgebra::Point3;
 use rustc_hash::FxHashMap;
 use slam_core::RegistrationError;
 
+use crate::neighbour_cache::{Candidate, NearestSearch};
+
 /// One stored point: f32 coordinates (half the memory traffic of f64; a local map spans far less
 /// than the kilometres where f32 would lose millimetres), the owner that added it and its
 /// thinning voxel, named by the low 10 bits of each voxel coordinate (unique within a cell,
@@ -90,7 +92,7 @@ fn cell_of(v: f64, inv: f64) -> i32 {
 /// The `k` best (smallest squared distance) candidates seen so far, sorted ascending.
 struct Best<'a> {
     k: usize,
-    items: &'a mut Vec<(f32, [f32; 3])>,
+    items: &'a mut Vec<Candidate>,
 }
 
 impl Best<'_> {
@@ -101,7 +103,7 @@ impl Best<'_> {
     /// The squared distance a candidate must beat.
     fn bound(&self, max_d2: f32) -> f32 {
         if self.full() {
-            self.items.last().map_or(max_d2, |l| l.0.min(max_d2))
+            self.items.last().map_or(max_d2, |l| l.d2.min(max_d2))
         } else {
             max_d2
         }
@@ -112,9 +114,9 @@ impl Best<'_> {
             self.items.pop();
         }
         // Insertion by swaps: k is small, and a `Vec::insert` would call memmove.
-        self.items.push((d2, p));
+        self.items.push(Candidate { d2, p, id: 0 });
         let mut i = self.items.len() - 1;
-        while i > 0 && self.items[i - 1].0 > d2 {
+        while i > 0 && self.items[i - 1].d2 > d2 {
             self.items.swap(i - 1, i);
             i -= 1;
         }
@@ -285,7 +287,7 @@ impl VoxelHashMap {
         }
         let mut items = Vec::with_capacity(k + 1);
         self.search(q, k, max_distance, &mut items);
-        out.extend(items.iter().map(|&(d2, p)| (f64::from(d2), widen(p))));
+        out.extend(items.iter().map(|c| (f64::from(c.d2), widen(c.p))));
     }
 
     /// The point nearest `q` within `max_distance`, with its squared distance.
@@ -303,7 +305,7 @@ impl VoxelHashMap {
         q: &Point3<f64>,
         k: usize,
         max_distance: f64,
-        items: &mut Vec<(f32, [f32; 3])>,
+        items: &mut Vec<Candidate>,
     ) {
         items.clear();
         if k == 0
@@ -393,6 +395,12 @@ impl VoxelHashMap {
                 }
             }
         }
+    }
+}
+
+impl NearestSearch for VoxelHashMap {
+    fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
+        self.search(q, n, max_distance, out);
     }
 }
 

@@ -53,7 +53,7 @@ struct LocalMap<T> {
 /// loop checks (the thesis uses point-to-point ICP), and any [`Optimizer`].
 ///
 /// Loop closure runs as a bounded step: each call of [`GraphSlam::loop_closure_step`] tries at
-/// most one queued candidate and optimises at most once. With
+/// most one queued candidate, optimises at most once and then rebuilds the local map. With
 /// [`GraphSlamConfig::inline_loop_closure`] (the default) [`GraphSlam::process`] calls it after
 /// each new keyframe; otherwise the caller schedules it (between scans, or on a timer), so that
 /// odometry is never held up. Either way the result is deterministic for a given input.
@@ -523,7 +523,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             self.report.optimizer_failures += 1;
         }
         self.report.loops_closed += 1;
+        // The keyframes moved: rebuild the local map now, within this step, so that the next
+        // scan's odometry does not pay for it.
         self.local_map = None;
+        self.ensure_local_map();
         let poses: Vec<Pose3> = self.graph.nodes().iter().map(|n| n.pose).collect();
         self.node_index.rebuild(poses.iter());
         LoopOutcome::Closed {
