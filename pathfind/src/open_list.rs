@@ -122,29 +122,24 @@ impl BucketRing {
         (bucket % RING as u64) as usize
     }
 
+    /// Buckets from the current one to the next occupied one; `None` when the ring is empty.
     #[inline]
-    fn is_empty(&self) -> bool {
-        self.occupied.iter().all(|&w| w == 0)
-    }
-
-    /// Buckets from the current one to the next occupied one (the ring is not empty).
-    #[inline]
-    fn distance_to_next(&self) -> u64 {
+    fn distance_to_next(&self) -> Option<u64> {
         let b = Self::slot(self.base);
         let (w, bit) = (b / 64, b % 64);
         let here = self.occupied[w] >> bit;
         if here != 0 {
-            return u64::from(here.trailing_zeros());
+            return Some(u64::from(here.trailing_zeros()));
         }
         // The following words, wrapping round to the low bits of the current word last.
         for k in 1..=RING_WORDS {
             let word = self.occupied[(w + k) % RING_WORDS];
             if word != 0 {
                 let slot = ((w + k) % RING_WORDS) * 64 + word.trailing_zeros() as usize;
-                return ((slot + RING - b) % RING) as u64;
+                return Some(((slot + RING - b) % RING) as u64);
             }
         }
-        0
+        None
     }
 }
 
@@ -194,10 +189,7 @@ impl OpenList for BucketRing {
     #[allow(clippy::inline_always)]
     #[inline(always)]
     fn pop(&mut self) -> Option<Open> {
-        if self.is_empty() {
-            return None;
-        }
-        let step = self.distance_to_next();
+        let step = self.distance_to_next()?;
         if step != 0 {
             self.base += step;
             self.sorted = false;
