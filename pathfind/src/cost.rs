@@ -2,14 +2,14 @@
 //! floating point, and no float-to-integer conversion when a cost becomes an open-list key.
 //!
 //! A straight step costs `2^29`, a diagonal step `round(sqrt(2) 2^29)`, which is
-//! `sqrt(2) 2^29 + 0.006` (29 bits happen to round `sqrt(2)` about as well as 36 would). The
+//! `sqrt(2) 2^29 + 0.006` (29 bits happen to round `sqrt(2)` about as well as 35 would). The
 //! searches are exact on these integer costs (the octile distance in the same units is consistent,
 //! so no rounding enters anywhere), and a path that is shortest in them is shortest in the true
 //! costs: the fixed-point costs of two paths whose diagonal step counts differ by `db` are off from
 //! `2^29` times their true costs by amounts at most `0.006 db` apart, while distinct true costs
 //! `a + b sqrt(2)` differ by at least about `1 / (2.9 db)` (`sqrt(2)` is badly approximable), so
-//! the order cannot flip while `db` stays below 170,000. Reported lengths are summed along the
-//! path in floating point, as before.
+//! the order cannot flip while `db` stays below 170,000. Reported lengths are summed step by step
+//! along the path in floating point ([`path_cost`](crate::movement::path_cost)).
 //!
 //! A `u64` holds costs up to `2^35` cells, beyond any `g + h` on a grid that a `u32` cell index can
 //! address (`2^32` cells).
