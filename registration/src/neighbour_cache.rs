@@ -96,52 +96,64 @@ impl NeighbourCache {
         let reach2 = self.max_distance * self.max_distance;
         if let Some(s) = entry {
             let kept = &self.pool[slot * self.kept..slot * self.kept + s.count];
-            self.order.clear();
-            self.order.extend(kept.iter().enumerate().map(|(i, c)| {
-                let d = [
-                    f64::from(c.p[0]) - p.x,
-                    f64::from(c.p[1]) - p.y,
-                    f64::from(c.p[2]) - p.z,
-                ];
-                ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f32, i)
-            }));
-            if self.order.len() >= self.k {
+            let margin = s.clear - (p - s.at).norm();
+            if margin > 0.0 {
+                self.order.clear();
                 self.order
-                    .select_nth_unstable_by(self.k - 1, |a, b| a.0.total_cmp(&b.0));
-                let kth = f64::from(self.order[self.k - 1].0);
-                let margin = s.clear - (p - s.at).norm();
-                if kth <= reach2 && margin > 0.0 && kth <= margin * margin {
-                    let chosen = self.order[..self.k]
-                        .iter()
-                        .fold(0u32, |m, &(_, i)| m | (1 << i));
-                    out.extend(
-                        self.order[..self.k]
+                    .extend(kept.iter().enumerate().filter_map(|(i, c)| {
+                        let d = [
+                            f64::from(c.p[0]) - p.x,
+                            f64::from(c.p[1]) - p.y,
+                            f64::from(c.p[2]) - p.z,
+                        ];
+                        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        (d2 <= reach2).then_some((d2 as f32, i))
+                    }));
+                if self.order.len() >= self.k {
+                    self.order
+                        .select_nth_unstable_by(self.k - 1, |a, b| a.0.total_cmp(&b.0));
+                    let kth = f64::from(self.order[self.k - 1].0);
+                    if kth <= margin * margin {
+                        let chosen = self.order[..self.k]
                             .iter()
-                            .map(|&(d2, i)| Candidate { d2, ..kept[i] }),
-                    );
-                    if let Some(Some(s)) = self.slots.get_mut(slot) {
-                        let same = s.chosen == chosen;
-                        s.chosen = chosen;
-                        if same {
-                            return Neighbours::Unchanged;
+                            .fold(0u32, |m, &(_, i)| m | (1 << i));
+                        out.extend(
+                            self.order[..self.k]
+                                .iter()
+                                .map(|&(d2, i)| Candidate { d2, ..kept[i] }),
+                        );
+                        if let Some(Some(s)) = self.slots.get_mut(slot) {
+                            let same = s.chosen == chosen;
+                            s.chosen = chosen;
+                            if same {
+                                return Neighbours::Unchanged;
+                            }
                         }
+                        return Neighbours::Changed;
                     }
-                    return Neighbours::Changed;
+                } else if margin >= self.max_distance {
+                    // No point that is not kept lies within reach, and fewer than k kept do.
+                    if let Some(Some(s)) = self.slots.get_mut(slot) {
+                        s.chosen = 0;
+                    }
+                    return Neighbours::TooFew;
                 }
             }
         }
-        // Search again, keeping more than asked for.
-        target.nearest_into(p, self.kept, self.max_distance, &mut self.found);
+        // Search again, keeping more than asked for and looking further than the reach, so that
+        // a point with too few neighbours can be answered again without a search.
+        let search_distance = SEARCH_SLACK * self.max_distance;
+        target.nearest_into(p, self.kept, search_distance, &mut self.found);
         let count = self.found.len().min(self.kept);
         self.pool[slot * self.kept..slot * self.kept + count].copy_from_slice(&self.found[..count]);
         let clear = if count == self.kept {
             f64::from(self.found[count - 1].d2).sqrt()
         } else {
-            // Every point within reach is kept.
-            self.max_distance
+            // Every point within the search distance is kept.
+            search_distance
         };
-        let enough = count >= self.k;
-        // `found` is nearest first: the first k are the answer.
+        // `found` is nearest first: the first k are the answer when the k-th is within reach.
+        let enough = count >= self.k && f64::from(self.found[self.k - 1].d2) <= reach2;
         self.slots[slot] = Some(Slot {
             at: *p,
             clear,
@@ -156,6 +168,9 @@ impl NeighbourCache {
         Neighbours::Changed
     }
 }
+
+/// Searches look this many times the reach away.
+const SEARCH_SLACK: f64 = 1.5;
 
 #[cfg(test)]
 mod tests {
