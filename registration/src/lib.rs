@@ -12,7 +12,10 @@
 //!   cloud's ring field or from a [`LidarLayout`]; edges matched to lines and planar points to
 //!   planes fitted to their nearest target features, Tukey-weighted Gauss-Newton (eq. 4.7).
 //!
-//! Correspondences come from `kiddo`'s immutable k-d tree, built once per target. Every result
+//! ICP correspondences come from `kiddo`'s immutable k-d tree, built once per target; LOAM's come
+//! from a [`VoxelHashMap`] (exact k-nearest in hashed cells), which a sliding local map can be
+//! updated in place. Both reuse a point's neighbours across iterations while the triangle
+//! inequality proves them still nearest, so most iterations run no search. Every result
 //! reports convergence, iterations, inliers, RMSE and the 6x6 information `J^T W J` with its
 //! smallest-to-largest eigenvalue ratio, so a caller can weigh a pose-graph edge and notice a
 //! degenerate scene (a single plane, a long featureless corridor).
