@@ -14,7 +14,8 @@ use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply,
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, ScanOutcome};
 use spot_adapter::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, Recording, Sample, SimulatedSpot,
-    SimulationConfig, TrajectoryEvaluation, loam_slam, point_to_plane_slam, slam_config,
+    SimulationConfig, TrajectoryEvaluation, body_trajectory, loam_slam, point_to_plane_slam,
+    slam_config,
 };
 
 const USAGE: &str = "usage: slam [RECORDING_DIR] [--seed N] [--registration p2plane|loam] \
@@ -132,12 +133,7 @@ fn run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         report.loops_closed, report.loops_attempted, report.odometry_fallbacks
     );
     let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);
-    let mut sorted = report.scan_ms.clone();
-    sorted.sort_by(f64::total_cmp);
-    let p99 = sorted
-        .get((sorted.len() * 99 / 100).min(sorted.len().saturating_sub(1)))
-        .copied()
-        .unwrap_or(0.0);
+    let p99 = report.scan_ms_quantile(0.99);
     let slowest = report
         .scan_ms
         .iter()
@@ -150,15 +146,7 @@ fn run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         report.max_scan_ms()
     );
     // Body trajectory in the map frame, for comparison with the ground truth.
-    let lidar_t_body = body_t_lidar.inverse();
-    let estimate: Vec<StampedPose> = slam
-        .scan_trajectory()
-        .into_iter()
-        .map(|(stamp, p)| StampedPose {
-            stamp,
-            pose: p * lidar_t_body,
-        })
-        .collect();
+    let estimate = body_trajectory(slam.scan_trajectory(), &body_t_lidar);
     if let Some(truth) = truth {
         let e = TrajectoryEvaluation::compute(
             &estimate,

@@ -4,11 +4,28 @@
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::ate::{AteReport, absolute_trajectory_error, associate};
+use crate::ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
 use crate::drift::{
-    EndPointDrift, SegmentDrift, end_point_drift, loop_end_point_error, segment_drift,
+    EndPointDrift, INDOOR_SEGMENT_LENGTHS, SegmentDrift, end_point_drift, loop_end_point_error,
+    segment_drift,
 };
 use crate::error::AdapterError;
+
+/// A trajectory of LiDAR poses (`map_T_lidar` per stamp) as body poses (`map_T_body`).
+#[must_use]
+pub fn body_trajectory(
+    lidar_trajectory: Vec<(f64, Pose3)>,
+    body_t_lidar: &Pose3,
+) -> Vec<StampedPose> {
+    let lidar_t_body = body_t_lidar.inverse();
+    lidar_trajectory
+        .into_iter()
+        .map(|(stamp, p)| StampedPose {
+            stamp,
+            pose: p * lidar_t_body,
+        })
+        .collect()
+}
 
 /// Accuracy of an estimated trajectory against the ground truth.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,5 +71,27 @@ impl TrajectoryEvaluation {
             segments,
             loop_end_point_error,
         })
+    }
+
+    /// Evaluate a SLAM run's trajectory of LiDAR poses (`map_T_lidar` per stamp, as
+    /// `GraphSlam::scan_trajectory` gives it) as body poses against the ground truth
+    /// (`world_T_body`), with [`DEFAULT_MAX_STAMP_DIFFERENCE`] and [`INDOOR_SEGMENT_LENGTHS`].
+    /// Returns the body trajectory too, for writing out.
+    ///
+    /// # Errors
+    /// As [`TrajectoryEvaluation::compute`].
+    pub fn of_lidar_trajectory(
+        lidar_trajectory: Vec<(f64, Pose3)>,
+        body_t_lidar: &Pose3,
+        truth: &[StampedPose],
+    ) -> Result<(Self, Vec<StampedPose>), AdapterError> {
+        let estimate = body_trajectory(lidar_trajectory, body_t_lidar);
+        let e = Self::compute(
+            &estimate,
+            truth,
+            DEFAULT_MAX_STAMP_DIFFERENCE,
+            &INDOOR_SEGMENT_LENGTHS,
+        )?;
+        Ok((e, estimate))
     }
 }

@@ -77,7 +77,7 @@ pub use drift::{
     loop_end_point_error, path_length, segment_drift,
 };
 pub use error::AdapterError;
-pub use evaluation::TrajectoryEvaluation;
+pub use evaluation::{TrajectoryEvaluation, body_trajectory};
 pub use floor_plan::OBSTACLE_HEIGHT;
 pub use frames::{GaitSway, SpotGeometry};
 pub use kitti::{KittiOdometry, KittiSequence};

@@ -33,22 +33,9 @@ fn meets_the_accuracy_targets<R: MapRegistrator, C: MapRegistrator, O: Optimizer
     }
     let report = slam.report();
     assert!(report.loops_closed >= 1, "{report:?}");
-    let lidar_t_body = body_t_lidar.inverse();
-    let estimate: Vec<StampedPose> = slam
-        .scan_trajectory()
-        .into_iter()
-        .map(|(stamp, p)| StampedPose {
-            stamp,
-            pose: p * lidar_t_body,
-        })
-        .collect();
-    let e = TrajectoryEvaluation::compute(
-        &estimate,
-        &truth,
-        DEFAULT_MAX_STAMP_DIFFERENCE,
-        &INDOOR_SEGMENT_LENGTHS,
-    )
-    .unwrap();
+    let (e, _) =
+        TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
+            .unwrap();
     let o = TrajectoryEvaluation::compute(
         &odom,
         &truth,

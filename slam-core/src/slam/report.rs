@@ -108,4 +108,21 @@ impl SlamReport {
     pub fn max_scan_ms(&self) -> f64 {
         self.scan_ms.iter().copied().fold(0.0, f64::max)
     }
+
+    /// The `q` quantile (0 to 1, nearest rank) of [`SlamReport::scan_ms`]; 0 without scans.
+    #[must_use]
+    pub fn scan_ms_quantile(&self, q: f64) -> f64 {
+        let mut sorted = self.scan_ms.clone();
+        sorted.sort_by(f64::total_cmp);
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            clippy::cast_precision_loss
+        )]
+        let rank = (q.clamp(0.0, 1.0) * sorted.len() as f64) as usize;
+        sorted
+            .get(rank.min(sorted.len().saturating_sub(1)))
+            .copied()
+            .unwrap_or(0.0)
+    }
 }
