@@ -130,8 +130,8 @@ impl VoxelHashMap {
     /// the k-th neighbour is fastest.
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] when `cell` is not positive and finite or `thin` is
-    /// negative or not finite.
+    /// [`RegistrationError::InvalidConfig`] when `cell` is not positive and finite, `thin` is
+    /// negative or not finite, or a cell would span more than 512 voxels per axis.
     pub fn new(cell: f64, thin: f64) -> Result<Self, RegistrationError> {
         if !(cell.is_finite() && cell > 0.0 && thin.is_finite() && thin >= 0.0) {
             return Err(RegistrationError::InvalidConfig(format!(
@@ -143,6 +143,12 @@ impl VoxelHashMap {
         } else {
             cell
         };
+        // Voxels are told apart by 10 bits per axis within a cell.
+        if thin > 0.0 && cell / thin > 512.0 {
+            return Err(RegistrationError::InvalidConfig(format!(
+                "voxel hash map: cell {cell} spans more than 512 voxels of {thin} per axis"
+            )));
+        }
         Ok(Self {
             cell,
             inv_cell: 1.0 / cell,
@@ -328,20 +334,23 @@ impl VoxelHashMap {
         let hi: [f64; 3] = std::array::from_fn(|a| self.cell - lo[a]);
         let max_d2 = (max_distance * max_distance) as f32;
         let mut best = Best { k, items };
+        let offer = |best: &mut Best<'_>, e: &Entry| {
+            let d = [e.p[0] - qf[0], e.p[1] - qf[1], e.p[2] - qf[2]];
+            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            // Full: only a strictly nearer point enters. Not full: any within reach.
+            let enters = if best.full() {
+                d2 < best.bound(max_d2)
+            } else {
+                d2 <= max_d2
+            };
+            if enters {
+                best.offer(d2, e.p);
+            }
+        };
         let scan = |best: &mut Best<'_>, key: u64| {
             if let Some(entries) = self.cells.get(&key) {
                 for e in entries {
-                    let d = [e.p[0] - qf[0], e.p[1] - qf[1], e.p[2] - qf[2]];
-                    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    // Full: only a strictly nearer point enters. Not full: any within reach.
-                    let enters = if best.full() {
-                        d2 < best.bound(max_d2)
-                    } else {
-                        d2 <= max_d2
-                    };
-                    if enters {
-                        best.offer(d2, e.p);
-                    }
+                    offer(best, e);
                 }
             }
         };
@@ -377,6 +386,25 @@ impl VoxelHashMap {
             // Every cell outside the rings searched so far is at least this far.
             let outside = f64::from(ring - 1) * self.cell + nearest_face;
             if outside * outside > f64::from(best.bound(max_d2)) {
+                break;
+            }
+            // A far reach over a sparse map: reading every occupied cell once is cheaper than
+            // enumerating the remaining rings.
+            let shell = (2 * i64::from(ring) + 1).pow(3) - (2 * i64::from(ring) - 1).pow(3);
+            if usize::try_from(shell).unwrap_or(usize::MAX) > self.cells.len() {
+                for e in self.cells.values().flatten() {
+                    let w = widen(e.p);
+                    let o = [
+                        cell_of(w.x, self.inv_cell) - base[0],
+                        cell_of(w.y, self.inv_cell) - base[1],
+                        cell_of(w.z, self.inv_cell) - base[2],
+                    ];
+                    // Points of the rings searched already.
+                    if o.iter().all(|v| v.abs() < ring) {
+                        continue;
+                    }
+                    offer(&mut best, e);
+                }
                 break;
             }
             for dz in -ring..=ring {

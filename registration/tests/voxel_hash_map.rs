@@ -162,8 +162,44 @@ fn sliding_window_holds_the_voxels_of_its_owners() {
     }
 }
 
+/// A reach of hundreds of cells over a sparse map (the search then reads the occupied cells
+/// instead of enumerating rings) still equals brute force.
+#[test]
+fn far_reach_over_a_sparse_map() {
+    let points: Vec<Point3<f64>> = (0..200)
+        .map(|i| {
+            let t = f64::from(i);
+            Point3::new(
+                40.0 * (t * 0.618).sin(),
+                40.0 * (t * 0.754).cos(),
+                (t * 0.57).sin(),
+            )
+        })
+        .collect();
+    let mut map = VoxelHashMap::new(0.05, 0.0).unwrap();
+    for p in &points {
+        map.insert(0, p);
+    }
+    let mut out = Vec::new();
+    for q in [
+        Point3::origin(),
+        Point3::new(30.0, -10.0, 2.0),
+        Point3::new(100.0, 0.0, 0.0),
+    ] {
+        for (k, r) in [(1, 50.0), (7, 80.0), (300, 200.0)] {
+            map.nearest_k(&q, k, r, &mut out);
+            let got: Vec<f32> = out.iter().map(|(d2, _)| *d2 as f32).collect();
+            assert_eq!(got, brute(&points, &q, k, r), "q {q} k {k} r {r}");
+        }
+    }
+}
+
 #[test]
 fn bad_input_is_refused_or_skipped() {
+    assert!(
+        VoxelHashMap::new(100.0, 0.05).is_err(),
+        "too many voxels per cell"
+    );
     assert!(VoxelHashMap::new(0.0, 0.0).is_err());
     assert!(VoxelHashMap::new(f64::NAN, 0.0).is_err());
     assert!(VoxelHashMap::new(0.25, -1.0).is_err());
