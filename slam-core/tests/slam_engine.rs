@@ -443,3 +443,139 @@ fn loop_closure_removes_odometry_drift() {
         map.len()
     );
 }
+
+/// `BruteIcp` whose local map is edited in place: it keeps the parts by key and rebuilds the
+/// union after each change exactly as `target_from_sources` would from the window's parts.
+struct InPlaceIcp(BruteIcp);
+
+struct InPlaceMap {
+    parts: std::collections::BTreeMap<u32, (Vec<Point3<f64>>, Pose3)>,
+    union: Prepared,
+}
+
+impl InPlaceMap {
+    fn refresh(&mut self, r: &BruteIcp) {
+        let owned: Vec<(Prepared, Pose3)> = self
+            .parts
+            .values()
+            .map(|(p, pose)| (Prepared(p.clone()), *pose))
+            .collect();
+        let refs: Vec<(&Prepared, Pose3)> = owned.iter().map(|(p, pose)| (p, *pose)).collect();
+        self.union = if refs.is_empty() {
+            Prepared(Vec::new())
+        } else {
+            r.target_from_sources(&refs).unwrap()
+        };
+    }
+}
+
+impl Registrator for InPlaceIcp {
+    type Source = Prepared;
+    type Target = InPlaceMap;
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Prepared, RegistrationError> {
+        self.0.prepare_source(cloud)
+    }
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<InPlaceMap, RegistrationError> {
+        Ok(InPlaceMap {
+            parts: std::collections::BTreeMap::new(),
+            union: self.0.prepare_target(cloud)?,
+        })
+    }
+    fn align(
+        &self,
+        s: &Prepared,
+        t: &InPlaceMap,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError> {
+        self.0.align(s, &t.union, initial)
+    }
+}
+
+impl MapRegistrator for InPlaceIcp {
+    fn target_from_sources(
+        &self,
+        parts: &[(&Prepared, Pose3)],
+    ) -> Result<InPlaceMap, RegistrationError> {
+        Ok(InPlaceMap {
+            parts: std::collections::BTreeMap::new(),
+            union: self.0.target_from_sources(parts)?,
+        })
+    }
+    fn empty_map(&self) -> Option<InPlaceMap> {
+        Some(InPlaceMap {
+            parts: std::collections::BTreeMap::new(),
+            union: Prepared(Vec::new()),
+        })
+    }
+    fn add_to_map(&self, map: &mut InPlaceMap, key: u32, source: &Prepared, pose: &Pose3) {
+        map.parts.insert(key, (source.0.clone(), *pose));
+        map.refresh(&self.0);
+    }
+    fn remove_from_map(&self, map: &mut InPlaceMap, key: u32) {
+        assert!(
+            map.parts.remove(&key).is_some(),
+            "removed {key}, never added"
+        );
+        map.refresh(&self.0);
+    }
+}
+
+/// A local map slid in place (one keyframe in, the oldest out) must hold exactly the window a
+/// rebuild would: same trajectory, bit for bit, as the engine that rebuilds it whole.
+#[test]
+fn local_map_slid_in_place_equals_rebuilt() {
+    let world = hall();
+    let truth = loop_poses();
+    let config = GraphSlamConfig {
+        keyframe_distance: 0.45,
+        local_map_keyframes: 6,
+        min_scan_points: 50,
+        // No loop closure: the window slides through the whole run.
+        loop_search_radius: 1e-6,
+        ..GraphSlamConfig::default()
+    };
+    let mut rebuilt = GraphSlam::new(
+        config.clone(),
+        BruteIcp { max_distance: 0.5 },
+        BruteIcp { max_distance: 1.0 },
+        BruteIcp { max_distance: 0.5 },
+        DenseGaussNewton,
+    );
+    let mut in_place = GraphSlam::new(
+        config,
+        InPlaceIcp(BruteIcp { max_distance: 0.5 }),
+        BruteIcp { max_distance: 1.0 },
+        InPlaceIcp(BruteIcp { max_distance: 0.5 }),
+        DenseGaussNewton,
+    );
+    // The first third of the loop, odometry 3 % long.
+    let n = truth.len() / 3;
+    let mut odom = truth[0];
+    for k in 0..n {
+        if k > 0 {
+            let d = truth[k - 1].inverse() * truth[k];
+            odom *= Pose3::from_parts((d.translation.vector * 1.03).into(), d.rotation);
+        }
+        let cloud = scan(&world, &truth[k]);
+        let input = ScanInput {
+            stamp: k as f64 * 0.2,
+            odom_t_body: odom,
+            body_t_lidar: Pose3::identity(),
+            cloud: &cloud,
+        };
+        assert_eq!(
+            rebuilt.process(&input),
+            in_place.process(&input),
+            "scan {k}"
+        );
+    }
+    assert!(in_place.keyframe_count() > 12, "the window slid");
+    assert_eq!(rebuilt.report().odometry_fallbacks, 0);
+    for ((_, a), (_, b)) in rebuilt
+        .scan_trajectory()
+        .iter()
+        .zip(in_place.scan_trajectory())
+    {
+        assert_eq!(a, &b);
+    }
+}
