@@ -81,29 +81,23 @@ pub(crate) fn symmetric_eigen3(a: &Matrix3<f64>) -> Eigen3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
-    /// Against nalgebra's iterative solver on random covariances, including near-degenerate
-    /// ones (points on a line, on a plane).
-    #[test]
-    fn matches_the_iterative_solver() {
-        let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            #[allow(clippy::cast_precision_loss)]
-            let v = (s >> 11) as f64 / (1u64 << 53) as f64;
-            v - 0.5
-        };
-        for case in 0..3000 {
-            let squash = [1.0, 1e-3, 1e-6][case % 3];
-            let pts: Vec<Vector3<f64>> = (0..5)
-                .map(|_| {
-                    Vector3::new(
-                        rnd(),
-                        rnd() * squash,
-                        rnd() * if case % 2 == 0 { 1.0 } else { squash },
-                    )
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+
+        /// Against nalgebra's iterative solver on random covariances, including near-degenerate
+        /// ones (points on a line, on a plane).
+        #[test]
+        fn matches_the_iterative_solver(
+            raw in prop::array::uniform5((-0.5..0.5f64, -0.5..0.5f64, -0.5..0.5f64)),
+            squash in prop::sample::select(vec![1.0, 1e-3, 1e-6]),
+            flat_z in any::<bool>(),
+        ) {
+            let pts: Vec<Vector3<f64>> = raw
+                .iter()
+                .map(|&(x, y, z)| {
+                    Vector3::new(x, y * squash, z * if flat_z { squash } else { 1.0 })
                 })
                 .collect();
             let mean = pts.iter().sum::<Vector3<f64>>() / 5.0;
@@ -114,16 +108,16 @@ mod tests {
             let slow = iterative(&cov);
             let norm = cov.norm();
             for k in 0..3 {
-                assert!(
+                prop_assert!(
                     (fast.values[k] - slow.values[k]).abs() <= 1e-9 * norm,
-                    "case {case}: {:?} vs {:?}",
+                    "{:?} vs {:?}",
                     fast.values,
                     slow.values
                 );
                 // Each column is an eigenvector: A v = lambda v.
                 let v = fast.vectors.column(k);
-                assert!((v.norm() - 1.0).abs() < 1e-9);
-                assert!((cov * v - v * fast.values[k]).norm() <= 1e-7 * norm);
+                prop_assert!((v.norm() - 1.0).abs() < 1e-9);
+                prop_assert!((cov * v - v * fast.values[k]).norm() <= 1e-7 * norm);
             }
         }
     }

@@ -6,7 +6,7 @@ use posegraph::LevenbergMarquardt;
 use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
 };
-use slam_core::{GraphSlam, GraphSlamConfig};
+use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
 pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, LevenbergMarquardt>;
@@ -25,14 +25,26 @@ pub fn slam_config() -> GraphSlamConfig {
     }
 }
 
-/// The thesis' loop check: point-to-point ICP on voxelised keyframes.
-fn loop_check() -> PointToPointIcp {
-    PointToPointIcp {
+/// The engine with `odometry` and `refine`, the thesis' loop check (point-to-point ICP on
+/// voxelised keyframes) and Levenberg-Marquardt.
+fn assemble<R: MapRegistrator>(
+    config: GraphSlamConfig,
+    odometry: R,
+    refine: R,
+) -> GraphSlam<R, PointToPointIcp, LevenbergMarquardt> {
+    let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
             ..IcpConfig::default()
         },
-    }
+    };
+    GraphSlam::new(
+        config,
+        odometry,
+        loop_check,
+        refine,
+        LevenbergMarquardt::default(),
+    )
 }
 
 /// Point-to-plane odometry (Tukey 10 cm, pairs within 0.5 m) against the local map, and
@@ -54,14 +66,7 @@ pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
             ..IcpConfig::default()
         },
     };
-    let coarse = loop_check();
-    GraphSlam::new(
-        config,
-        odometry,
-        coarse,
-        refine,
-        LevenbergMarquardt::default(),
-    )
+    assemble(config, odometry, refine)
 }
 
 /// LOAM odometry against a local map of edge and planar features (5 cm and 10 cm voxels,
@@ -79,12 +84,5 @@ pub fn loam_slam(config: GraphSlamConfig) -> LoamSlam {
             ..LoamConfig::default()
         },
     };
-    let coarse = loop_check();
-    GraphSlam::new(
-        config,
-        odometry,
-        coarse,
-        refine,
-        LevenbergMarquardt::default(),
-    )
+    assemble(config, odometry, refine)
 }
