@@ -125,16 +125,21 @@ fn noisy_measurements_land_near_the_truth_and_lm_finishes() {
     assert!(dt < 0.1 && dr < 3f64.to_radians(), "{dt} m, {dr} rad");
 }
 
+/// `n` poses evenly around a circle of `radius`, each heading its polar angle plus `offset`.
+fn ring(n: u32, radius: f64, offset: f64) -> Vec<Pose2> {
+    (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            Pose2::new(Vector2::new(radius * a.cos(), radius * a.sin()), a + offset)
+        })
+        .collect()
+}
+
 #[test]
 fn se2_ring_from_random_headings() {
     let mut r = rng(11);
     let n = 40;
-    let truth: Vec<Pose2> = (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
-            Pose2::new(Vector2::new(5.0 * a.cos(), 5.0 * a.sin()), a + 1.0)
-        })
-        .collect();
+    let truth = ring(n, 5.0, 1.0);
     let mut g = PoseGraph::new();
     for (i, t) in truth.iter().enumerate() {
         let guess = Pose2::new(Vector2::new(10.0 * r(), 10.0 * r()), 6.0 * r());
@@ -201,12 +206,7 @@ fn two_fixed_nodes_anchor_the_solution_and_bad_graphs_are_errors() {
     // A ring whose nodes 0 and 20 are both fixed at the truth, everything else random.
     let mut r = rng(21);
     let n = 40;
-    let truth: Vec<Pose2> = (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
-            Pose2::new(Vector2::new(3.0 * a.cos(), 3.0 * a.sin()), a - 0.5)
-        })
-        .collect();
+    let truth = ring(n, 3.0, -0.5);
     let mut g = PoseGraph::new();
     for (i, t) in truth.iter().enumerate() {
         let fixed = i == 0 || i == 20;
@@ -238,7 +238,7 @@ fn two_fixed_nodes_anchor_the_solution_and_bad_graphs_are_errors() {
     }
     // Every node fixed: nothing to do.
     let mut all_fixed = g.clone();
-    for i in 0..n as u64 {
+    for i in 0..u64::from(n) {
         all_fixed.fix(i).unwrap();
     }
     initialize_chordal(&mut all_fixed).unwrap();
