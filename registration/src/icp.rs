@@ -63,6 +63,59 @@ fn correspondences(
     }
 }
 
+/// Each coarse-stage source point moved by `pose` and its nearest target point within reach
+/// (one plain search each), into `pairs`.
+fn coarse_correspondences(
+    source: &[Point3<f64>],
+    stride: usize,
+    target: &PreparedTarget,
+    pose: &Pose3,
+    max_distance: f64,
+    pairs: &mut Vec<Pair>,
+) {
+    pairs.clear();
+    for s in source.iter().step_by(stride) {
+        let p = pose * s;
+        if let Some(i) = target.nearest_one(&p, max_distance) {
+            pairs.push(Pair {
+                p,
+                q: target.points[i],
+                n: target.normal(i),
+            });
+        }
+    }
+}
+
+/// The coarse stage ends once an update moves less than this (metres) ...
+const COARSE_TRANSLATION: f64 = 0.01;
+/// ... and turns less than this (radians, 0.1 degrees).
+const COARSE_ROTATION: f64 = 1.745e-3;
+
+/// One robust step from `pairs`, applied to `pose`; returns the update's translation and
+/// rotation norms.
+fn update<S: IcpStep>(
+    config: &IcpConfig,
+    pairs: &[Pair],
+    weights: &mut Vec<f64>,
+    pose: &mut Pose3,
+) -> Result<(f64, f64), RegistrationError> {
+    weights.clear();
+    weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
+    let Some(delta) = S::step(pairs, weights) else {
+        return Err(RegistrationError::Degenerate(
+            "singular normal equations".into(),
+        ));
+    };
+    if !delta.iter().all(|v| v.is_finite()) {
+        return Err(RegistrationError::Degenerate("non-finite update".into()));
+    }
+    *pose = se3_exp(&delta) * *pose;
+    Ok((
+        delta.fixed_rows::<3>(0).norm(),
+        delta.fixed_rows::<3>(3).norm(),
+    ))
+}
+
 pub(crate) fn align<S: IcpStep>(
     config: &IcpConfig,
     source: &[Point3<f64>],
@@ -72,14 +125,39 @@ pub(crate) fn align<S: IcpStep>(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
-    // The nearest target point of each source point, and three more: later iterations reuse
-    // them while they provably stay nearest.
-    let mut cache = NeighbourCache::new(source.len(), 1, 4, config.max_correspondence_distance);
     let mut pairs = Vec::with_capacity(source.len());
     let mut pose = *initial;
     let mut converged = false;
     let mut iterations = 0;
     let mut weights = Vec::new();
+    // Coarse stage: while the pose still moves centimetres per step, the neighbours cached
+    // below would be stale after every step; a subsample with single plain searches gets
+    // there for a fraction of the searches.
+    let stride = config.coarse_stride.max(1);
+    if stride > 1 && source.len() / stride >= config.min_correspondences {
+        for _ in 0..config.max_iterations {
+            iterations += 1;
+            coarse_correspondences(
+                source,
+                stride,
+                target,
+                &pose,
+                config.max_correspondence_distance,
+                &mut pairs,
+            );
+            if pairs.len() < config.min_correspondences {
+                // Too few for the subsample: leave it to the full set.
+                break;
+            }
+            let (dt, dr) = update::<S>(config, &pairs, &mut weights, &mut pose)?;
+            if dt < COARSE_TRANSLATION && dr < COARSE_ROTATION {
+                break;
+            }
+        }
+    }
+    // The nearest target point of each source point, and three more: later iterations reuse
+    // them while they provably stay nearest.
+    let mut cache = NeighbourCache::new(source.len(), 1, 4, config.max_correspondence_distance);
     for _ in 0..config.max_iterations {
         iterations += 1;
         correspondences(source, target, &pose, &mut cache, &mut pairs);
@@ -89,21 +167,7 @@ pub(crate) fn align<S: IcpStep>(
                 required: config.min_correspondences,
             });
         }
-        weights = pairs
-            .iter()
-            .map(|p| config.kernel.weight(S::residual(p)))
-            .collect();
-        let Some(delta) = S::step(&pairs, &weights) else {
-            return Err(RegistrationError::Degenerate(
-                "singular normal equations".into(),
-            ));
-        };
-        if !delta.iter().all(|v| v.is_finite()) {
-            return Err(RegistrationError::Degenerate("non-finite update".into()));
-        }
-        pose = se3_exp(&delta) * pose;
-        let dt = delta.fixed_rows::<3>(0).norm();
-        let dr = delta.fixed_rows::<3>(3).norm();
+        let (dt, dr) = update::<S>(config, &pairs, &mut weights, &mut pose)?;
         if dt < config.translation_tolerance && dr < config.rotation_tolerance {
             converged = true;
             break;

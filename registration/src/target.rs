@@ -105,6 +105,19 @@ impl PreparedTarget {
     }
 }
 
+impl PreparedTarget {
+    /// The index of the target point nearest to `q` within `max_distance`.
+    #[allow(clippy::cast_possible_truncation)]
+    pub(crate) fn nearest_one(&self, q: &Point3<f64>, max_distance: f64) -> Option<usize> {
+        let nn = self
+            .tree
+            .query(&[q.x as f32, q.y as f32, q.z as f32])
+            .nearest_one::<SquaredEuclidean<f32>>()
+            .execute();
+        (f64::from(nn.distance) <= max_distance * max_distance).then_some(nn.item as usize)
+    }
+}
+
 impl NearestSearch for PreparedTarget {
     #[allow(clippy::cast_possible_truncation)]
     fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {

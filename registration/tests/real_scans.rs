@@ -119,6 +119,42 @@ fn hdl32e_pair_matches_the_reference() {
     }
 }
 
+/// The coarse stage (a subsample with plain searches first) only shortens the way: both ICP
+/// backends end where they end without it, from identity and from 1 m and 10 degrees off.
+#[test]
+fn coarse_stage_ends_at_the_same_pose() {
+    let source = read_ply(here("tests/data/source.ply")).unwrap();
+    let target = target_scan();
+    let off = reference() * pose3_from_xyz_rpy(0.8, -0.6, 0.0, 0.0, 0.0, 10f64.to_radians());
+    let with = IcpConfig {
+        max_correspondence_distance: 2.0,
+        max_iterations: 300,
+        ..IcpConfig::default()
+    };
+    let without = IcpConfig {
+        coarse_stride: 1,
+        ..with
+    };
+    for initial in [Pose3::identity(), off] {
+        let plane = [with, without]
+            .map(|config| run(&PointToPlaneIcp { config }, &source, &target, &initial));
+        same_pose("point-to-plane", &plane[0], &plane[1]);
+        let point = [with, without]
+            .map(|config| run(&PointToPointIcp { config }, &source, &target, &initial));
+        same_pose("point-to-point", &point[0], &point[1]);
+    }
+}
+
+/// Within 0.01 degrees and 0.2 mm of each other.
+fn same_pose(what: &str, a: &Pose3, b: &Pose3) {
+    let (rot, trans) = error(a, b);
+    eprintln!(
+        "{what}, coarse stage or not: {rot:.4} deg, {:.2} mm",
+        trans * 1e3
+    );
+    assert!(rot < 0.01 && trans < 0.0002, "{what}: {rot} deg, {trans} m");
+}
+
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
     let icp = PointToPlaneIcp::default();

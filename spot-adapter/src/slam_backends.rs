@@ -56,6 +56,8 @@ pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.1 },
             max_correspondence_distance: 0.5,
+            // The engine's guesses are centimetres off: no coarse stage needed.
+            coarse_stride: 1,
             ..IcpConfig::default()
         },
     };
