@@ -55,6 +55,9 @@ pub(crate) struct NeighbourCache {
     k: usize,
     kept: usize,
     max_distance: f64,
+    /// Searches look this far first, and as far as `SEARCH_SLACK * max_distance` only when
+    /// fewer than k points lie this near: a k-d tree prunes much more with a small bound.
+    first_radius: f64,
     slots: Vec<Option<Slot>>,
     /// `kept` candidates per slot.
     pool: Vec<Candidate>,
@@ -71,11 +74,18 @@ impl NeighbourCache {
             k,
             kept,
             max_distance,
+            first_radius: f64::INFINITY,
             slots: vec![None; slots],
             pool: vec![Candidate::default(); slots * kept],
             found: Vec::with_capacity(kept + 1),
             order: Vec::with_capacity(kept),
         }
+    }
+
+    /// Search within `radius` first (and farther only when fewer than k lie that near).
+    pub(crate) fn with_first_radius(mut self, radius: f64) -> Self {
+        self.first_radius = radius;
+        self
     }
 
     /// The `k` points of `target` nearest `p` within reach for point `slot`, into `out`
@@ -142,8 +152,13 @@ impl NeighbourCache {
         }
         // Search again, keeping more than asked for and looking further than the reach, so that
         // a point with too few neighbours can be answered again without a search.
-        let search_distance = SEARCH_SLACK * self.max_distance;
+        let wide = SEARCH_SLACK * self.max_distance;
+        let mut search_distance = self.first_radius.min(wide);
         target.nearest_into(p, self.kept, search_distance, &mut self.found);
+        if self.found.len() < self.k && search_distance < wide {
+            search_distance = wide;
+            target.nearest_into(p, self.kept, search_distance, &mut self.found);
+        }
         let count = self.found.len().min(self.kept);
         self.pool[slot * self.kept..slot * self.kept + count].copy_from_slice(&self.found[..count]);
         let clear = if count == self.kept {
@@ -189,12 +204,13 @@ mod tests {
             steps in prop::collection::vec((-0.05..0.05f64, -0.05..0.05f64, -0.05..0.05f64), 1..40),
             start in (0.0..3.0f64, 0.0..3.0f64, 0.0..0.5f64),
             k in 1usize..7,
+            first_radius in prop::sample::select(vec![0.05, 0.2, 0.5, f64::INFINITY]),
         ) {
             let mut map = VoxelHashMap::new(0.4, 0.0).unwrap();
             for &(x, y, z) in &points {
                 map.insert(0, &Point3::new(x, y, z));
             }
-            let mut cache = NeighbourCache::new(2, k, 2 * k, 1.0);
+            let mut cache = NeighbourCache::new(2, k, 2 * k, 1.0).with_first_radius(first_radius);
             let mut p = Point3::new(start.0, start.1, start.2);
             let (mut out, mut fresh) = (Vec::new(), Vec::new());
             let mut last: Option<Vec<f64>> = None;
