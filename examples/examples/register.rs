@@ -2,13 +2,15 @@
 //!
 //! ```sh
 //! cargo run --release --example register -- SOURCE TARGET [--method p2p|p2plane|loam] \
-//!     [--voxel M] [--init x,y,z,roll,pitch,yaw] [--layout vlp16|hdl32e|os1-128] [--reference FILE]
+//!     [--voxel M] [--init x,y,z,roll,pitch,yaw] [--layout vlp16|hdl32e|os1-128] [--reference FILE] \
+//!     [--repeat N]
 //! ```
 //!
 //! Files are PCD, PLY or KITTI `.bin`. `--voxel` sets the ICP voxel (default 0.25 m); `--init`
 //! is the initial guess (metres, degrees); `--layout` gives LOAM the ring layout of clouds
 //! without a ring field (default VLP-16); `--reference` reads a 4x4 row-major `target_T_source`
-//! and prints the result's distance to it. With no files it registers the bundled HDL-32E pair
+//! and prints the result's distance to it; `--repeat N` runs preparation and alignment N times and
+//! prints the best and median times. With no files it registers the bundled HDL-32E pair
 //! (`small_gicp`'s data, MIT) against its reference pose.
 
 use std::path::{Path, PathBuf};
@@ -30,6 +32,7 @@ struct Args {
     init: Pose3,
     layout: LidarLayout,
     reference: Option<PathBuf>,
+    repeat: usize,
 }
 
 fn bundled(p: &str) -> PathBuf {
@@ -46,6 +49,7 @@ fn parse_args() -> Result<Args> {
         init: Pose3::identity(),
         layout: LidarLayout::VLP16,
         reference: None,
+        repeat: 1,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -74,6 +78,12 @@ fn parse_args() -> Result<Args> {
                 }
             }
             "--reference" => args.reference = Some(value()?.into()),
+            "--repeat" => {
+                args.repeat = value()?.parse().context("--repeat")?;
+                if args.repeat == 0 {
+                    bail!("--repeat needs at least 1");
+                }
+            }
             _ if a.starts_with("--") => bail!("unknown option {a}"),
             _ => files.push(PathBuf::from(a)),
         }
@@ -112,20 +122,68 @@ fn read_reference(path: &Path) -> Result<Pose3> {
     ))
 }
 
-/// Prepare both clouds and align: (result, prepare ms, align ms).
+/// What `run` measured: the last result, and per run the preparation and alignment times (ms).
+struct Timed {
+    alignment: Alignment,
+    prepare_ms: Vec<f64>,
+    align_ms: Vec<f64>,
+}
+
+/// Prepare both clouds and align, `repeat` times.
 fn run<R: Registrator>(
     r: &R,
     source: &PointCloud,
     target: &PointCloud,
     init: &Pose3,
-) -> Result<(Alignment, f64, f64)> {
-    let t0 = Instant::now();
-    let s = r.prepare_source(source)?;
-    let t = r.prepare_target(target)?;
-    let t1 = Instant::now();
-    let a = r.align(&s, &t, init)?;
+    repeat: usize,
+) -> Result<Timed> {
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    Ok((a, ms(t1 - t0), ms(t1.elapsed())))
+    let (mut prepare_ms, mut align_ms) = (Vec::new(), Vec::new());
+    let mut alignment = None;
+    for _ in 0..repeat {
+        let t0 = Instant::now();
+        let s = r.prepare_source(source)?;
+        let t = r.prepare_target(target)?;
+        let t1 = Instant::now();
+        alignment = Some(r.align(&s, &t, init)?);
+        prepare_ms.push(ms(t1 - t0));
+        align_ms.push(ms(t1.elapsed()));
+    }
+    Ok(Timed {
+        alignment: alignment.context("no run")?,
+        prepare_ms,
+        align_ms,
+    })
+}
+
+/// Smallest and median of `v` (not empty).
+fn best_and_median(mut v: Vec<f64>) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[0], v[v.len() / 2])
+}
+
+/// The time line: one run's two parts, or the best and median of several.
+fn print_times(timed: &Timed, repeat: usize) {
+    if repeat == 1 {
+        println!(
+            "time        {:.1} ms prepare + {:.1} ms align",
+            timed.prepare_ms[0], timed.align_ms[0]
+        );
+    } else {
+        let total: Vec<f64> = timed
+            .prepare_ms
+            .iter()
+            .zip(&timed.align_ms)
+            .map(|(p, a)| p + a)
+            .collect();
+        let (best, median) = best_and_median(total);
+        let (prepare, _) = best_and_median(timed.prepare_ms.clone());
+        let (align, _) = best_and_median(timed.align_ms.clone());
+        println!(
+            "time        prepare + align: best {best:.1} ms, median {median:.1} ms of {repeat} runs \
+             (best prepare {prepare:.1} ms, best align {align:.1} ms)"
+        );
+    }
 }
 
 fn main() -> Result<()> {
@@ -141,27 +199,31 @@ fn main() -> Result<()> {
     loam.features.layout = args.layout;
     // A pair may start far from its answer: begin with a wide robust threshold.
     loam.initial_tukey_threshold = 1.0;
-    let (a, prepare_ms, align_ms) = match args.method.as_str() {
+    let timed = match args.method.as_str() {
         "p2p" => run(
             &PointToPointIcp { config: icp },
             &source,
             &target,
             &args.init,
+            args.repeat,
         )?,
         "p2plane" => run(
             &PointToPlaneIcp { config: icp },
             &source,
             &target,
             &args.init,
+            args.repeat,
         )?,
         "loam" => run(
             &LoamRegistrator { config: loam },
             &source,
             &target,
             &args.init,
+            args.repeat,
         )?,
         other => bail!("unknown method {other} (p2p, p2plane, loam)"),
     };
+    let a = &timed.alignment;
     let (t, q) = (a.pose.translation.vector, a.pose.rotation.coords);
     println!(
         "source      {} ({} points)",
@@ -197,7 +259,7 @@ fn main() -> Result<()> {
         "degeneracy  smallest/largest information eigenvalue {:.2e}",
         a.min_eigenvalue_ratio
     );
-    println!("time        {prepare_ms:.1} ms prepare + {align_ms:.1} ms align");
+    print_times(&timed, args.repeat);
     if let Some(path) = &args.reference {
         let e = read_reference(path)?.inverse() * a.pose;
         println!(
