@@ -36,8 +36,9 @@ pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
     j
 }
 
-/// Each source point moved by `pose` and its nearest target point within reach, through
-/// `cache` (slot = source index), into `pairs`.
+/// Each source point moved by `pose` and its target point within reach, through `cache`
+/// (slot = source index), into `pairs`: the nearest target point when the cache answers one
+/// neighbour, the mean of its neighbours when it answers more.
 fn correspondences(
     source: &[Point3<f64>],
     target: &PreparedTarget,
@@ -46,7 +47,7 @@ fn correspondences(
     pairs: &mut Vec<Pair>,
 ) {
     pairs.clear();
-    let mut nearest = Vec::with_capacity(1);
+    let mut nearest = Vec::with_capacity(4);
     for (slot, s) in source.iter().enumerate() {
         let p = pose * s;
         if cache.nearest(slot, target, &p, &mut nearest) == Neighbours::TooFew {
@@ -55,9 +56,17 @@ fn correspondences(
         let Some(i) = nearest.first().map(|c| c.id as usize) else {
             continue;
         };
+        let q = if nearest.len() == 1 {
+            target.points[i]
+        } else {
+            let sum = nearest.iter().fold(Vector3::zeros(), |m, c| {
+                m + target.points[c.id as usize].coords
+            });
+            Point3::from(sum / nearest.len() as f64)
+        };
         pairs.push(Pair {
             p,
-            q: target.points[i],
+            q,
             n: target.normal(i),
         });
     }
@@ -116,8 +125,11 @@ fn update<S: IcpStep>(
     ))
 }
 
+/// ICP from `initial`, pairing each source point with the mean of its `pair_points` nearest
+/// target points (1: the nearest, as textbook ICP).
 pub(crate) fn align<S: IcpStep>(
     config: &IcpConfig,
+    pair_points: usize,
     source: &[Point3<f64>],
     target: &PreparedTarget,
     initial: &Pose3,
@@ -155,14 +167,20 @@ pub(crate) fn align<S: IcpStep>(
             }
         }
     }
-    // The nearest target point of each source point, and three more: later iterations reuse
-    // them while they provably stay nearest.
+    // The k nearest target points of each source point, and more (4 at least): later
+    // iterations reuse them while they provably stay nearest.
     // Searches look half the reach (or two target voxels) away first, where the tree prunes
     // more: the HDL-32E pair aligns in 12.8 ms instead of 13.2 ms.
     let first_radius =
         (0.5 * config.max_correspondence_distance).max(2.0 * f64::from(config.target_voxel));
-    let mut cache = NeighbourCache::new(source.len(), 1, 4, config.max_correspondence_distance)
-        .with_first_radius(first_radius);
+    let k = pair_points.clamp(1, 16);
+    let mut cache = NeighbourCache::new(
+        source.len(),
+        k,
+        (2 * k).max(4),
+        config.max_correspondence_distance,
+    )
+    .with_first_radius(first_radius);
     for _ in 0..config.max_iterations {
         iterations += 1;
         correspondences(source, target, &pose, &mut cache, &mut pairs);

@@ -76,7 +76,7 @@ impl Registrator for PointToPlaneIcp {
         target: &Self::Target,
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError> {
-        align::<GaussNewtonPlane>(&self.config, source, target, initial)
+        align::<GaussNewtonPlane>(&self.config, 1, source, target, initial)
     }
 }
 

@@ -88,7 +88,13 @@ impl Registrator for PointToPointIcp {
         target: &Self::Target,
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError> {
-        align::<Svd>(&self.config, source, target, initial)
+        align::<Svd>(
+            &self.config,
+            self.config.pair_target_points,
+            source,
+            target,
+            initial,
+        )
     }
 }
 

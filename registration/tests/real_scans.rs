@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{error, here, random_halves, reference, target_scan};
+use common::{error, here, random_halves, random_halves_with, reference, target_scan};
 use nalgebra::Point3;
 use registration::{IcpConfig, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
@@ -49,13 +49,12 @@ fn random_halves_of_a_real_scan() {
     );
 }
 
-/// The same with point-to-point ICP. Known gap: on this ring-structured scan point-to-point pairs
-/// snap to neighbouring laser rings and the rotation ends about 0.14 degrees off (translation
-/// about 1 mm), short of the 0.1 degree target; run with `--ignored` to see the figure.
+/// The same with point-to-point ICP on every point, over three random splits and three known
+/// transforms (up to 0.45 m and 10 degrees). Each source point pairs with the midpoint of its two
+/// nearest target points (the default `pair_target_points`): textbook nearest-point pairs end
+/// 0.13-0.14 degrees off here, pulled onto the other half's sampling lattice.
 #[test]
-#[ignore = "known gap: point-to-point ends 0.14 degrees off on ring-structured halves"]
 fn random_halves_point_to_point() {
-    let (source, target, truth) = random_halves();
     let dense = IcpConfig {
         source_voxel: 0.0,
         target_voxel: 0.0,
@@ -63,19 +62,34 @@ fn random_halves_point_to_point() {
         max_iterations: 200,
         ..IcpConfig::default()
     };
-    let (rot, trans) = error(
-        &truth,
-        &run(
-            &PointToPointIcp { config: dense },
-            &source,
-            &target,
-            &Pose3::identity(),
-        ),
-    );
-    assert!(
-        rot < 0.1 && trans < 0.01,
-        "point-to-point: {rot} deg, {trans} m"
-    );
+    let truths = [
+        pose3_from_xyz_rpy(0.4, -0.25, 0.1, 0.03, -0.05, 10f64.to_radians()),
+        pose3_from_xyz_rpy(-0.3, 0.35, -0.05, -0.04, 0.02, -8f64.to_radians()),
+        pose3_from_xyz_rpy(0.1, 0.45, 0.0, 0.08, 0.05, 4f64.to_radians()),
+    ];
+    for truth in &truths {
+        for seed in [
+            0x1234_5678_9ABC_DEF1,
+            0xDEAD_BEEF_1234_5677,
+            0x0F0F_1234_AAAA_5551,
+        ] {
+            let (source, target) = random_halves_with(seed, truth);
+            let (rot, trans) = error(
+                truth,
+                &run(
+                    &PointToPointIcp { config: dense },
+                    &source,
+                    &target,
+                    &Pose3::identity(),
+                ),
+            );
+            eprintln!("point-to-point halves: {rot:.3} deg, {:.2} mm", trans * 1e3);
+            assert!(
+                rot < 0.1 && trans < 0.01,
+                "point-to-point: {rot} deg, {trans} m"
+            );
+        }
+    }
 }
 
 /// `small_gicp`'s HDL-32E pair against its reference pose, from identity and from 1 m and 10
@@ -145,14 +159,15 @@ fn coarse_stage_ends_at_the_same_pose() {
     }
 }
 
-/// Within 0.01 degrees and 0.2 mm of each other.
+/// Within 0.01 degrees and 1 mm of each other (both stop once a step moves less than 0.1 mm,
+/// so where they stop depends a little on the way there).
 fn same_pose(what: &str, a: &Pose3, b: &Pose3) {
     let (rot, trans) = error(a, b);
     eprintln!(
         "{what}, coarse stage or not: {rot:.4} deg, {:.2} mm",
         trans * 1e3
     );
-    assert!(rot < 0.01 && trans < 0.0002, "{what}: {rot} deg, {trans} m");
+    assert!(rot < 0.01 && trans < 0.001, "{what}: {rot} deg, {trans} m");
 }
 
 #[test]

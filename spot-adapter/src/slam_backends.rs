@@ -35,6 +35,9 @@ fn assemble<R: MapRegistrator>(
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
+            // The thesis' check: textbook nearest-point pairs, whose mean squared error the
+            // acceptance threshold was set on.
+            pair_target_points: 1,
             ..IcpConfig::default()
         },
     };

@@ -35,8 +35,16 @@ pub fn error(a: &Pose3, b: &Pose3) -> (f64, f64) {
 /// A real scan split into two random halves (not even/odd: the lasers interleave), the source
 /// half moved by a known transform: (source, target, `target_T_source`).
 pub fn random_halves() -> (PointCloud, PointCloud, Pose3) {
+    let truth = pose3_from_xyz_rpy(0.4, -0.25, 0.1, 0.03, -0.05, 10f64.to_radians());
+    let (source, target) = random_halves_with(0x1234_5678_9ABC_DEF1, &truth);
+    (source, target, truth)
+}
+
+/// The scan split by coin flips from `seed` (xorshift, not 0), the source half moved by
+/// `truth` (`target_T_source`): (source, target).
+pub fn random_halves_with(seed: u64, truth: &Pose3) -> (PointCloud, PointCloud) {
     let scan = target_scan();
-    let mut s: u64 = 0x1234_5678_9ABC_DEF1;
+    let mut s = seed;
     let mut coin = move || {
         s ^= s << 13;
         s ^= s >> 7;
@@ -51,11 +59,9 @@ pub fn random_halves() -> (PointCloud, PointCloud, Pose3) {
             b.push(p);
         }
     }
-    let truth = pose3_from_xyz_rpy(0.4, -0.25, 0.1, 0.03, -0.05, 10f64.to_radians());
     (
         PointCloud::from_points(b).transformed(&truth.inverse()),
         PointCloud::from_points(a),
-        truth,
     )
 }
 
