@@ -4,7 +4,8 @@
 //! [`slam_core::MapRegistrator`]:
 //!
 //! - [`PointToPointIcp`]: closed-form weighted SVD step per iteration (Besl & McKay 1992; Arun
-//!   et al. 1987).
+//!   et al. 1987), each source point paired with the midpoint of its two nearest target points
+//!   by default (textbook nearest-point pairs snap onto the target's sampling lattice).
 //! - [`PointToPlaneIcp`]: Gauss-Newton on SE(3) against target normals from PCA (Chen & Medioni
 //!   1992), with Huber or Tukey weights (thesis eq. 4.7).
 //! - [`LoamFeatures`] + [`LoamRegistrator`]: LOAM (Zhang & Singh 2014, thesis section 4.1.1):
@@ -12,7 +13,9 @@
 //!   cloud's ring field or from a [`LidarLayout`]; edges matched to lines and planar points to
 //!   planes fitted to their nearest target features, Tukey-weighted Gauss-Newton (eq. 4.7).
 //!
-//! ICP correspondences come from `kiddo`'s immutable k-d tree, built once per target; LOAM's come
+//! Both ICP backends first align a quarter of the source points with plain nearest searches,
+//! then all of them. ICP correspondences come from `kiddo`'s immutable k-d tree, built once per
+//! target; LOAM's come
 //! from a [`VoxelHashMap`] (exact k-nearest in hashed cells), which a sliding local map can be
 //! updated in place. Both reuse a point's neighbours across iterations while the triangle
 //! inequality proves them still nearest, so most iterations run no search. Every result
