@@ -12,21 +12,7 @@ import time
 import numpy as np
 import small_gicp
 
-
-def read_ply_xyz(path):
-    with open(path, "rb") as f:
-        n = 0
-        props = []
-        while True:
-            line = f.readline().decode().strip()
-            if line.startswith("element vertex"):
-                n = int(line.split()[-1])
-            elif line.startswith("property"):
-                props.append(line.split()[-1])
-            elif line == "end_header":
-                break
-        data = np.frombuffer(f.read(n * 4 * len(props)), dtype=np.float32).reshape(n, len(props))
-    return data[:, :3].astype(np.float64)
+from ply_xyz import read_ply_xyz
 
 
 source_path, target_path, reference_path = sys.argv[1:4]

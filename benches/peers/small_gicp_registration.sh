@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # small_gicp 1.0.1 (PyPI) point-to-plane ICP on the HDL-32E pair, beside spot-nav's in the same run.
 # Usage: bash benches/peers/small_gicp_registration.sh
+# Prints the two times run in turns, then both sides' errors against exact ground truth (random
+# halves of a real scan, one moved by a known transform: small_gicp_halves.py).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 venv=target/peers/small-gicp-venv
@@ -35,3 +37,7 @@ ob=$(min "${our_bests[@]}"); om=$(median "${our_medians[@]}")
 echo "small_gicp: best $pb ms, median of round medians $pm ms; ours: best $ob ms, median $om ms"
 awk -v pb="$pb" -v pm="$pm" -v ob="$ob" -v om="$om" \
     'BEGIN { printf "ours / small_gicp: best %.2f, median %.2f\n", ob / pb, om / pm }'
+work=$(mktemp -d)
+"$venv/bin/python" benches/peers/small_gicp_halves.py \
+    slam-core/tests/data/hdl32e_pair_target.ply target/release/examples/register "$work"
+rm -rf "$work"
