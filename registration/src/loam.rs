@@ -503,6 +503,14 @@ impl MapRegistrator for LoamRegistrator {
     ) -> Result<Self::Target, RegistrationError> {
         let c = &self.config;
         let mut target = c.empty_target(c.local_map_edge_voxel, c.local_map_plane_voxel)?;
+        // Keyframes of a local map overlap: of the simulated Spot's 40-keyframe map, 57 % of the
+        // edge and 23 % of the planar points land in voxels of their own. Room for half of them
+        // saves the rehashes.
+        let (edges, planes) = parts.iter().fold((0, 0), |(e, p), (f, _)| {
+            (e + f.edge_map.len(), p + f.plane_map.len())
+        });
+        target.edges.reserve(edges / 2);
+        target.planes.reserve(planes / 2);
         for (owner, (features, pose)) in (0u32..).zip(parts) {
             add_features(&mut target, owner, features, pose);
         }

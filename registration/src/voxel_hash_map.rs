@@ -6,18 +6,24 @@
 use nalgebra::Point3;
 use rustc_hash::FxHashMap;
 use slam_core::RegistrationError;
+use std::collections::hash_map::Entry as MapEntry;
 
 use crate::neighbour_cache::{Candidate, NearestSearch};
 
 /// One stored point: f32 coordinates (half the memory traffic of f64; a local map spans far less
-/// than the kilometres where f32 would lose millimetres), the owner that added it and its
-/// thinning voxel, named by the low 10 bits of each voxel coordinate (unique within a cell,
-/// which spans far fewer than 1024 voxels).
+/// than the kilometres where f32 would lose millimetres) and the owner that added it.
 #[derive(Clone, Copy, Debug)]
 struct Entry {
     p: [f32; 3],
     owner: u32,
-    voxel: u32,
+}
+
+/// What one owner put in the map: the cells it added points to (possibly since overwritten by a
+/// newer owner), and the voxels it stands in for.
+#[derive(Clone, Debug, Default)]
+struct Touched {
+    cells: Vec<u64>,
+    standins: Vec<u64>,
 }
 
 /// Points in cubic cells of a hash map, for exact k-nearest-neighbour queries within a radius.
@@ -26,7 +32,9 @@ struct Entry {
 /// keeps the point of the oldest owner that saw it, so that a sliding window of scans stays
 /// anchored to its oldest scan instead of chaining each scan to the previous one; when that
 /// owner is removed, the newest other owner that saw the voxel takes over, so the voxels held
-/// are always those some remaining owner saw. A query searches the query's cell and
+/// are always those some remaining owner saw. Voxels are keyed map-wide (21 bits per axis: two
+/// voxels 2^21 voxels apart, 105 km at 5 cm, would count as one), so an insertion finds its
+/// voxel in one lookup. A query searches the query's cell and
 /// then rings of cells around it, skipping every cell farther than the current k-th neighbour, and
 /// stops as soon as no unsearched cell can hold a nearer point: the answer equals a brute-force
 /// search's (ties aside).
@@ -52,11 +60,14 @@ pub struct VoxelHashMap {
     cell: f64,
     inv_cell: f64,
     thin: f64,
+    inv_thin: f64,
     cells: FxHashMap<u64, Vec<Entry>>,
-    /// Per cell, for voxels held by an older owner: the newest other owner's point.
-    standins: FxHashMap<u64, Vec<Entry>>,
-    /// The cells each owner has put points in (possibly since overwritten by a newer owner).
-    owners: FxHashMap<u32, Vec<u64>>,
+    /// With thinning: the owner whose point holds each voxel (the point is in `cells`). Keyed
+    /// by voxel, so an insertion finds its voxel in one lookup instead of a scan of its cell.
+    held: FxHashMap<u64, u32>,
+    /// With thinning, for voxels held by an older owner: the newest other owner's point.
+    standins: FxHashMap<u64, Entry>,
+    owners: FxHashMap<u32, Touched>,
     len: usize,
 }
 
@@ -131,7 +142,7 @@ impl VoxelHashMap {
     ///
     /// # Errors
     /// [`RegistrationError::InvalidConfig`] when `cell` is not positive and finite, `thin` is
-    /// negative or not finite, or a cell would span more than 512 voxels per axis.
+    /// negative or not finite.
     pub fn new(cell: f64, thin: f64) -> Result<Self, RegistrationError> {
         if !(cell.is_finite() && cell > 0.0 && thin.is_finite() && thin >= 0.0) {
             return Err(RegistrationError::InvalidConfig(format!(
@@ -143,21 +154,27 @@ impl VoxelHashMap {
         } else {
             cell
         };
-        // Voxels are told apart by 10 bits per axis within a cell.
-        if thin > 0.0 && cell / thin > 512.0 {
-            return Err(RegistrationError::InvalidConfig(format!(
-                "voxel hash map: cell {cell} spans more than 512 voxels of {thin} per axis"
-            )));
-        }
         Ok(Self {
             cell,
             inv_cell: 1.0 / cell,
             thin,
+            inv_thin: if thin > 0.0 { 1.0 / thin } else { 0.0 },
             cells: FxHashMap::default(),
+            held: FxHashMap::default(),
             standins: FxHashMap::default(),
             owners: FxHashMap::default(),
             len: 0,
         })
+    }
+
+    /// Makes room for about `points` more points (fewer rehashes when a whole map is built at
+    /// once; a thinned map's voxels are counted as points).
+    pub fn reserve(&mut self, points: usize) {
+        if self.thin > 0.0 {
+            self.held.reserve(points);
+        }
+        // A cell holds tens of points on a surface.
+        self.cells.reserve(points / 16);
     }
 
     /// Side of a search cell (metres), after rounding to the thinning voxel.
@@ -194,38 +211,40 @@ impl VoxelHashMap {
         #[allow(clippy::cast_possible_truncation)]
         let q = [p.x as f32, p.y as f32, p.z as f32];
         let key = self.cell_key(q);
-        let voxel = if self.thin > 0.0 {
-            voxel_id(q, 1.0 / self.thin)
-        } else {
-            0
-        };
-        let entry = Entry { p: q, owner, voxel };
-        let entries = self.cells.entry(key).or_default();
-        if self.thin > 0.0
-            && let Some(held) = entries.iter().find(|e| e.voxel == voxel)
-        {
-            if held.owner == owner {
-                return false;
+        let entry = Entry { p: q, owner };
+        if self.thin > 0.0 {
+            let voxel = self.voxel_key(q);
+            match self.held.entry(voxel) {
+                MapEntry::Occupied(held) => {
+                    if *held.get() == owner {
+                        return false;
+                    }
+                    self.standins.insert(voxel, entry);
+                    let touched = self.owners.entry(owner).or_default();
+                    touched.standins.push(voxel);
+                    // A stand-in may come to hold the voxel: its owner's removal visits the cell.
+                    touch(touched, key);
+                    return true;
+                }
+                MapEntry::Vacant(free) => {
+                    free.insert(owner);
+                }
             }
-            let standins = self.standins.entry(key).or_default();
-            match standins.iter_mut().find(|e| e.voxel == voxel) {
-                Some(e) => *e = entry,
-                None => standins.push(entry),
-            }
-            self.touch(owner, key);
-            return true;
         }
-        entries.push(entry);
+        self.cells.entry(key).or_default().push(entry);
         self.len += 1;
-        self.touch(owner, key);
+        touch(self.owners.entry(owner).or_default(), key);
         true
     }
 
-    fn touch(&mut self, owner: u32, key: u64) {
-        let touched = self.owners.entry(owner).or_default();
-        if touched.last() != Some(&key) {
-            touched.push(key);
-        }
+    /// The key of the thinning voxel holding `p`.
+    fn voxel_key(&self, p: [f32; 3]) -> u64 {
+        let w = widen(p);
+        pack([
+            cell_of(w.x, self.inv_thin),
+            cell_of(w.y, self.inv_thin),
+            cell_of(w.z, self.inv_thin),
+        ])
     }
 
     /// The key of the cell holding `p`.
@@ -242,26 +261,35 @@ impl VoxelHashMap {
     /// other owner that saw it. Returns how many searchable points were removed, net of
     /// stand-ins that took their place.
     pub fn remove_owner(&mut self, owner: u32) -> usize {
-        let Some(mut keys) = self.owners.remove(&owner) else {
+        let Some(touched) = self.owners.remove(&owner) else {
             return 0;
         };
+        for voxel in touched.standins {
+            if self.standins.get(&voxel).is_some_and(|e| e.owner == owner) {
+                self.standins.remove(&voxel);
+            }
+        }
+        let mut keys = touched.cells;
         keys.sort_unstable();
         keys.dedup();
         let before = self.len;
         for key in keys {
-            let mut removed = 0;
-            let mut standins = self.standins.remove(&key).unwrap_or_default();
-            standins.retain(|e| e.owner != owner);
             let Some(mut entries) = self.cells.remove(&key) else {
                 continue;
             };
+            let mut removed = 0;
             entries.retain_mut(|e| {
                 if e.owner != owner {
                     return true;
                 }
-                if let Some(i) = standins.iter().position(|s| s.voxel == e.voxel) {
-                    *e = standins.swap_remove(i);
-                    return true;
+                if self.thin > 0.0 {
+                    let voxel = self.voxel_key(e.p);
+                    if let Some(standin) = self.standins.remove(&voxel) {
+                        self.held.insert(voxel, standin.owner);
+                        *e = standin;
+                        return true;
+                    }
+                    self.held.remove(&voxel);
                 }
                 removed += 1;
                 false
@@ -269,9 +297,6 @@ impl VoxelHashMap {
             self.len -= removed;
             if !entries.is_empty() {
                 self.cells.insert(key, entries);
-            }
-            if !standins.is_empty() {
-                self.standins.insert(key, standins);
             }
         }
         before - self.len
@@ -465,12 +490,11 @@ const RING_ONE_NEAR_FIRST: [[i32; 3]; 26] = [
     [-1, -1, -1],
 ];
 
-/// The thinning voxel of `p` at `inv` voxels per metre, as [`Entry::voxel`].
-#[allow(clippy::cast_sign_loss)]
-fn voxel_id(p: [f32; 3], inv: f64) -> u32 {
-    let w = widen(p);
-    let axis = |v: f64| cell_of(v, inv) as u32 & 0x3FF;
-    (axis(w.x) << 20) | (axis(w.y) << 10) | axis(w.z)
+/// Records that an owner put a point in cell `key` (once per run of points in one cell).
+fn touch(touched: &mut Touched, key: u64) {
+    if touched.cells.last() != Some(&key) {
+        touched.cells.push(key);
+    }
 }
 
 fn widen(p: [f32; 3]) -> Point3<f64> {

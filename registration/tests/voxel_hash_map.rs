@@ -110,6 +110,12 @@ fn thinning_keeps_the_oldest_point_and_hands_over_to_the_newest() {
     assert_eq!(map.remove_owner(1), 0, "the voxel stays held");
     let (_, p) = map.nearest(&Point3::origin(), 1.0).unwrap();
     assert!((p.x - 0.07).abs() < 1e-6, "owner 3 took over: {p}");
+    assert!(
+        !map.insert(3, &Point3::new(0.08, 0.05, 0.05)),
+        "owner 3 holds the voxel now: its first point stays"
+    );
+    let (_, p) = map.nearest(&Point3::origin(), 1.0).unwrap();
+    assert!((p.x - 0.07).abs() < 1e-6, "{p}");
     assert_eq!(map.remove_owner(2), 1);
     assert_eq!(map.remove_owner(3), 1);
     assert!(map.is_empty());
@@ -196,10 +202,15 @@ fn far_reach_over_a_sparse_map() {
 
 #[test]
 fn bad_input_is_refused_or_skipped() {
+    // Cells may span any number of voxels (2,000 per axis here): voxels are keyed map-wide.
+    let mut wide = VoxelHashMap::new(100.0, 0.05).unwrap();
+    assert!(wide.insert(1, &Point3::new(10.01, 0.01, 0.01)));
     assert!(
-        VoxelHashMap::new(100.0, 0.05).is_err(),
-        "too many voxels per cell"
+        !wide.insert(1, &Point3::new(10.02, 0.02, 0.02)),
+        "same voxel, same owner"
     );
+    assert!(wide.insert(1, &Point3::new(60.01, 0.01, 0.01)));
+    assert_eq!(wide.len(), 2);
     assert!(VoxelHashMap::new(0.0, 0.0).is_err());
     assert!(VoxelHashMap::new(f64::NAN, 0.0).is_err());
     assert!(VoxelHashMap::new(0.25, -1.0).is_err());
