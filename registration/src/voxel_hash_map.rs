@@ -239,22 +239,12 @@ impl VoxelHashMap {
 
     /// The key of the thinning voxel holding `p`.
     fn voxel_key(&self, p: [f32; 3]) -> u64 {
-        let w = widen(p);
-        pack([
-            cell_of(w.x, self.inv_thin),
-            cell_of(w.y, self.inv_thin),
-            cell_of(w.z, self.inv_thin),
-        ])
+        grid_key(p, self.inv_thin)
     }
 
     /// The key of the cell holding `p`.
     fn cell_key(&self, p: [f32; 3]) -> u64 {
-        let w = widen(p);
-        pack([
-            cell_of(w.x, self.inv_cell),
-            cell_of(w.y, self.inv_cell),
-            cell_of(w.z, self.inv_cell),
-        ])
+        grid_key(p, self.inv_cell)
     }
 
     /// Removes every point `owner` added; a voxel it held passes to its stand-in, the newest
@@ -489,6 +479,12 @@ const RING_ONE_NEAR_FIRST: [[i32; 3]; 26] = [
     [1, -1, -1],
     [-1, -1, -1],
 ];
+
+/// The packed key of the grid box holding `p`, at `inv` boxes per metre.
+fn grid_key(p: [f32; 3], inv: f64) -> u64 {
+    let w = widen(p);
+    pack([cell_of(w.x, inv), cell_of(w.y, inv), cell_of(w.z, inv)])
+}
 
 /// Records that an owner put a point in cell `key` (once per run of points in one cell).
 fn touch(touched: &mut Touched, key: u64) {
