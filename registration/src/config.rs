@@ -1,5 +1,7 @@
 //! Settings of the ICP backends.
 
+use slam_core::RegistrationError;
+
 use crate::kernel::IcpKernel;
 
 /// Settings of [`PointToPointIcp`](crate::PointToPointIcp) and
@@ -31,8 +33,9 @@ pub struct IcpConfig {
     /// sampling lattice: two random halves of a real HDL-32E scan, one moved by a known
     /// transform, end 0.11-0.14° off with it (one azimuth step of that LiDAR is 0.16°), and
     /// 0.01-0.04° off with the default 2, which pairs a point with the midpoint of two target
-    /// samples (3 splits x 3 transforms x 4 voxel settings). Point-to-plane always pairs with
-    /// the nearest point and its normal.
+    /// samples (3 splits x 3 transforms x 4 voxel settings). A source point with fewer target
+    /// points within reach is left out. Point-to-plane always pairs with the nearest point and
+    /// its normal.
     pub pair_target_points: usize,
     /// Coarse stage: every `coarse_stride`-th source point aligns first, with one plain
     /// nearest-neighbour search per point and iteration, until an update moves less than 1 cm
@@ -59,5 +62,48 @@ impl Default for IcpConfig {
             pair_target_points: 2,
             coarse_stride: 4,
         }
+    }
+}
+
+impl IcpConfig {
+    /// Checks every setting: voxels finite and not negative; reach, kernel threshold and
+    /// tolerances finite and positive (tolerances may be 0); at least one iteration, 3 normal
+    /// neighbours, one correspondence; `pair_target_points` 1 to 16; `coarse_stride` at least 1.
+    /// Preparation and alignment call it, so a bad setting is an error, not a silent change.
+    ///
+    /// # Errors
+    /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), RegistrationError> {
+        let bad = |what: &str| Err(RegistrationError::InvalidConfig(format!("ICP: {what}")));
+        let voxel_ok = |v: f32| v.is_finite() && v >= 0.0;
+        if !(voxel_ok(self.source_voxel) && voxel_ok(self.target_voxel)) {
+            return bad("voxel sizes must be finite and not negative");
+        }
+        if !(self.max_correspondence_distance.is_finite() && self.max_correspondence_distance > 0.0)
+        {
+            return bad("max_correspondence_distance must be finite and positive");
+        }
+        let tolerance_ok = |v: f64| v.is_finite() && v >= 0.0;
+        if !(tolerance_ok(self.translation_tolerance) && tolerance_ok(self.rotation_tolerance)) {
+            return bad("tolerances must be finite and not negative");
+        }
+        if let IcpKernel::Huber { k } | IcpKernel::Tukey { k } = self.kernel
+            && !(k.is_finite() && k > 0.0)
+        {
+            return bad("kernel threshold must be finite and positive");
+        }
+        if self.max_iterations == 0 || self.min_correspondences == 0 {
+            return bad("max_iterations and min_correspondences must be at least 1");
+        }
+        if self.normal_neighbours < 3 {
+            return bad("normal_neighbours must be at least 3");
+        }
+        if !(1..=16).contains(&self.pair_target_points) {
+            return bad("pair_target_points must be 1 to 16");
+        }
+        if self.coarse_stride == 0 {
+            return bad("coarse_stride must be at least 1 (1 skips the coarse stage)");
+        }
+        Ok(())
     }
 }

@@ -134,6 +134,7 @@ pub(crate) fn align<S: IcpStep>(
     target: &PreparedTarget,
     initial: &Pose3,
 ) -> Result<Alignment, RegistrationError> {
+    config.validate()?;
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
@@ -145,7 +146,7 @@ pub(crate) fn align<S: IcpStep>(
     // Coarse stage: while the pose still moves centimetres per step, the neighbours cached
     // below would be stale after every step; a subsample with single plain searches gets
     // there for a fraction of the searches.
-    let stride = config.coarse_stride.max(1);
+    let stride = config.coarse_stride;
     if stride > 1 && source.len() / stride >= config.min_correspondences {
         for _ in 0..config.max_iterations {
             iterations += 1;
@@ -173,7 +174,7 @@ pub(crate) fn align<S: IcpStep>(
     // more: the HDL-32E pair aligns in 12.8 ms instead of 13.2 ms.
     let first_radius =
         (0.5 * config.max_correspondence_distance).max(2.0 * f64::from(config.target_voxel));
-    let k = pair_points.clamp(1, 16);
+    let k = pair_points;
     let mut cache = NeighbourCache::new(
         source.len(),
         k,

@@ -63,6 +63,7 @@ impl Registrator for PointToPlaneIcp {
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
+        self.config.validate()?;
         PreparedTarget::new(
             finite_points(cloud, self.config.target_voxel),
             Some(self.config.normal_neighbours),

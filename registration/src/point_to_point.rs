@@ -75,6 +75,7 @@ impl Registrator for PointToPointIcp {
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
+        self.config.validate()?;
         PreparedTarget::new(
             finite_points(cloud, self.config.target_voxel),
             None,

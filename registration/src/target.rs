@@ -162,6 +162,7 @@ pub(crate) fn prepare_source_points(
     config: &IcpConfig,
     cloud: &PointCloud,
 ) -> Result<Vec<Point3<f64>>, RegistrationError> {
+    config.validate()?;
     let pts = finite_points(cloud, config.source_voxel);
     if pts.len() < config.min_correspondences {
         return Err(RegistrationError::TooFewPoints {

@@ -6,7 +6,7 @@ mod common;
 
 use common::{error, here, random_halves, random_halves_with, reference, target_scan};
 use nalgebra::Point3;
-use registration::{IcpConfig, PointToPlaneIcp, PointToPointIcp};
+use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
 use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
 
@@ -168,6 +168,93 @@ fn same_pose(what: &str, a: &Pose3, b: &Pose3) {
         trans * 1e3
     );
     assert!(rot < 0.01 && trans < 0.001, "{what}: {rot} deg, {trans} m");
+}
+
+/// Every bad setting is refused by preparation and by alignment, never silently changed.
+#[test]
+fn invalid_settings_are_errors() {
+    let cloud = target_scan();
+    let good = IcpConfig::default();
+    let p2p = PointToPointIcp { config: good };
+    let (source, target) = (
+        p2p.prepare_source(&cloud).unwrap(),
+        p2p.prepare_target(&cloud).unwrap(),
+    );
+    let bad = [
+        IcpConfig {
+            source_voxel: -0.1,
+            ..good
+        },
+        IcpConfig {
+            target_voxel: f32::NAN,
+            ..good
+        },
+        IcpConfig {
+            max_correspondence_distance: 0.0,
+            ..good
+        },
+        IcpConfig {
+            max_correspondence_distance: f64::INFINITY,
+            ..good
+        },
+        IcpConfig {
+            translation_tolerance: -1.0,
+            ..good
+        },
+        IcpConfig {
+            kernel: IcpKernel::Tukey { k: 0.0 },
+            ..good
+        },
+        IcpConfig {
+            kernel: IcpKernel::Huber { k: f64::NAN },
+            ..good
+        },
+        IcpConfig {
+            max_iterations: 0,
+            ..good
+        },
+        IcpConfig {
+            normal_neighbours: 2,
+            ..good
+        },
+        IcpConfig {
+            pair_target_points: 0,
+            ..good
+        },
+        IcpConfig {
+            pair_target_points: 17,
+            ..good
+        },
+        IcpConfig {
+            coarse_stride: 0,
+            ..good
+        },
+    ];
+    let invalid =
+        |r: Result<_, RegistrationError>| matches!(r, Err(RegistrationError::InvalidConfig(_)));
+    for config in bad {
+        let (plane, point) = (PointToPlaneIcp { config }, PointToPointIcp { config });
+        assert!(
+            invalid(plane.prepare_source(&cloud).map(|_| ())),
+            "{config:?}"
+        );
+        assert!(
+            invalid(plane.prepare_target(&cloud).map(|_| ())),
+            "{config:?}"
+        );
+        assert!(
+            invalid(point.prepare_target(&cloud).map(|_| ())),
+            "{config:?}"
+        );
+        assert!(
+            invalid(
+                point
+                    .align(&source, &target, &Pose3::identity())
+                    .map(|_| ())
+            ),
+            "{config:?}"
+        );
+    }
 }
 
 #[test]
