@@ -52,6 +52,7 @@
 mod alignment;
 mod ate;
 mod building;
+mod commanded_spot;
 mod drift;
 mod error;
 mod evaluation;
@@ -59,6 +60,7 @@ mod floor_plan;
 mod frames;
 mod kitti;
 mod lidar;
+mod navigator;
 mod odometry;
 mod ray_cast;
 mod recording;
@@ -72,6 +74,7 @@ mod slam_backends;
 pub use alignment::align_rigid;
 pub use ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
 pub use building::{BoxKind, Building, BuildingConfig, Room, SolidBox};
+pub use commanded_spot::{CommandedSpot, MAX_YAW_RATE, VelocityCommand};
 pub use drift::{
     EndPointDrift, INDOOR_SEGMENT_LENGTHS, KITTI_SEGMENT_LENGTHS, SegmentDrift, end_point_drift,
     loop_end_point_error, path_length, segment_drift,
@@ -82,6 +85,7 @@ pub use floor_plan::OBSTACLE_HEIGHT;
 pub use frames::{GaitSway, SpotGeometry};
 pub use kitti::{KittiOdometry, KittiSequence};
 pub use lidar::{Vlp16, Vlp16Config};
+pub use navigator::{NavigationStep, Navigator, NavigatorConfig};
 pub use odometry::{OdometryDriftConfig, OdometryModel};
 pub use ray_cast::{HitTarget, RayHit};
 pub use recording::{Recording, RecordingSamples, RecordingWriter};

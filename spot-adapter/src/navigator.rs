@@ -1,0 +1,271 @@
+//! `Navigator`: walks the robot to a goal in a mapped building. Each cycle it localises the live
+//! scan against the map, replans on the map's occupancy grid, and turns the first leg of the
+//! filtered path into a velocity command (DESIGN.md's last stage).
+
+use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
+use nalgebra::Vector2;
+use pathfind::{JumpPointSearch, filter_path};
+use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
+
+use crate::commanded_spot::{MAX_YAW_RATE, VelocityCommand};
+use crate::error::AdapterError;
+use crate::sample::Sample;
+
+/// Settings of [`Navigator`]. Lengths in metres, angles in radians, speeds per second.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavigatorConfig {
+    /// The occupancy grid of the map (0.10 m cells, the slice 0.2 m either side of the LiDAR).
+    pub grid: OccupancyGridConfig,
+    /// Obstacles are inflated by this much: the robot's half width (0.25 m) and a margin for
+    /// localisation and control error, 0.40 m.
+    pub clearance: f64,
+    /// Arrived when the body is this close to the goal, 0.20 m.
+    pub goal_tolerance: f64,
+    /// Turn in place while the heading error to the next waypoint exceeds this, 0.5 (29°).
+    pub turn_in_place_above: f64,
+    /// Walking speed, 0.6 m/s (the simulated Spot's).
+    pub speed: f64,
+    /// Turn rate per radian of heading error, 1.5 /s (capped at Spot's 1 rad/s).
+    pub heading_gain: f64,
+}
+
+impl Default for NavigatorConfig {
+    fn default() -> Self {
+        Self {
+            grid: OccupancyGridConfig::default(),
+            clearance: 0.40,
+            goal_tolerance: 0.20,
+            turn_in_place_above: 0.5,
+            speed: 0.6,
+            heading_gain: 1.5,
+        }
+    }
+}
+
+/// What the navigator decided this cycle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NavigationStep {
+    /// Walk: hold this command until the next scan.
+    Walk(VelocityCommand),
+    /// The body is within the goal tolerance: stop.
+    Arrived,
+    /// No collision-free path joins the robot and the goal on the map (an answer, not a
+    /// failure): stop.
+    NoPath,
+}
+
+/// Walks the robot to goals in a mapped building (map frame = the map cloud's frame).
+///
+/// Each [`Navigator::step`] predicts the body pose from the odometry since the previous scan,
+/// corrects it by registering the scan against the map (prepared once), replans with
+/// [`JumpPointSearch`] on the map's inflated occupancy grid and keeps the turning points that a
+/// straight collision-free segment cannot skip ([`filter_path`]); then it turns in place while
+/// the heading error to the next waypoint is large, and otherwise walks toward it steering
+/// proportionally. A goal that cannot be reached is answered with [`NavigationStep::NoPath`];
+/// nothing loops forever.
+pub struct Navigator<R: Registrator> {
+    config: NavigatorConfig,
+    registrator: R,
+    map: R::Target,
+    grid: BitGrid,
+    map_t_body: Pose3,
+    last_odom_t_body: Option<Pose3>,
+    waypoints: Vec<Vector2<f64>>,
+    localisation_failures: usize,
+}
+
+impl<R: Registrator> Navigator<R> {
+    /// A navigator on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) whose LiDAR sits
+    /// `lidar_height` above the map frame's origin, localising with `registrator`, starting from
+    /// `map_t_body`.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for invalid settings, a map the registrator refuses or an
+    /// occupancy grid that cannot be built.
+    pub fn new(
+        registrator: R,
+        map: &PointCloud,
+        lidar_height: f64,
+        map_t_body: Pose3,
+        config: NavigatorConfig,
+    ) -> Result<Self, AdapterError> {
+        let positive = [
+            config.clearance,
+            config.goal_tolerance,
+            config.turn_in_place_above,
+            config.speed,
+            config.heading_gain,
+        ];
+        if !positive.iter().all(|v| v.is_finite() && *v > 0.0) {
+            return Err(AdapterError::InvalidConfig(format!(
+                "navigator settings must be finite and positive: {config:?}"
+            )));
+        }
+        let invalid = |what: &str, e: &dyn std::fmt::Display| {
+            AdapterError::InvalidConfig(format!("navigator {what}: {e}"))
+        };
+        let occupancy = OccupancyGridBuilder::new(config.grid.clone())
+            .and_then(|b| b.build(map, lidar_height))
+            .map_err(|e| invalid("grid", &e))?;
+        let grid = inflate(occupancy.occupied(), config.clearance);
+        let target = registrator
+            .prepare_target(map)
+            .map_err(|e| invalid("map", &e))?;
+        Ok(Self {
+            config,
+            registrator,
+            map: target,
+            grid,
+            map_t_body,
+            last_odom_t_body: None,
+            waypoints: Vec::new(),
+            localisation_failures: 0,
+        })
+    }
+
+    /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame, metres).
+    pub fn step(&mut self, sample: &Sample, goal: Vector2<f64>) -> NavigationStep {
+        self.localise(sample);
+        let position = self.map_t_body.translation.vector.xy();
+        if (goal - position).norm() <= self.config.goal_tolerance {
+            self.waypoints.clear();
+            return NavigationStep::Arrived;
+        }
+        let Some(waypoints) = self.plan(position, goal) else {
+            self.waypoints.clear();
+            return NavigationStep::NoPath;
+        };
+        self.waypoints = waypoints;
+        NavigationStep::Walk(self.command(position))
+    }
+
+    /// Predict from the odometry, then correct by registration (the prediction stands when the
+    /// registration fails or does not converge).
+    fn localise(&mut self, sample: &Sample) {
+        if let Some(last) = self.last_odom_t_body.replace(sample.odom_t_body) {
+            self.map_t_body *= last.inverse() * sample.odom_t_body;
+        }
+        let guess = self.map_t_body * sample.body_t_lidar;
+        let aligned = self
+            .registrator
+            .prepare_source(&sample.cloud)
+            .and_then(|s| self.registrator.align(&s, &self.map, &guess));
+        match aligned {
+            Ok(a) if a.converged => self.map_t_body = a.pose * sample.body_t_lidar.inverse(),
+            _ => self.localisation_failures += 1,
+        }
+    }
+
+    /// Waypoints (metres) from `position` to `goal` after the start, or `None` when none joins
+    /// them. A start inside the inflated obstacles (the robot brushed a wall) plans from the
+    /// nearest free cell.
+    fn plan(&self, position: Vector2<f64>, goal: Vector2<f64>) -> Option<Vec<Vector2<f64>>> {
+        let goal_cell = self
+            .grid
+            .cell_at(goal)
+            .filter(|&c| !self.grid.is_blocked(c))?;
+        let start = nearest_free(&self.grid, self.grid.cell_at(position)?)?;
+        // Both ends are on the grid and free: `NoPath` is the only error left.
+        let path = JumpPointSearch::new(&self.grid)
+            .plan(start, goal_cell)
+            .ok()?;
+        let filtered = filter_path(&self.grid, &path);
+        let mut waypoints: Vec<Vector2<f64>> = filtered
+            .waypoints
+            .iter()
+            .skip(1)
+            .map(|&c| self.grid.cell_center(c))
+            .collect();
+        // The goal itself, not its cell's centre, ends the path.
+        if let Some(last) = waypoints.last_mut() {
+            *last = goal;
+        } else {
+            waypoints.push(goal);
+        }
+        Some(waypoints)
+    }
+
+    /// The command toward the first waypoint that is not already underfoot.
+    fn command(&self, position: Vector2<f64>) -> VelocityCommand {
+        let near = 0.5 * self.config.goal_tolerance;
+        let target = self
+            .waypoints
+            .iter()
+            .find(|w| (*w - position).norm() > near)
+            .or(self.waypoints.last())
+            .copied()
+            .unwrap_or(position);
+        let to = target - position;
+        let yaw = self.map_t_body.rotation.euler_angles().2;
+        let error = wrap(to.y.atan2(to.x) - yaw);
+        let yaw_rate = (self.config.heading_gain * error).clamp(-MAX_YAW_RATE, MAX_YAW_RATE);
+        if error.abs() > self.config.turn_in_place_above {
+            return VelocityCommand {
+                forward: 0.0,
+                yaw_rate,
+            };
+        }
+        // Slow down for the last metre so that one 0.2 s step cannot overshoot the tolerance.
+        let remaining: f64 = self.waypoints.last().map_or(0.0, |g| (g - position).norm());
+        VelocityCommand {
+            forward: self.config.speed.min(remaining) * error.cos(),
+            yaw_rate,
+        }
+    }
+
+    /// The current estimate of the body pose in the map frame.
+    #[must_use]
+    pub fn pose(&self) -> Pose3 {
+        self.map_t_body
+    }
+
+    /// The planned waypoints (metres) after the robot's position, ending at the goal.
+    #[must_use]
+    pub fn waypoints(&self) -> &[Vector2<f64>] {
+        &self.waypoints
+    }
+
+    /// The planning grid: the map's occupancy with obstacles inflated by the clearance.
+    #[must_use]
+    pub fn grid(&self) -> &BitGrid {
+        &self.grid
+    }
+
+    /// Cycles whose registration failed or did not converge (the odometry's prediction stood).
+    #[must_use]
+    pub fn localisation_failures(&self) -> usize {
+        self.localisation_failures
+    }
+}
+
+/// `angle` wrapped to (-pi, pi].
+fn wrap(angle: f64) -> f64 {
+    let a = angle.rem_euclid(std::f64::consts::TAU);
+    if a > std::f64::consts::PI {
+        a - std::f64::consts::TAU
+    } else {
+        a
+    }
+}
+
+/// `cell` when free, else the nearest free cell within 1 m at 0.10 m cells (rings of growing
+/// Chebyshev radius, nearest centre first within a ring).
+fn nearest_free(grid: &BitGrid, cell: Cell) -> Option<Cell> {
+    if !grid.is_blocked(cell) {
+        return Some(cell);
+    }
+    let (cx, cy) = (i64::from(cell.x), i64::from(cell.y));
+    for r in 1..=10i64 {
+        let ring = (-r..=r)
+            .flat_map(|dx| (-r..=r).map(move |dy| (dx, dy)))
+            .filter(|&(dx, dy)| dx.abs() == r || dy.abs() == r);
+        let best = ring
+            .filter(|&(dx, dy)| grid.is_free_signed(cx + dx, cy + dy))
+            .min_by_key(|&(dx, dy)| dx * dx + dy * dy);
+        if let Some((dx, dy)) = best {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            return Some(Cell::new((cx + dx) as u32, (cy + dy) as u32));
+        }
+    }
+    None
+}
