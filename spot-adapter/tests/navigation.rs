@@ -41,7 +41,8 @@ fn localiser() -> PointToPlaneIcp {
 }
 
 /// Runs the navigator from `start` (facing `yaw`) to `goal` for at most `cycles` scans; returns
-/// the final step, the robot, and the largest localisation error seen (metres).
+/// the final step, the robot, the largest localisation error seen and the distance walked
+/// (metres), and the cycles run.
 fn run(
     building: &Building,
     map: &PointCloud,
@@ -49,7 +50,7 @@ fn run(
     yaw: f64,
     goal: Vector2<f64>,
     cycles: usize,
-) -> (NavigationStep, CommandedSpot, f64) {
+) -> (NavigationStep, CommandedSpot, f64, f64, usize) {
     let config = SimulationConfig::default();
     let mut spot = CommandedSpot::new(building.clone(), start, yaw, &config).unwrap();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
@@ -62,8 +63,8 @@ fn run(
     )
     .unwrap();
     let mut sample = spot.sense();
-    let mut worst: f64 = 0.0;
-    for _ in 0..cycles {
+    let (mut worst, mut walked): (f64, f64) = (0.0, 0.0);
+    for cycle in 0..cycles {
         let step = nav.step(&sample, goal);
         let truth = sample.ground_truth.unwrap();
         worst = worst.max(
@@ -72,14 +73,20 @@ fn run(
                 .norm(),
         );
         match step {
-            NavigationStep::Walk(command) => sample = spot.step(command),
-            done => return (done, spot, worst),
+            NavigationStep::Walk(command) => {
+                let before = spot.position();
+                sample = spot.step(command);
+                walked += (spot.position() - before).norm();
+            }
+            done => return (done, spot, worst, walked, cycle),
         }
     }
     (
         NavigationStep::Walk(VelocityCommand::default()),
         spot,
         worst,
+        walked,
+        cycles,
     )
 }
 
@@ -96,11 +103,14 @@ fn walks_into_rooms_without_touching_anything() {
         .max_by(|a, b| (a.door - start).norm().total_cmp(&(b.door - start).norm()))
         .unwrap();
     let goal = far.entry_point();
-    let (step, spot, worst) = run(&building, &map, start, 0.0, goal, 1500);
+    let (step, spot, worst, walked, cycles) = run(&building, &map, start, 0.0, goal, 1500);
     eprintln!(
-        "to ({:.2}, {:.2}): {step:?}, ended {:.3} m from the goal, {} collisions, localisation error up to {:.3} m",
+        "({:.2}, {:.2}) to ({:.2}, {:.2}), {:.1} m apart: {step:?} after {cycles} scans and {walked:.1} m, ended {:.3} m from the goal, {} collisions, localisation error up to {:.3} m",
+        start.x,
+        start.y,
         goal.x,
         goal.y,
+        (goal - start).norm(),
         (spot.position() - goal).norm(),
         spot.collisions(),
         worst
@@ -121,7 +131,7 @@ fn unreachable_goals_are_answered() {
     let (building, map) = building_and_map();
     let start = building.corridor_loop()[0];
     let outside = Vector2::new(-5.0, -5.0);
-    let (step, spot, _) = run(&building, &map, start, 0.0, outside, 5);
+    let (step, spot, ..) = run(&building, &map, start, 0.0, outside, 5);
     assert_eq!(step, NavigationStep::NoPath);
     assert_eq!(spot.position(), start);
 }
