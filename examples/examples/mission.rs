@@ -19,13 +19,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use nalgebra::{Point3, Vector2};
-use registration::{IcpConfig, IcpKernel, PointToPlaneIcp};
+use registration::PointToPlaneIcp;
 use slam_core::io::{PlyEncoding, write_ply};
 use slam_core::{Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
 use spot_adapter::{
     CommandedSpot, DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, NavigationStep, Navigator,
     NavigatorConfig, SimulatedSpot, SimulationConfig, TrajectoryEvaluation, body_trajectory,
-    loam_slam, point_to_plane_slam, slam_config,
+    loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
 
 const USAGE: &str =
@@ -256,20 +256,12 @@ fn main() -> Result<()> {
         .coords
         .xy();
     let mut spot = CommandedSpot::new(building, start, lap_end.rotation.euler_angles().2, &config)?;
-    let localiser = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.1 },
-            max_correspondence_distance: 0.5,
-            coarse_stride: 1,
-            ..IcpConfig::default()
-        },
-    };
     // The map frame's origin is the body at the lap's start: the LiDAR sits its mounting height
     // above it.
     let lidar_height = config.spot.body_t_lidar.translation.z;
     let started = Instant::now();
     let mut nav = Navigator::new(
-        localiser,
+        point_to_plane_tracker(),
         &mapped.map,
         lidar_height,
         mapped.map_t_body,

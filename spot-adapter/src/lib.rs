@@ -94,4 +94,6 @@ pub use route::Route;
 pub use route_planner::RouteConfig;
 pub use sample::Sample;
 pub use simulator::{SimulatedSpot, SimulationConfig};
-pub use slam_backends::{LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_slam, slam_config};
+pub use slam_backends::{
+    LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
+};

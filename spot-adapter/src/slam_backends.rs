@@ -50,20 +50,27 @@ fn assemble<R: MapRegistrator>(
     )
 }
 
-/// Point-to-plane odometry (Tukey 10 cm, pairs within 0.5 m) against the local map, and
+/// Point-to-plane ICP for tracking a scan against a map from a guess centimetres off (the
+/// SLAM odometry's, and the navigator's localisation): Tukey 10 cm, pairs within 0.5 m, no coarse
+/// stage.
+#[must_use]
+pub fn point_to_plane_tracker() -> PointToPlaneIcp {
+    PointToPlaneIcp {
+        config: IcpConfig {
+            kernel: IcpKernel::Tukey { k: 0.1 },
+            max_correspondence_distance: 0.5,
+            coarse_stride: 1,
+            ..IcpConfig::default()
+        },
+    }
+}
+
+/// Point-to-plane odometry ([`point_to_plane_tracker`]) against the local map, and
 /// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m), with `config` (usually
 /// [`slam_config`]).
 #[must_use]
 pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
-    let odometry = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.1 },
-            max_correspondence_distance: 0.5,
-            // The engine's guesses are centimetres off: no coarse stage needed.
-            coarse_stride: 1,
-            ..IcpConfig::default()
-        },
-    };
+    let odometry = point_to_plane_tracker();
     let refine = PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.10 },

@@ -5,11 +5,10 @@
 #![allow(clippy::unwrap_used)]
 
 use nalgebra::Vector2;
-use registration::{IcpConfig, IcpKernel, PointToPlaneIcp};
 use slam_core::PointCloud;
 use spot_adapter::{
     Building, CommandedSpot, NavigationStep, Navigator, NavigatorConfig, SimulatedSpot,
-    SimulationConfig, VelocityCommand,
+    SimulationConfig, VelocityCommand, point_to_plane_tracker,
 };
 
 /// The building of seed 3 and a map of it: every 4th scan of one lap, at its true pose, thinned
@@ -29,17 +28,6 @@ fn building_and_map() -> (Building, PointCloud) {
     (building, map)
 }
 
-fn localiser() -> PointToPlaneIcp {
-    PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.1 },
-            max_correspondence_distance: 0.5,
-            coarse_stride: 1,
-            ..IcpConfig::default()
-        },
-    }
-}
-
 /// Runs the navigator from `start` (facing `yaw`) to `goal` for at most `cycles` scans; returns
 /// the final step, the robot, the largest localisation error seen and the distance walked
 /// (metres), and the cycles run.
@@ -55,7 +43,7 @@ fn run(
     let mut spot = CommandedSpot::new(building.clone(), start, yaw, &config).unwrap();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let mut nav = Navigator::new(
-        localiser(),
+        point_to_plane_tracker(),
         map,
         lidar_height,
         spot.body_pose(),
