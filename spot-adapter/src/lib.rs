@@ -2,7 +2,8 @@
 //!
 //! Everything between a Spot robot and the SLAM engine: the [`Sample`] every source delivers
 //! (stamp, `odom_T_body`, `body_T_lidar`, cloud), a simulated Spot that needs no hardware,
-//! recordings on disk, a reader for KITTI-style folders, and the evaluation of trajectories.
+//! recordings on disk, a reader for KITTI-style folders, the evaluation of trajectories, and the
+//! navigator that walks the robot to goals on the map.
 //!
 //! - [`Building`]: a procedurally generated office floor from a seed (ring corridor, rooms,
 //!   doors, pilasters, pillars, furniture, floor and ceiling) as axis-aligned boxes with a
@@ -13,6 +14,12 @@
 //! - [`OdometryModel`]: Spot's leg odometry, drifting 1.9 % of the distance walked.
 //! - [`Route`]: the corridor loop or a planned route between two points, walked at 0.6 m/s.
 //! - [`SimulatedSpot`]: all of the above as an iterator of [`Sample`]s with ground truth.
+//! - [`CommandedSpot`]: the same robot driven by [`VelocityCommand`]s, for closed loops.
+//! - [`Navigator`]: walks the robot to a goal on a map: localises each scan against the map,
+//!   replans with Jump Point Search on the map's inflated occupancy grid, and turns or walks
+//!   toward the next filtered waypoint.
+//! - [`point_to_plane_slam`], [`loam_slam`]: the Graph-SLAM engine put together with this
+//!   workspace's backends.
 //! - [`RecordingWriter`], [`Recording`], [`KittiSequence`]: runs on disk.
 //! - [`absolute_trajectory_error`], [`end_point_drift`], [`segment_drift`],
 //!   [`loop_end_point_error`], all at once in [`TrajectoryEvaluation`]: accuracy against ground
