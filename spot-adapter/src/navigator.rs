@@ -27,6 +27,11 @@ pub struct NavigatorConfig {
     pub speed: f64,
     /// Turn rate per radian of heading error, 1.5 /s (capped at Spot's 1 rad/s).
     pub heading_gain: f64,
+    /// A registration that moves the odometry's prediction farther than this is rejected, 0.3 m
+    /// (odometry drifts millimetres between two scans: a larger correction is a wrong match).
+    pub max_correction: f64,
+    /// ... or turns it more than this, 0.1 rad (5.7°).
+    pub max_correction_angle: f64,
 }
 
 impl Default for NavigatorConfig {
@@ -38,6 +43,8 @@ impl Default for NavigatorConfig {
             turn_in_place_above: 0.5,
             speed: 0.6,
             heading_gain: 1.5,
+            max_correction: 0.3,
+            max_correction_angle: 0.1,
         }
     }
 }
@@ -95,6 +102,8 @@ impl<R: Registrator> Navigator<R> {
             config.turn_in_place_above,
             config.speed,
             config.heading_gain,
+            config.max_correction,
+            config.max_correction_angle,
         ];
         if !positive.iter().all(|v| v.is_finite() && *v > 0.0) {
             return Err(AdapterError::InvalidConfig(format!(
@@ -140,7 +149,7 @@ impl<R: Registrator> Navigator<R> {
     }
 
     /// Predict from the odometry, then correct by registration (the prediction stands when the
-    /// registration fails or does not converge).
+    /// registration fails, does not converge, or would move it implausibly far).
     fn localise(&mut self, sample: &Sample) {
         if let Some(last) = self.last_odom_t_body.replace(sample.odom_t_body) {
             self.map_t_body *= last.inverse() * sample.odom_t_body;
@@ -150,9 +159,18 @@ impl<R: Registrator> Navigator<R> {
             .registrator
             .prepare_source(&sample.cloud)
             .and_then(|s| self.registrator.align(&s, &self.map, &guess));
-        match aligned {
-            Ok(a) if a.converged => self.map_t_body = a.pose * sample.body_t_lidar.inverse(),
-            _ => self.localisation_failures += 1,
+        let corrected = aligned
+            .ok()
+            .filter(|a| a.converged)
+            .map(|a| a.pose * sample.body_t_lidar.inverse())
+            .filter(|c| {
+                let jump = self.map_t_body.inverse() * c;
+                jump.translation.vector.norm() <= self.config.max_correction
+                    && jump.rotation.angle() <= self.config.max_correction_angle
+            });
+        match corrected {
+            Some(c) => self.map_t_body = c,
+            None => self.localisation_failures += 1,
         }
     }
 
@@ -231,7 +249,8 @@ impl<R: Registrator> Navigator<R> {
         &self.grid
     }
 
-    /// Cycles whose registration failed or did not converge (the odometry's prediction stood).
+    /// Cycles whose registration failed, did not converge or was rejected as too large a jump
+    /// (the odometry's prediction stood).
     #[must_use]
     pub fn localisation_failures(&self) -> usize {
         self.localisation_failures
