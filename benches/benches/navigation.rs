@@ -1,0 +1,76 @@
+//! The navigator's cycle on the simulated Spot (seed 3): localising one scan against the map,
+//! replanning across the building and the command, with the map built once; and the map's
+//! preparation (occupancy grid, inflation, the registrator's target).
+//!
+//! `cargo bench -p spot-nav-benches --bench navigation`
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use slam_core::PointCloud;
+use spot_adapter::{
+    CommandedSpot, Navigator, NavigatorConfig, SimulatedSpot, SimulationConfig,
+    point_to_plane_tracker,
+};
+
+fn navigation(c: &mut Criterion) {
+    let config = SimulationConfig::default();
+    let Ok(sim) = SimulatedSpot::corridor_loop(3, &config) else {
+        eprintln!("navigation bench: simulation failed; skipping");
+        return;
+    };
+    let building = sim.building().clone();
+    let body_t_lidar = sim.body_t_lidar();
+    // The map: every 4th scan of one lap at its true pose, thinned to 5 cm (as the tests).
+    let mut points = Vec::new();
+    for sample in sim.step_by(4) {
+        if let Some(truth) = sample.ground_truth {
+            points.extend_from_slice(sample.cloud.transformed(&(truth * body_t_lidar)).points());
+        }
+    }
+    let Ok(map) = PointCloud::from_points(points).voxel_downsample(0.05) else {
+        return;
+    };
+    let start = building.corridor_loop()[0];
+    // The farthest room's entry: every cycle plans across the building.
+    let Some(goal) = building
+        .rooms()
+        .iter()
+        .map(spot_adapter::Room::entry_point)
+        .max_by(|a, b| (a - start).norm().total_cmp(&(b - start).norm()))
+    else {
+        return;
+    };
+    let Ok(mut spot) = CommandedSpot::new(building, start, 0.0, &config) else {
+        return;
+    };
+    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let start_pose = spot.body_pose();
+    let build = || {
+        Navigator::new(
+            point_to_plane_tracker(),
+            &map,
+            lidar_height,
+            start_pose,
+            NavigatorConfig::default(),
+        )
+    };
+    let mut group = c.benchmark_group("navigation_seed3");
+    group.sample_size(10);
+    group.bench_function("prepare_map", |b| b.iter(|| black_box(build().is_ok())));
+    let Ok(mut nav) = build() else {
+        eprintln!("navigation bench: navigator failed; skipping");
+        return;
+    };
+    let sample = spot.sense();
+    // Normals on first use: warm the map's target as a running navigator has.
+    nav.step(&sample, goal);
+    group.sample_size(30);
+    group.bench_function("cycle_localise_plan_command", |b| {
+        b.iter(|| black_box(nav.step(&sample, goal)));
+    });
+    group.finish();
+}
+
+criterion_group!(benches, navigation);
+criterion_main!(benches);
