@@ -288,3 +288,37 @@ fn nearest_free(grid: &BitGrid, cell: Cell) -> Option<Cell> {
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles_wrap_into_minus_pi_to_pi() {
+        use std::f64::consts::PI;
+        for (a, want) in [
+            (0.0, 0.0),
+            (PI, PI),
+            (-PI, PI),
+            (1.5 * PI, -0.5 * PI),
+            (-1.5 * PI, 0.5 * PI),
+            (7.0, 7.0 - 2.0 * PI),
+        ] {
+            assert!((wrap(a) - want).abs() < 1e-12, "{a} -> {}", wrap(a));
+        }
+    }
+
+    #[test]
+    fn a_blocked_start_moves_to_the_closest_free_cell_of_the_first_ring_that_has_one() {
+        // A 3-cell-thick wall across the middle; free everywhere else.
+        let grid = BitGrid::from_fn(20, 20, |_, y| (9..12).contains(&y)).unwrap();
+        assert_eq!(nearest_free(&grid, Cell::new(5, 3)), Some(Cell::new(5, 3)));
+        // From the wall's middle row, the nearest free cells are 2 rows away, straight up or down.
+        let found = nearest_free(&grid, Cell::new(5, 10)).unwrap();
+        assert_eq!(found.x, 5);
+        assert!(found.y == 8 || found.y == 12, "{found:?}");
+        // Nothing free within 10 cells: no start.
+        let solid = BitGrid::from_fn(30, 30, |_, _| true).unwrap();
+        assert_eq!(nearest_free(&solid, Cell::new(15, 15)), None);
+    }
+}
