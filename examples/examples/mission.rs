@@ -25,7 +25,7 @@ use slam_core::{Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
 use spot_adapter::{
     CommandedSpot, DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, NavigationStep, Navigator,
     NavigatorConfig, SimulatedSpot, SimulationConfig, TrajectoryEvaluation, body_trajectory,
-    loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
+    loam_slam, navigation_grid, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
 
 const USAGE: &str =
@@ -117,7 +117,7 @@ struct Walk {
 /// Runs `nav` on `spot` to `goal_map` (map frame; `goal_world` the same in the world, for the
 /// progress line) until it arrives, finds no path or reaches the scan limit.
 fn walk(
-    nav: &mut Navigator<PointToPlaneIcp>,
+    nav: &mut Navigator<'_, PointToPlaneIcp>,
     spot: &mut CommandedSpot,
     goal_map: Vector2<f64>,
     goal_world: Vector2<f64>,
@@ -260,10 +260,11 @@ fn main() -> Result<()> {
     // above it.
     let lidar_height = config.spot.body_t_lidar.translation.z;
     let started = Instant::now();
+    let grid = navigation_grid(&mapped.map, lidar_height, &NavigatorConfig::default())?;
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         &mapped.map,
-        lidar_height,
+        &grid,
         mapped.map_t_body,
         NavigatorConfig::default(),
     )?;

@@ -92,7 +92,7 @@ pub use floor_plan::OBSTACLE_HEIGHT;
 pub use frames::{GaitSway, SpotGeometry};
 pub use kitti::{KittiOdometry, KittiSequence};
 pub use lidar::{Vlp16, Vlp16Config};
-pub use navigator::{NavigationStep, Navigator, NavigatorConfig};
+pub use navigator::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
 pub use odometry::{OdometryDriftConfig, OdometryModel};
 pub use ray_cast::{HitTarget, RayHit};
 pub use recording::{Recording, RecordingSamples, RecordingWriter};

@@ -49,6 +49,49 @@ impl Default for NavigatorConfig {
     }
 }
 
+impl NavigatorConfig {
+    /// Every length, angle, speed and gain finite and positive.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] naming the settings.
+    pub fn validate(&self) -> Result<(), AdapterError> {
+        let positive = [
+            self.clearance,
+            self.goal_tolerance,
+            self.turn_in_place_above,
+            self.speed,
+            self.heading_gain,
+            self.max_correction,
+            self.max_correction_angle,
+        ];
+        if positive.iter().all(|v| v.is_finite() && *v > 0.0) {
+            Ok(())
+        } else {
+            Err(AdapterError::InvalidConfig(format!(
+                "navigator settings must be finite and positive: {self:?}"
+            )))
+        }
+    }
+}
+
+/// The grid a [`Navigator`] plans on: the occupancy of `map` (a map cloud whose LiDAR sits
+/// `lidar_height` above the frame's origin) with obstacles inflated by `config.clearance`. Built
+/// once per map; the navigator borrows it, so its planner labels the grid once, not per cycle.
+///
+/// # Errors
+/// [`AdapterError::InvalidConfig`] for invalid settings or a grid that cannot be built.
+pub fn navigation_grid(
+    map: &PointCloud,
+    lidar_height: f64,
+    config: &NavigatorConfig,
+) -> Result<BitGrid, AdapterError> {
+    config.validate()?;
+    let occupancy = OccupancyGridBuilder::new(config.grid.clone())
+        .and_then(|b| b.build(map, lidar_height))
+        .map_err(|e| AdapterError::InvalidConfig(format!("navigator grid: {e}")))?;
+    Ok(inflate(occupancy.occupied(), config.clearance))
+}
+
 /// What the navigator decided this cycle.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NavigationStep {
@@ -70,61 +113,41 @@ pub enum NavigationStep {
 /// the heading error to the next waypoint is large, and otherwise walks toward it steering
 /// proportionally. A goal that cannot be reached is answered with [`NavigationStep::NoPath`];
 /// nothing loops forever.
-pub struct Navigator<R: Registrator> {
+pub struct Navigator<'g, R: Registrator> {
     config: NavigatorConfig,
     registrator: R,
     map: R::Target,
-    grid: BitGrid,
+    grid: &'g BitGrid,
+    planner: JumpPointSearch<'g>,
     map_t_body: Pose3,
     last_odom_t_body: Option<Pose3>,
     waypoints: Vec<Vector2<f64>>,
     localisation_failures: usize,
 }
 
-impl<R: Registrator> Navigator<R> {
-    /// A navigator on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) whose LiDAR sits
-    /// `lidar_height` above the map frame's origin, localising with `registrator`, starting from
-    /// `map_t_body`.
+impl<'g, R: Registrator> Navigator<'g, R> {
+    /// A navigator on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) and its `grid`
+    /// ([`navigation_grid`]), localising with `registrator`, starting from `map_t_body`.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid settings, a map the registrator refuses or an
-    /// occupancy grid that cannot be built.
+    /// [`AdapterError::InvalidConfig`] for invalid settings or a map the registrator refuses.
     pub fn new(
         registrator: R,
         map: &PointCloud,
-        lidar_height: f64,
+        grid: &'g BitGrid,
         map_t_body: Pose3,
         config: NavigatorConfig,
     ) -> Result<Self, AdapterError> {
-        let positive = [
-            config.clearance,
-            config.goal_tolerance,
-            config.turn_in_place_above,
-            config.speed,
-            config.heading_gain,
-            config.max_correction,
-            config.max_correction_angle,
-        ];
-        if !positive.iter().all(|v| v.is_finite() && *v > 0.0) {
-            return Err(AdapterError::InvalidConfig(format!(
-                "navigator settings must be finite and positive: {config:?}"
-            )));
-        }
-        let invalid = |what: &str, e: &dyn std::fmt::Display| {
-            AdapterError::InvalidConfig(format!("navigator {what}: {e}"))
-        };
-        let occupancy = OccupancyGridBuilder::new(config.grid.clone())
-            .and_then(|b| b.build(map, lidar_height))
-            .map_err(|e| invalid("grid", &e))?;
-        let grid = inflate(occupancy.occupied(), config.clearance);
+        config.validate()?;
         let target = registrator
             .prepare_target(map)
-            .map_err(|e| invalid("map", &e))?;
+            .map_err(|e| AdapterError::InvalidConfig(format!("navigator map: {e}")))?;
         Ok(Self {
             config,
             registrator,
             map: target,
             grid,
+            planner: JumpPointSearch::new(grid),
             map_t_body,
             last_odom_t_body: None,
             waypoints: Vec::new(),
@@ -177,17 +200,15 @@ impl<R: Registrator> Navigator<R> {
     /// Waypoints (metres) from `position` to `goal` after the start, or `None` when none joins
     /// them. A start inside the inflated obstacles (the robot brushed a wall) plans from the
     /// nearest free cell.
-    fn plan(&self, position: Vector2<f64>, goal: Vector2<f64>) -> Option<Vec<Vector2<f64>>> {
+    fn plan(&mut self, position: Vector2<f64>, goal: Vector2<f64>) -> Option<Vec<Vector2<f64>>> {
         let goal_cell = self
             .grid
             .cell_at(goal)
             .filter(|&c| !self.grid.is_blocked(c))?;
-        let start = nearest_free(&self.grid, self.grid.cell_at(position)?)?;
+        let start = nearest_free(self.grid, self.grid.cell_at(position)?)?;
         // Both ends are on the grid and free: `NoPath` is the only error left.
-        let path = JumpPointSearch::new(&self.grid)
-            .plan(start, goal_cell)
-            .ok()?;
-        let filtered = filter_path(&self.grid, &path);
+        let path = self.planner.plan(start, goal_cell).ok()?;
+        let filtered = filter_path(self.grid, &path);
         let mut waypoints: Vec<Vector2<f64>> = filtered
             .waypoints
             .iter()
@@ -246,7 +267,7 @@ impl<R: Registrator> Navigator<R> {
     /// The planning grid: the map's occupancy with obstacles inflated by the clearance.
     #[must_use]
     pub fn grid(&self) -> &BitGrid {
-        &self.grid
+        self.grid
     }
 
     /// Cycles whose registration failed, did not converge or was rejected as too large a jump

@@ -9,7 +9,7 @@ use registration::{IcpConfig, PointToPlaneIcp};
 use slam_core::PointCloud;
 use spot_adapter::{
     Building, CommandedSpot, NavigationStep, Navigator, NavigatorConfig, SimulatedSpot,
-    SimulationConfig, VelocityCommand, point_to_plane_tracker,
+    SimulationConfig, VelocityCommand, navigation_grid, point_to_plane_tracker,
 };
 
 /// The building of seed 3 and a map of it: every 4th scan of one lap, at its true pose, thinned
@@ -55,10 +55,11 @@ fn run(
     let mut spot = CommandedSpot::new(building.clone(), start, yaw, &config).unwrap();
     let truth_grid = building.occupancy_grid(0.1).unwrap();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let grid = navigation_grid(map, lidar_height, &NavigatorConfig::default()).unwrap();
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         map,
-        lidar_height,
+        &grid,
         spot.body_pose(),
         NavigatorConfig::default(),
     )
@@ -160,6 +161,7 @@ fn a_jump_is_rejected() {
     let mut there = CommandedSpot::new(building, start + offset, 0.0, &config).unwrap();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let goal = start + 5.0 * ahead;
+    let grid = navigation_grid(&map, lidar_height, &NavigatorConfig::default()).unwrap();
     let mut moved_by = |max_correction: f64| {
         let wide = PointToPlaneIcp {
             config: IcpConfig {
@@ -170,7 +172,7 @@ fn a_jump_is_rejected() {
         let mut nav = Navigator::new(
             wide,
             &map,
-            lidar_height,
+            &grid,
             here.body_pose(),
             NavigatorConfig {
                 max_correction,
