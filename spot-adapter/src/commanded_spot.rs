@@ -109,15 +109,13 @@ impl CommandedSpot {
         let world_t_body = self.body_pose();
         let odom_t_body = self.odometry.step(&world_t_body);
         let world_t_lidar = world_t_body * self.body_t_lidar;
-        let scan = self
-            .lidar
-            .scan(&self.building, &world_t_lidar, &mut self.noise);
-        let n = scan.len();
         Sample {
             stamp: self.stamp,
             odom_t_body,
             body_t_lidar: self.body_t_lidar,
-            cloud: scan.clone().with_time(vec![0.0; n]).unwrap_or(scan),
+            cloud: self
+                .lidar
+                .scan_at_rest(&self.building, &world_t_lidar, &mut self.noise),
             ground_truth: Some(world_t_body),
         }
     }

@@ -143,7 +143,19 @@ impl Vlp16 {
     /// `max_range`, closer than `min_range`, or dropped out give no point.
     #[must_use]
     pub fn scan(&self, building: &Building, world_t_lidar: &Pose3, rng: &mut SimRng) -> PointCloud {
-        self.cast(building, |_| *world_t_lidar, rng)
+        self.cast(building, |_| *world_t_lidar, true, rng)
+    }
+
+    /// As [`Vlp16::scan`], from a sensor that stood still during the sweep: every point's `time`
+    /// is 0, so a deskewing consumer leaves it alone (the points are the same).
+    #[must_use]
+    pub fn scan_at_rest(
+        &self,
+        building: &Building,
+        world_t_lidar: &Pose3,
+        rng: &mut SimRng,
+    ) -> PointCloud {
+        self.cast(building, |_| *world_t_lidar, false, rng)
     }
 
     /// One full turn while the LiDAR moves from `start` (at time 0) to `end` (one sweep period
@@ -162,15 +174,18 @@ impl Vlp16 {
         self.cast(
             building,
             |col| interpolate(start, end, f64::from(col) / columns),
+            true,
             rng,
         )
     }
 
-    /// Cast every ray, column `col` from `pose_of(col)`.
+    /// Cast every ray, column `col` from `pose_of(col)`; `time` is each column's firing time when
+    /// `firing_times`, else 0.
     fn cast(
         &self,
         building: &Building,
         pose_of: impl Fn(u32) -> Pose3,
+        firing_times: bool,
         rng: &mut SimRng,
     ) -> PointCloud {
         let c = &self.config;
@@ -179,7 +194,11 @@ impl Vlp16 {
         let mut rings = Vec::with_capacity(n);
         let mut times = Vec::with_capacity(n);
         let rings_per_col = c.rings as usize;
-        let dt = self.sweep_period() / f64::from(c.columns);
+        let dt = if firing_times {
+            self.sweep_period() / f64::from(c.columns)
+        } else {
+            0.0
+        };
         for (col, dirs) in self.directions.chunks_exact(rings_per_col).enumerate() {
             let pose = pose_of(col as u32);
             let origin = Point3::from(pose.translation.vector);

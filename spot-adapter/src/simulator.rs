@@ -198,13 +198,10 @@ impl Iterator for SimulatedSpot {
                 &mut self.noise,
             ),
             // The last sample of a run has no later pose: the robot has stopped.
-            _ => {
-                // Cast from one pose: every point was measured at the stamp, and its time says
-                // so (a deskewing consumer must leave it alone).
-                let scan = self.lidar.scan(&self.building, &start, &mut self.noise);
-                let n = scan.len();
-                scan.clone().with_time(vec![0.0; n]).unwrap_or(scan)
-            }
+            // Cast from one pose: every point was measured at the stamp, and its time says so.
+            _ => self
+                .lidar
+                .scan_at_rest(&self.building, &start, &mut self.noise),
         };
         Some(Sample {
             stamp,

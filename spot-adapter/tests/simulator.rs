@@ -66,6 +66,21 @@ fn scan_points_lie_at_the_ray_cast_distance() {
     }
 }
 
+/// A scan at rest is the same cloud as a plain scan (same noise stream) with every time 0.
+#[test]
+fn scan_at_rest_has_the_points_of_a_scan_and_zero_times() {
+    let b = Building::generate(6, &BuildingConfig::default()).unwrap();
+    let lidar = Vlp16::new(Vlp16Config::default()).unwrap();
+    let c = b.corridor_loop()[0];
+    let pose = Pose3::translation(c.x + 1.0, c.y, 0.8);
+    let scan = lidar.scan(&b, &pose, &mut SimRng::new(4, 4));
+    let rest = lidar.scan_at_rest(&b, &pose, &mut SimRng::new(4, 4));
+    assert_eq!(scan.points(), rest.points());
+    assert_eq!(scan.ring(), rest.ring());
+    assert!(scan.time().unwrap().iter().any(|&t| t > 0.1));
+    assert!(rest.time().unwrap().iter().all(|&t| t == 0.0));
+}
+
 #[test]
 fn moving_scan_casts_each_column_from_its_firing_pose() {
     let b = Building::generate(6, &BuildingConfig::default()).unwrap();
