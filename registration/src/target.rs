@@ -35,14 +35,20 @@ impl std::fmt::Debug for PreparedTarget {
 
 /// Finite points of `cloud` as f64, voxel-filtered when `voxel > 0`.
 pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> {
-    let mut c = PointCloud::from_points(cloud.points().to_vec());
-    c.remove_non_finite();
-    let c = if voxel > 0.0 {
-        c.voxel_downsample(voxel).unwrap_or(c)
-    } else {
-        c
-    };
-    c.points().iter().map(|p| p.cast::<f64>()).collect()
+    if voxel > 0.0 {
+        // Points only (the channels would be averaged for nothing); the downsampling skips
+        // non-finite points itself.
+        let c = PointCloud::from_points(cloud.points().to_vec());
+        if let Ok(down) = c.voxel_downsample(voxel) {
+            return down.points().iter().map(|p| p.cast::<f64>()).collect();
+        }
+    }
+    cloud
+        .points()
+        .iter()
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .map(|p| p.cast::<f64>())
+        .collect()
 }
 
 impl PreparedTarget {
