@@ -1,6 +1,5 @@
 //! `GraphSlam`: keyframes, LiDAR odometry against a local map, loop closure and map assembly.
 
-use std::collections::VecDeque;
 use std::time::Instant;
 
 use nalgebra::{Matrix6, Vector6};
@@ -41,12 +40,13 @@ struct Keyframe<S, C> {
     cloud: PointCloud,
 }
 
-/// The target the odometry registers against: the last keyframes placed at their poses.
+/// The target the odometry registers against: the last `local_map_keyframes` keyframes placed
+/// at their poses (keyed by their index).
 struct LocalMap<T> {
     target: T,
-    /// The keyframes in it, oldest first, when the backend updates it in place
-    /// ([`MapRegistrator::empty_map`]); `None` when it is rebuilt whole after every keyframe.
-    members: Option<VecDeque<u32>>,
+    /// Whether the backend updates it in place ([`MapRegistrator::empty_map`]); otherwise it is
+    /// rebuilt whole after every keyframe.
+    in_place: bool,
 }
 
 /// Graph-SLAM over any [`MapRegistrator`] (odometry and loop refinement), a second one for coarse
@@ -280,16 +280,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         let n = self.keyframes.len();
         let first = n.saturating_sub(self.config.local_map_keyframes);
-        let keys: Option<VecDeque<u32>> = (first..n).map(|i| u32::try_from(i).ok()).collect();
-        if let (Some(mut target), Some(keys)) = (self.odometry.empty_map(), keys) {
-            for (&key, i) in keys.iter().zip(first..n) {
+        let keyed = u32::try_from(n).is_ok();
+        if let (Some(mut target), true) = (self.odometry.empty_map(), keyed) {
+            for i in first..n {
                 let pose = self.keyframe_pose(i);
+                #[allow(clippy::cast_possible_truncation)]
                 self.odometry
-                    .add_to_map(&mut target, key, &self.keyframes[i].source, &pose);
+                    .add_to_map(&mut target, i as u32, &self.keyframes[i].source, &pose);
             }
             self.local_map = Some(LocalMap {
                 target,
-                members: Some(keys),
+                in_place: true,
             });
         } else {
             let parts: Vec<(&R::Source, Pose3)> = (first..n)
@@ -301,33 +302,30 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .ok()
                 .map(|target| LocalMap {
                     target,
-                    members: None,
+                    in_place: false,
                 });
         }
         self.local_map.is_some()
     }
 
-    /// Adds keyframe `index` (the newest) to an in-place local map and drops the keyframes that
-    /// left the window; a map built whole is dropped, to be rebuilt when next needed.
+    /// Adds keyframe `index` (the newest) to an in-place local map and drops the one that left
+    /// the window; a map built whole is dropped, to be rebuilt when next needed.
     fn slide_local_map(&mut self, index: usize) {
         let window = self.config.local_map_keyframes;
-        let key = u32::try_from(index).ok();
         let pose = self.keyframe_pose(index);
-        match (&mut self.local_map, key) {
+        match (&mut self.local_map, u32::try_from(index)) {
             (
                 Some(LocalMap {
                     target,
-                    members: Some(members),
+                    in_place: true,
                 }),
-                Some(key),
+                Ok(key),
             ) => {
                 self.odometry
                     .add_to_map(target, key, &self.keyframes[index].source, &pose);
-                members.push_back(key);
-                while members.len() > window {
-                    if let Some(old) = members.pop_front() {
-                        self.odometry.remove_from_map(target, old);
-                    }
+                if let Some(old) = index.checked_sub(window) {
+                    #[allow(clippy::cast_possible_truncation)]
+                    self.odometry.remove_from_map(target, old as u32);
                 }
             }
             _ => self.local_map = None,
