@@ -9,14 +9,19 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use slam_core::{PointCloud, Registrator};
-use spot_adapter::{
-    CommandedSpot, Navigator, NavigatorConfig, SimulatedSpot, SimulationConfig, navigation_grid,
-    point_to_plane_tracker,
+use spot_adapter::nav::{Navigator, NavigatorConfig, navigation_grid};
+use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::robot::Robot;
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, Route, SimulatedSpot, SimulationConfig,
 };
 
 fn navigation(c: &mut Criterion) {
     let config = SimulationConfig::default();
-    let Ok(sim) = SimulatedSpot::corridor_loop(3, &config) else {
+    // Building 3 with the noise and drift of seed 0, as the navigation test's map.
+    let sim = Building::generate(3, &BuildingConfig::default())
+        .and_then(|b| SimulatedSpot::new(b.clone(), &Route::corridor_loop(&b), &config));
+    let Ok(sim) = sim else {
         eprintln!("navigation bench: simulation failed; skipping");
         return;
     };
@@ -37,7 +42,7 @@ fn navigation(c: &mut Criterion) {
     let Some(goal) = building
         .rooms()
         .iter()
-        .map(spot_adapter::Room::entry_point)
+        .map(spot_adapter::sim::Room::entry_point)
         .max_by(|a, b| (a - start).norm().total_cmp(&(b - start).norm()))
     else {
         return;
@@ -66,6 +71,7 @@ fn navigation(c: &mut Criterion) {
         &map,
         &grid,
         start_pose,
+        spot.description(),
         nav_config,
     ) else {
         eprintln!("navigation bench: navigator failed; skipping");
@@ -73,7 +79,10 @@ fn navigation(c: &mut Criterion) {
     };
     let sample = spot.sense();
     // Normals on first use: warm the map's target as a running navigator has.
-    nav.step(&sample, goal);
+    if let Err(e) = nav.step(&sample, goal) {
+        eprintln!("navigation bench: navigator step failed: {e}; skipping");
+        return;
+    }
     group.sample_size(30);
     group.bench_function("cycle_localise_plan_command", |b| {
         b.iter(|| black_box(nav.step(&sample, goal)));

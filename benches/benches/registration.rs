@@ -9,7 +9,8 @@ use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_ma
 use registration::{LidarLayout, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
 use slam_core::{MapRegistrator, PointCloud, Pose3, Registrator, pose3_from_xyz_rpy};
-use spot_adapter::{Sample, SimulatedSpot, SimulationConfig};
+use spot_adapter::robot::Sample;
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 fn pair() -> Option<(PointCloud, PointCloud)> {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -97,7 +98,7 @@ fn registration(c: &mut Criterion) {
 /// SLAM engine's settings (`LoamConfig::local_map_odometry`) and with every pick kept. Also the
 /// local map built whole, and slid by one keyframe in place (what the engine does per keyframe).
 fn loam_odometry_step(c: &mut Criterion) {
-    let Ok(sim) = SimulatedSpot::corridor_loop(1, &SimulationConfig::default()) else {
+    let Ok(sim) = SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(1)) else {
         eprintln!("loam_odometry_step: simulation failed; skipping");
         return;
     };

@@ -8,7 +8,7 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
-use spot_adapter::{
+use spot_adapter::sim::{
     Building, BuildingConfig, Route, SimRng, SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
 };
 
@@ -55,7 +55,7 @@ fn sim(c: &mut Criterion) {
     });
     group.bench_function("simulated_sample", |b| {
         b.iter_batched(
-            || SimulatedSpot::corridor_loop(1, &SimulationConfig::default()),
+            || SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(1)),
             |sim| black_box(sim.map(|mut s| s.next())),
             criterion::BatchSize::LargeInput,
         );

@@ -15,10 +15,9 @@
 //! `SLAM_BENCH_SETUPS=loam` and `SLAM_BENCH_REPEATS=5` pick runs; 3 laps by default)
 
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, SlamReport};
-use spot_adapter::{
-    SimulatedSpot, SimulationConfig, TrajectoryEvaluation, loam_slam, point_to_plane_slam,
-    slam_config,
-};
+use spot_adapter::eval::TrajectoryEvaluation;
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// One lap: the engine's report and its trajectory.
 struct Lap {
@@ -119,7 +118,7 @@ fn main() {
         for setup in &setups {
             let mut config = SimulationConfig::default();
             config.seed = seed_n;
-            let simulate = || SimulatedSpot::corridor_loop(seed_n, &config);
+            let simulate = || SimulatedSpot::corridor_loop(&config);
             let sim = match simulate() {
                 Ok(sim) => sim,
                 Err(e) => {

@@ -22,11 +22,15 @@ use nalgebra::{Point3, Vector2};
 use registration::PointToPlaneIcp;
 use slam_core::io::{PlyEncoding, write_ply};
 use slam_core::{Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
-use spot_adapter::{
-    CommandedSpot, DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, NavigationStep, Navigator,
-    NavigatorConfig, SimulatedSpot, SimulationConfig, TrajectoryEvaluation, body_trajectory,
-    loam_slam, navigation_grid, point_to_plane_slam, point_to_plane_tracker, slam_config,
+use spot_adapter::eval::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation, body_trajectory,
 };
+use spot_adapter::nav::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
+use spot_adapter::pipelines::{
+    loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
+};
+use spot_adapter::robot::Robot;
+use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
 
 const USAGE: &str =
     "usage: mission [--seed N] [--registration p2plane|loam] [--goal X,Y] [--out DIR]";
@@ -129,7 +133,7 @@ fn walk(
     let mut cycle_ms = Vec::new();
     let result = loop {
         let t = Instant::now();
-        let step = nav.step(&sample, goal_map);
+        let step = nav.step(&sample, goal_map)?;
         cycle_ms.push(t.elapsed().as_secs_f64() * 1e3);
         let truth_map = world_t_map.inverse() * sample.ground_truth.context("simulated")?;
         worst = worst.max(
@@ -223,7 +227,7 @@ fn main() -> Result<()> {
     } = parse_args()?;
     let mut config = SimulationConfig::default();
     config.seed = seed;
-    let sim = SimulatedSpot::corridor_loop(seed, &config)?;
+    let sim = SimulatedSpot::corridor_loop(&config)?;
     let building = sim.building().clone();
     let truth = sim.ground_truth();
     // The map frame is the odometry frame, which starts at the first body pose.
@@ -266,6 +270,7 @@ fn main() -> Result<()> {
         &mapped.map,
         &grid,
         mapped.map_t_body,
+        spot.description(),
         NavigatorConfig::default(),
     )?;
     println!(

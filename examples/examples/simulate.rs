@@ -8,10 +8,11 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
-use spot_adapter::{
-    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, RecordingWriter, SimulatedSpot,
-    SimulationConfig, TrajectoryEvaluation,
+use spot_adapter::eval::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation,
 };
+use spot_adapter::record::RecordingWriter;
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 fn main() -> anyhow::Result<()> {
     let mut seed = 1u64;
@@ -26,7 +27,7 @@ fn main() -> anyhow::Result<()> {
     }
     let mut config = SimulationConfig::default();
     config.seed = seed;
-    let mut sim = SimulatedSpot::corridor_loop(seed, &config)?;
+    let mut sim = SimulatedSpot::corridor_loop(&config)?;
     let size = sim.building().size();
     let truth = sim.ground_truth();
     let gt: Vec<Pose3> = truth.iter().map(|p| p.pose).collect();
@@ -36,7 +37,7 @@ fn main() -> anyhow::Result<()> {
         size.y,
         sim.building().boxes().len(),
         sim.building().rooms().len(),
-        spot_adapter::path_length(&gt),
+        spot_adapter::eval::path_length(&gt),
         sim.len()
     );
     let mut writer = match &out {

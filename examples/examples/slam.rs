@@ -12,11 +12,13 @@ use anyhow::{Context, Result, bail};
 use posegraph::g2o::{G2oGraph, write_g2o};
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, ScanOutcome};
-use spot_adapter::{
-    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, Recording, Sample, SimulatedSpot,
-    SimulationConfig, TrajectoryEvaluation, body_trajectory, loam_slam, point_to_plane_slam,
-    slam_config,
+use spot_adapter::eval::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation, body_trajectory,
 };
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
+use spot_adapter::record::Recording;
+use spot_adapter::robot::Sample;
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 const USAGE: &str = "usage: slam [RECORDING_DIR] [--seed N] [--registration p2plane|loam] \
                      [--skewed] [--no-deskew] [--out DIR]";
@@ -33,17 +35,15 @@ fn open(
     if let Some(dir) = recording {
         let rec = Recording::open(dir)?;
         let body_t_lidar = rec.body_t_lidar();
-        let truth = rec.ground_truth().map(<[StampedPose]>::to_vec);
-        let all: Vec<Result<Sample>> = rec
-            .samples()
-            .map(|s| s.map_err(anyhow::Error::from))
-            .collect();
-        Ok((Box::new(all.into_iter()), body_t_lidar, truth))
+        let truth = rec.read_ground_truth()?;
+        // One scan at a time: memory stays that of one scan however long the recording.
+        let samples = rec.into_iter().map(|s| s.map_err(anyhow::Error::from));
+        Ok((Box::new(samples), body_t_lidar, truth))
     } else {
         let mut config = SimulationConfig::default();
         config.seed = seed;
         config.motion_distortion = skewed;
-        let sim = SimulatedSpot::corridor_loop(seed, &config)?;
+        let sim = SimulatedSpot::corridor_loop(&config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = Some(sim.ground_truth());
         Ok((Box::new(sim.map(Ok)), body_t_lidar, truth))

@@ -1,39 +1,34 @@
 //! # spot-adapter
 //!
-//! Everything between a Spot robot and the SLAM engine: the [`Sample`] every source delivers
-//! (stamp, `odom_T_body`, `body_T_lidar`, cloud), a simulated Spot that needs no hardware,
-//! recordings on disk, a reader for KITTI-style folders, the evaluation of trajectories, and the
-//! navigator that walks the robot to goals on the map.
+//! Everything between a robot and the SLAM engine and planners of spot-nav, in rooms:
 //!
-//! - [`Building`]: a procedurally generated office floor from a seed (ring corridor, rooms,
-//!   doors, pilasters, pillars, furniture, floor and ceiling) as axis-aligned boxes with a
-//!   ray-casting index, its ground-truth floor plan ([`Building::is_obstacle`],
-//!   [`Building::occupancy_grid`]).
-//! - [`Vlp16`]: a VLP-16 ray-cast against the building (16 rings, 1800 columns, range noise,
-//!   dropouts; `ring` and `time` channels).
-//! - [`OdometryModel`]: Spot's leg odometry, drifting 1.9 % of the distance walked.
-//! - [`Route`]: the corridor loop or a planned route between two points, walked at 0.6 m/s.
-//! - [`SimulatedSpot`]: all of the above as an iterator of [`Sample`]s with ground truth.
-//! - [`CommandedSpot`]: the same robot driven by [`VelocityCommand`]s, for closed loops.
-//! - [`Navigator`]: walks the robot to a goal on a map: localises each scan against the map,
-//!   replans with Jump Point Search on the map's inflated occupancy grid, and turns or walks
-//!   toward the next filtered waypoint.
-//! - [`point_to_plane_slam`], [`loam_slam`]: the Graph-SLAM engine put together with this
-//!   workspace's backends.
-//! - [`RecordingWriter`], [`Recording`], [`KittiSequence`]: runs on disk.
-//! - [`absolute_trajectory_error`], [`end_point_drift`], [`segment_drift`],
-//!   [`loop_end_point_error`], all at once in [`TrajectoryEvaluation`]: accuracy against ground
-//!   truth.
+//! - [`robot`]: what any robot source gives and takes, nothing simulated: the
+//!   [`Sample`](robot::Sample) every source delivers (stamp, `odom_T_body`, `body_T_lidar`,
+//!   cloud), Spot's geometry and motion limits, the commands ([`VelocityCommand`](robot::VelocityCommand),
+//!   [`Se2Trajectory`](robot::Se2Trajectory)) and the [`Robot`](robot::Robot) trait.
+//! - [`sim`] (cargo feature `sim`, on by default): the test world: a procedurally generated
+//!   building with obstacles that can be added later, a VLP-16 model, drifting leg odometry,
+//!   routes, [`SimulatedSpot`](sim::SimulatedSpot) (walks a route) and
+//!   [`CommandedSpot`](sim::CommandedSpot) (a `Robot` driven by commands).
+//! - [`record`]: recordings in: the spot-nav recording format and KITTI folders, streamed one
+//!   scan at a time.
+//! - [`eval`]: accuracy against ground truth: ATE, drift, loop end-point error.
+//! - [`nav`]: the [`Navigator`](nav::Navigator) (localise, plan, command) and
+//!   [`drive`](nav::drive), which runs it on any `Robot`.
+//! - [`pipelines`]: the Graph-SLAM engine put together with this workspace's backends.
+//!
+//! `robot`, `record` and `eval` need `slam-core` only; `nav` adds `gridmap` and `pathfind`;
+//! only `sim` uses random numbers. Build with `--no-default-features` to leave the simulator
+//! out.
 //!
 //! ```
-//! use spot_adapter::{
-//!     DEFAULT_MAX_STAMP_DIFFERENCE, SimulatedSpot, SimulationConfig, absolute_trajectory_error,
-//!     end_point_drift,
-//! };
 //! use slam_core::io::StampedPose;
+//! use spot_adapter::eval::{DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, end_point_drift};
+//! use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 //!
 //! // A simulated lap of building 7's corridor loop; keep the poses, skip the clouds' use here.
-//! let sim = SimulatedSpot::corridor_loop(7, &SimulationConfig::default())?;
+//! let config = SimulationConfig::with_seed(7);
+//! let sim = SimulatedSpot::corridor_loop(&config)?;
 //! let truth = sim.ground_truth();
 //! let odometry: Vec<StampedPose> = sim
 //!     .take(40)
@@ -48,59 +43,16 @@
 //! # Ok::<(), spot_adapter::AdapterError>(())
 //! ```
 //!
-//! Simplifications, each documented where it lives: by default a scan is cast from one pose (no
-//! motion distortion, so no deskewing is needed; `SimulationConfig::motion_distortion` turns it
-//! on), the body stays level at a fixed height unless
-//! [`GaitSway`] is set, and surfaces reflect every ray (no intensity, no multi-path).
-//!
-//! When not to use it: the simulator is for testing SLAM and navigation logic at scale, not for
+//! When not to use the simulator: it is for testing SLAM and navigation logic at scale, not for
 //! photorealistic sensor studies (no materials, no beam divergence, no mixed pixels).
 
-mod alignment;
-mod ate;
-mod building;
-mod commanded_spot;
-mod drift;
 mod error;
-mod evaluation;
-mod floor_plan;
-mod frames;
-mod kitti;
-mod lidar;
-mod navigator;
-mod odometry;
-mod ray_cast;
-mod recording;
-mod rng;
-mod route;
-mod route_planner;
-mod sample;
-mod simulator;
-mod slam_backends;
+pub mod eval;
+pub mod nav;
+pub mod pipelines;
+pub mod record;
+pub mod robot;
+#[cfg(feature = "sim")]
+pub mod sim;
 
-pub use alignment::align_rigid;
-pub use ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
-pub use building::{BoxKind, Building, BuildingConfig, Room, SolidBox};
-pub use commanded_spot::{CommandedSpot, MAX_YAW_RATE, VelocityCommand};
-pub use drift::{
-    EndPointDrift, INDOOR_SEGMENT_LENGTHS, KITTI_SEGMENT_LENGTHS, SegmentDrift, end_point_drift,
-    loop_end_point_error, path_length, segment_drift,
-};
-pub use error::AdapterError;
-pub use evaluation::{TrajectoryEvaluation, body_trajectory};
-pub use floor_plan::OBSTACLE_HEIGHT;
-pub use frames::{GaitSway, SpotGeometry};
-pub use kitti::{KittiOdometry, KittiSequence};
-pub use lidar::{Vlp16, Vlp16Config};
-pub use navigator::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
-pub use odometry::{OdometryDriftConfig, OdometryModel};
-pub use ray_cast::{HitTarget, RayHit};
-pub use recording::{Recording, RecordingSamples, RecordingWriter};
-pub use rng::SimRng;
-pub use route::Route;
-pub use route_planner::RouteConfig;
-pub use sample::Sample;
-pub use simulator::{SimulatedSpot, SimulationConfig};
-pub use slam_backends::{
-    LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
-};
+pub use error::{AdapterError, DriveError};

@@ -6,7 +6,9 @@
 #![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
 
 use nalgebra::{Point3, Vector2, Vector3};
-use spot_adapter::{Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox};
+use spot_adapter::sim::{
+    BoxKind, Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox,
+};
 
 fn building(seed: u64) -> Building {
     Building::generate(seed, &BuildingConfig::default()).unwrap()
@@ -68,9 +70,9 @@ fn same_seed_same_building_and_realistic_scale() {
             );
         }
         let kinds = |k| a.boxes().iter().filter(|b| b.kind == k).count();
-        assert!(kinds(spot_adapter::BoxKind::Furniture) >= a.rooms().len());
-        assert!(kinds(spot_adapter::BoxKind::Pillar) > 10);
-        assert!(kinds(spot_adapter::BoxKind::Lintel) == a.rooms().len());
+        assert!(kinds(spot_adapter::sim::BoxKind::Furniture) >= a.rooms().len());
+        assert!(kinds(spot_adapter::sim::BoxKind::Pillar) > 10);
+        assert!(kinds(spot_adapter::sim::BoxKind::Lintel) == a.rooms().len());
     }
 }
 
@@ -210,4 +212,79 @@ fn tour_through_rooms_returns_to_its_start() {
         visited += stops.iter().filter(|s| (p - **s).norm() < 0.011).count();
     }
     assert!(visited >= stops.len(), "every stop is on the tour");
+}
+
+/// Boxes added after the building was made are seen by the ray casting (checked against the
+/// brute force over every box, the added ones included), blocked in the floor plan, and gone
+/// again once removed.
+#[test]
+fn added_boxes_are_seen_and_removed_boxes_are_gone() {
+    let mut b = building(11);
+    let before = b.clone();
+    let route = Route::corridor_loop(&b);
+    let on_route = route.point_at(10.0);
+    let crate_box = SolidBox {
+        min: Point3::new(on_route.x - 0.4, on_route.y - 0.4, 0.0),
+        max: Point3::new(on_route.x + 0.4, on_route.y + 0.4, 0.5),
+        kind: BoxKind::Obstacle,
+    };
+    let id = b.add_box(crate_box).unwrap();
+    assert!(b.is_obstacle(on_route) && !before.is_obstacle(on_route));
+    assert_eq!(b.clearance(on_route), 0.0);
+    let grid = b.occupancy_grid(0.1).unwrap();
+    assert!(grid.is_blocked(grid.cell_at(on_route).unwrap()));
+    // Down onto the crate's top from 0.8 m: 0.3 m, where the floor was 0.8 m.
+    let down = b
+        .cast_ray(
+            &Point3::new(on_route.x, on_route.y, 0.8),
+            &-Vector3::z(),
+            10.0,
+        )
+        .unwrap();
+    assert!((down.range - 0.3).abs() < 1e-12);
+    assert_eq!(down.target, HitTarget::Box(b.boxes().len() - 1));
+    let mut rng = SimRng::new(1, 2);
+    let mut on_crate = 0;
+    for i in 0..2000 {
+        let o = Point3::new(
+            on_route.x + rng.range(-3.0, 3.0),
+            on_route.y + rng.range(-1.0, 1.0),
+            rng.range(0.2, 1.5),
+        );
+        let d = Vector3::new(rng.normal(1.0), rng.normal(1.0), rng.normal(0.4)).normalize();
+        let fast = b.cast_ray(&o, &d, 100.0);
+        let slow = brute_force(&b, &o, &d, 100.0);
+        match (fast, slow) {
+            (Some(f), Some(s)) => {
+                assert!((f.range - s).abs() < 1e-9, "ray {i}: {} vs {s}", f.range);
+                on_crate += usize::from(f.target == HitTarget::Box(b.boxes().len() - 1));
+            }
+            (None, None) => {}
+            other => panic!("ray {i}: {other:?}"),
+        }
+    }
+    assert!(on_crate > 20, "{on_crate} rays hit the crate");
+    // A box that is not one is refused.
+    let mut flat = crate_box;
+    flat.max.z = flat.min.z;
+    assert!(b.add_box(flat).is_err());
+    flat.max.z = f64::NAN;
+    assert!(b.add_box(flat).is_err());
+    // Moved, then removed: the floor plan and the rays are the building's own again.
+    let elsewhere = route.point_at(20.0);
+    let mut moved = crate_box;
+    moved.min = Point3::new(elsewhere.x - 0.4, elsewhere.y - 0.4, 0.0);
+    moved.max = Point3::new(elsewhere.x + 0.4, elsewhere.y + 0.4, 0.5);
+    b.move_box(id, moved).unwrap();
+    assert!(!b.is_obstacle(on_route) && b.is_obstacle(elsewhere));
+    assert_eq!(b.remove_box(id), Some(moved));
+    assert_eq!(b.remove_box(id), None);
+    assert!(b.move_box(id, moved).is_err());
+    assert!(!b.is_obstacle(elsewhere));
+    assert_eq!(b.boxes(), before.boxes());
+    let o = Point3::new(on_route.x, on_route.y, 0.8);
+    assert_eq!(
+        b.cast_ray(&o, &-Vector3::z(), 10.0),
+        before.cast_ray(&o, &-Vector3::z(), 10.0)
+    );
 }

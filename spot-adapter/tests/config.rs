@@ -3,62 +3,107 @@
 #![allow(clippy::unwrap_used)]
 
 use nalgebra::Vector2;
-use spot_adapter::{
-    AdapterError, Building, BuildingConfig, OdometryDriftConfig, OdometryModel, Route, RouteConfig,
-    SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
+use spot_adapter::AdapterError;
+use spot_adapter::nav::NavigatorConfig;
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, OdometryDriftConfig, OdometryModel, Route,
+    RouteConfig, SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
 };
 
+/// Whether `r` is the invalid-setting error naming `setting`, with the value given.
 #[allow(clippy::needless_pass_by_value)] // Takes the results straight from the calls.
-fn invalid<T: std::fmt::Debug>(r: Result<T, AdapterError>) -> bool {
-    matches!(r, Err(AdapterError::InvalidConfig(_)))
+fn invalid<T: std::fmt::Debug>(r: Result<T, AdapterError>, setting: &str) -> bool {
+    match r {
+        Err(AdapterError::InvalidConfig { setting: s, .. }) if s == setting => true,
+        other => {
+            eprintln!("expected an invalid {setting}, got {other:?}");
+            false
+        }
+    }
 }
 
 #[test]
 fn bad_settings_are_rejected() {
     let mut c = BuildingConfig::default();
     c.corridor_width = (2.0, 1.0);
-    assert!(invalid(Building::generate(0, &c)));
+    assert!(invalid(Building::generate(0, &c), "corridor_width.1"));
     let mut c = BuildingConfig::default();
     c.door_height = 5.0;
-    assert!(invalid(Building::generate(0, &c)));
+    assert!(invalid(Building::generate(0, &c), "door_height"));
     let mut c = BuildingConfig::default();
     c.wall_thickness = f64::NAN;
-    assert!(invalid(Building::generate(0, &c)));
+    assert!(invalid(Building::generate(0, &c), "wall_thickness"));
 
     let mut l = Vlp16Config::default();
     l.rings = 0;
-    assert!(invalid(Vlp16::new(l)));
+    assert!(invalid(Vlp16::new(l), "rings"));
     let mut l = Vlp16Config::default();
     l.dropout_probability = 1.5;
-    assert!(invalid(Vlp16::new(l)));
+    assert!(invalid(Vlp16::new(l), "dropout_probability"));
     let mut l = Vlp16Config::default();
     l.max_range = 0.1;
-    assert!(invalid(Vlp16::new(l)));
+    assert!(invalid(Vlp16::new(l), "max_range"));
 
     let mut o = OdometryDriftConfig::default();
     o.drift_rate = -0.01;
-    assert!(invalid(OdometryModel::new(o, 0)));
+    assert!(invalid(OdometryModel::new(o, 0), "drift_rate"));
     let mut o = OdometryDriftConfig::default();
     o.vertical_fraction = 2.0;
-    assert!(invalid(OdometryModel::new(o, 0)));
+    assert!(invalid(OdometryModel::new(o, 0), "vertical_fraction"));
 
-    assert!(invalid(Route::new(vec![Vector2::zeros()], false)));
-    assert!(invalid(Route::new(vec![Vector2::zeros(); 3], false)));
+    assert!(invalid(Route::new(vec![Vector2::zeros()], false), "points"));
+    assert!(invalid(
+        Route::new(vec![Vector2::zeros(); 3], false),
+        "route length"
+    ));
     let b = Building::generate(0, &BuildingConfig::default()).unwrap();
     let lap = Route::corridor_loop(&b);
-    assert!(invalid(lap.walk(0.0, 5.0, 0.5)));
-    assert!(invalid(lap.walk(0.6, f64::INFINITY, 0.5)));
+    assert!(invalid(lap.walk(0.0, 5.0, 0.5), "speed"));
+    assert!(invalid(lap.walk(0.6, f64::INFINITY, 0.5), "rate"));
     let mut s = SimulationConfig::default();
     s.speed = -1.0;
-    assert!(invalid(SimulatedSpot::new(b.clone(), &lap, &s)));
+    assert!(invalid(SimulatedSpot::new(b.clone(), &lap, &s), "speed"));
     let mut r = RouteConfig::default();
     r.clearance = -1.0;
     let p = b.rooms()[0].entry_point();
-    assert!(invalid(Route::between(&b, p, p, &r)));
+    assert!(invalid(Route::between(&b, p, p, &r), "clearance"));
     let mut r = RouteConfig::default();
     r.resolution = 0.0;
     assert!(matches!(
         Route::between(&b, p, p, &r),
         Err(AdapterError::Grid(_))
     ));
+
+    let mut s = SimulationConfig::default();
+    s.limits.max_yaw_rate = 0.0;
+    let start = b.corridor_loop()[0];
+    assert!(invalid(
+        CommandedSpot::new(b.clone(), start, 0.0, &s),
+        "max_yaw_rate"
+    ));
+    assert!(invalid(
+        CommandedSpot::new(b.clone(), start, f64::NAN, &SimulationConfig::default()),
+        "yaw"
+    ));
+    let n = NavigatorConfig {
+        goal_tolerance: -0.1,
+        ..NavigatorConfig::default()
+    };
+    assert!(invalid(n.validate(), "goal_tolerance"));
+    let n = NavigatorConfig {
+        max_correction: f64::NAN,
+        ..NavigatorConfig::default()
+    };
+    assert!(invalid(n.validate(), "max_correction"));
+}
+
+#[test]
+fn the_error_message_names_the_setting_and_its_value() {
+    let mut l = Vlp16Config::default();
+    l.range_noise = -0.5;
+    let message = Vlp16::new(l).unwrap_err().to_string();
+    assert!(
+        message.contains("range_noise") && message.contains("-0.5"),
+        "{message}"
+    );
 }

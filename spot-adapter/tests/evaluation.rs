@@ -7,10 +7,12 @@
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3, Vector6};
 use slam_core::io::StampedPose;
 use slam_core::{Pose3, se3_exp};
-use spot_adapter::{
-    DEFAULT_MAX_STAMP_DIFFERENCE, SimRng, absolute_trajectory_error, align_rigid, associate,
-    end_point_drift, loop_end_point_error, path_length, segment_drift,
+use spot_adapter::eval::align_rigid;
+use spot_adapter::eval::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate, end_point_drift,
+    loop_end_point_error, path_length, segment_drift,
 };
+use spot_adapter::sim::SimRng;
 
 /// A wandering 3D trajectory: a circle of radius 5 m with a gentle climb, 0.1 s apart.
 fn reference(n: usize) -> Vec<StampedPose> {
@@ -155,7 +157,7 @@ fn scale_error_gives_known_drift() {
     assert!((path_length(&gt) - 100.0).abs() < 1e-9);
     let d = end_point_drift(&est, &gt).unwrap();
     assert!((d.end_point_error - 2.0).abs() < 1e-9 && (d.relative_drift - 0.02).abs() < 1e-12);
-    let s = segment_drift(&est, &gt, &spot_adapter::INDOOR_SEGMENT_LENGTHS, 10).unwrap();
+    let s = segment_drift(&est, &gt, &spot_adapter::eval::INDOOR_SEGMENT_LENGTHS, 10).unwrap();
     assert!((s.translation - 0.02).abs() < 1e-9, "{s:?}");
     assert!(s.rotation.abs() < 1e-12);
     assert_eq!(s.per_length.len(), 5);
@@ -231,7 +233,7 @@ fn evaluation_combines_the_figures() {
         .enumerate()
         .map(|(i, p)| Pose3::translation(i as f64 / (n - 1) as f64, 0.0, 0.0) * p)
         .collect();
-    let e = spot_adapter::TrajectoryEvaluation::compute(
+    let e = spot_adapter::eval::TrajectoryEvaluation::compute(
         &stamped(&est),
         &stamped(&gt),
         DEFAULT_MAX_STAMP_DIFFERENCE,

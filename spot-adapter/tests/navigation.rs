@@ -7,15 +7,21 @@
 use nalgebra::Vector2;
 use registration::{IcpConfig, PointToPlaneIcp};
 use slam_core::PointCloud;
-use spot_adapter::{
-    Building, CommandedSpot, NavigationStep, Navigator, NavigatorConfig, SimulatedSpot,
-    SimulationConfig, VelocityCommand, navigation_grid, point_to_plane_tracker,
+use spot_adapter::AdapterError;
+use spot_adapter::nav::{DriveOutcome, Navigator, NavigatorConfig, drive, navigation_grid};
+use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::robot::Robot;
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, Route, SimulatedSpot, SimulationConfig,
 };
 
 /// The building of seed 3 and a map of it: every 4th scan of one lap, at its true pose, thinned
 /// to 5 cm.
 fn building_and_map() -> (Building, PointCloud) {
-    let sim = SimulatedSpot::corridor_loop(3, &SimulationConfig::default()).unwrap();
+    // Building 3 with the noise and drift of seed 0.
+    let building = Building::generate(3, &BuildingConfig::default()).unwrap();
+    let lap = Route::corridor_loop(&building);
+    let sim = SimulatedSpot::new(building, &lap, &SimulationConfig::default()).unwrap();
     let building = sim.building().clone();
     let body_t_lidar = sim.body_t_lidar();
     let mut points = Vec::new();
@@ -30,8 +36,8 @@ fn building_and_map() -> (Building, PointCloud) {
 }
 
 /// What a run did, measured on the ground truth.
-struct Outcome {
-    step: NavigationStep,
+struct Run {
+    outcome: DriveOutcome,
     spot: CommandedSpot,
     /// Largest localisation error (metres).
     worst: f64,
@@ -42,7 +48,8 @@ struct Outcome {
     in_obstacle_cells: usize,
 }
 
-/// Runs the navigator from `start` (facing `yaw`) to `goal` for at most `cycles` scans.
+/// Drives the robot from `start` (facing `yaw`) to `goal` for at most `cycles` scans, through
+/// the `Robot` interface as any robot is driven.
 fn run(
     building: &Building,
     map: &PointCloud,
@@ -50,7 +57,7 @@ fn run(
     yaw: f64,
     goal: Vector2<f64>,
     cycles: usize,
-) -> Outcome {
+) -> Run {
     let config = SimulationConfig::default();
     let mut spot = CommandedSpot::new(building.clone(), start, yaw, &config).unwrap();
     let truth_grid = building.occupancy_grid(0.1).unwrap();
@@ -61,41 +68,33 @@ fn run(
         map,
         &grid,
         spot.body_pose(),
+        spot.description(),
         NavigatorConfig::default(),
     )
     .unwrap();
-    let mut sample = spot.sense();
-    let mut outcome = Outcome {
-        step: NavigationStep::Walk(VelocityCommand::default()),
-        spot: spot.clone(),
-        worst: 0.0,
-        walked: 0.0,
-        cycles,
-        in_obstacle_cells: 0,
-    };
-    for cycle in 0..cycles {
-        let step = nav.step(&sample, goal);
-        let truth = sample.ground_truth.unwrap().translation.vector.xy();
-        let error = (nav.pose().translation.vector.xy() - truth).norm();
-        outcome.worst = outcome.worst.max(error);
+    let (mut worst, mut walked, mut in_obstacle_cells) = (0.0f64, 0.0, 0);
+    let mut last: Option<Vector2<f64>> = None;
+    let report = drive(&mut spot, &mut nav, goal, cycles, |cycle| {
+        let truth = cycle.sample.ground_truth.unwrap().translation.vector.xy();
+        worst = worst.max((cycle.estimate.translation.vector.xy() - truth).norm());
+        walked += last.map_or(0.0, |p| (truth - p).norm());
+        last = Some(truth);
         if truth_grid
             .cell_at(truth)
             .is_none_or(|c| truth_grid.is_blocked(c))
         {
-            outcome.in_obstacle_cells += 1;
+            in_obstacle_cells += 1;
         }
-        if let NavigationStep::Walk(command) = step {
-            let before = spot.position();
-            sample = spot.step(command);
-            outcome.walked += (spot.position() - before).norm();
-        } else {
-            outcome.step = step;
-            outcome.cycles = cycle;
-            break;
-        }
+    })
+    .unwrap();
+    Run {
+        outcome: report.outcome,
+        spot,
+        worst,
+        walked,
+        cycles: report.cycles,
+        in_obstacle_cells,
     }
-    outcome.spot = spot;
-    outcome
 }
 
 /// From the corridor into the room whose door is farthest away: arrives within the tolerance
@@ -120,14 +119,14 @@ fn walks_into_rooms_without_touching_anything() {
         goal.x,
         goal.y,
         (goal - start).norm(),
-        o.step,
+        o.outcome,
         o.cycles,
         o.walked,
         o.spot.collisions(),
         o.in_obstacle_cells,
         o.worst
     );
-    assert_eq!(o.step, NavigationStep::Arrived);
+    assert_eq!(o.outcome, DriveOutcome::Arrived);
     assert!(end < 0.3, "ended at {}", o.spot.position());
     assert_eq!(o.spot.collisions(), 0);
     assert_eq!(o.in_obstacle_cells, 0);
@@ -141,8 +140,41 @@ fn unreachable_goals_are_answered() {
     let start = building.corridor_loop()[0];
     let outside = Vector2::new(-5.0, -5.0);
     let o = run(&building, &map, start, 0.0, outside, 5);
-    assert_eq!(o.step, NavigationStep::NoPath);
+    assert_eq!(o.outcome, DriveOutcome::NoPath);
+    assert_eq!(o.cycles, 1, "answered on the first cycle");
     assert_eq!(o.spot.position(), start);
+}
+
+/// A goal that is not a finite point is an error before anything moves.
+#[test]
+fn a_non_finite_goal_is_an_error_before_any_step() {
+    let (building, map) = building_and_map();
+    let config = SimulationConfig::default();
+    let start = building.corridor_loop()[0];
+    let mut spot = CommandedSpot::new(building, start, 0.0, &config).unwrap();
+    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let grid = navigation_grid(&map, lidar_height, &NavigatorConfig::default()).unwrap();
+    let mut nav = Navigator::new(
+        point_to_plane_tracker(),
+        &map,
+        &grid,
+        spot.body_pose(),
+        spot.description(),
+        NavigatorConfig::default(),
+    )
+    .unwrap();
+    let goal = Vector2::new(f64::NAN, f64::NAN);
+    let result = drive(&mut spot, &mut nav, goal, 10, |_| {});
+    assert!(
+        matches!(
+            result,
+            Err(spot_adapter::DriveError::Navigation(
+                AdapterError::NonFiniteGoal { .. }
+            ))
+        ),
+        "{result:?}"
+    );
+    assert_eq!(spot.position(), start);
 }
 
 /// A scan that does not belong where the odometry says the robot is (taken 0.5 m away) cannot
@@ -174,17 +206,18 @@ fn a_jump_is_rejected() {
             &map,
             &grid,
             here.body_pose(),
+            here.description(),
             NavigatorConfig {
                 max_correction,
                 ..NavigatorConfig::default()
             },
         )
         .unwrap();
-        nav.step(&here.sense(), goal);
+        nav.step(&here.sense(), goal).unwrap();
         assert_eq!(nav.localisation_failures(), 0);
         let mut wrong = there.sense();
         wrong.odom_t_body = here.sense().odom_t_body;
-        nav.step(&wrong, goal);
+        nav.step(&wrong, goal).unwrap();
         let moved = (nav.pose().translation.vector - here.body_pose().translation.vector).norm();
         (moved, nav.localisation_failures())
     };

@@ -9,10 +9,9 @@ use std::path::PathBuf;
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::io::{write_kitti_bin, write_kitti_poses};
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::{
-    AdapterError, Building, BuildingConfig, KittiOdometry, KittiSequence, Recording,
-    RecordingWriter, Route, SimulatedSpot, SimulationConfig,
-};
+use spot_adapter::AdapterError;
+use spot_adapter::record::{KittiOdometry, KittiSequence, Recording, RecordingWriter};
+use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("spot-adapter-{name}-{}", std::process::id()));
@@ -54,7 +53,7 @@ fn recording_round_trip() {
         ));
     }
     // The owning iterator yields the same samples, boxed like any other sample source.
-    let stream: Box<dyn Iterator<Item = Result<spot_adapter::Sample, AdapterError>>> =
+    let stream: Box<dyn Iterator<Item = Result<spot_adapter::robot::Sample, AdapterError>>> =
         Box::new(Recording::open(&dir).unwrap().into_iter());
     let mut count = 0;
     for (got, want) in stream.map(Result::unwrap).zip(&expected) {
@@ -77,9 +76,10 @@ fn recording_without_ground_truth() {
         w.write(s).unwrap();
     }
     let rec = Recording::open(w.finish().unwrap()).unwrap();
-    assert!(rec.ground_truth().is_none() && !dir.join("ground_truth.tum").exists());
+    assert!(!rec.has_ground_truth() && !dir.join("ground_truth.tum").exists());
+    assert!(rec.read_ground_truth().unwrap().is_none());
     assert_eq!(rec.len(), samples.len());
-    assert!(rec.sample(0).unwrap().unwrap().ground_truth.is_none());
+    assert!(rec.samples().all(|s| s.unwrap().ground_truth.is_none()));
     // Mixing samples with and without ground truth, out-of-order stamps, or another mounting
     // are errors.
     let mut w = RecordingWriter::create(&dir, samples[0].body_t_lidar).unwrap();
@@ -127,6 +127,41 @@ fn inconsistent_recordings_are_errors() {
         Recording::open(&dir),
         Err(AdapterError::Io { .. })
     ));
+}
+
+/// The index may only name clouds inside the recording's folder, and a broken line is reported
+/// with its file and line number; the check runs when the recording is opened.
+#[test]
+fn index_lines_are_checked_when_opening() {
+    let dir = temp_dir("index");
+    let _ = short_run().record(&dir).unwrap();
+    let index = std::fs::read_to_string(dir.join("index.txt")).unwrap();
+    for bad in ["/dev/zero", "../elsewhere.pcd", "clouds/../../x.pcd"] {
+        let edited = index.replacen("clouds/000001.pcd", bad, 1);
+        std::fs::write(dir.join("index.txt"), edited).unwrap();
+        match Recording::open(&dir) {
+            Err(AdapterError::Recording { path, message }) => {
+                assert!(path.ends_with("index.txt"), "{path:?}");
+                assert!(message.starts_with("line 4:"), "{message}");
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    // A stamp that disagrees with the odometry's names the odometry file and line.
+    let edited = index.replacen(" 0.2 ", " 0.25 ", 1);
+    assert_ne!(edited, index);
+    std::fs::write(dir.join("index.txt"), edited).unwrap();
+    match Recording::open(&dir) {
+        Err(AdapterError::Recording { path, message }) => {
+            assert!(path.ends_with("odometry.tum"), "{path:?}");
+            // The odometry file has one header line, the index two.
+            assert!(message.starts_with("line 3:"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    std::fs::write(dir.join("index.txt"), &index).unwrap();
+    assert_eq!(Recording::open(&dir).unwrap().len(), 6);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -6,9 +6,11 @@
 
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3};
 use slam_core::Pose3;
-use spot_adapter::{
+use spot_adapter::eval::end_point_drift;
+use spot_adapter::robot::SpotGeometry;
+use spot_adapter::sim::{
     Building, BuildingConfig, OdometryDriftConfig, OdometryModel, Route, SimRng, SimulatedSpot,
-    SimulationConfig, SpotGeometry, Vlp16, Vlp16Config, end_point_drift,
+    SimulationConfig, Vlp16, Vlp16Config,
 };
 
 fn noiseless() -> Vlp16Config {
@@ -169,21 +171,20 @@ fn noise_and_dropouts_have_the_configured_size() {
 fn same_seeds_same_samples() {
     let mut config = SimulationConfig::default();
     config.seed = 9;
-    let a: Vec<_> = SimulatedSpot::corridor_loop(5, &config)
-        .unwrap()
-        .take(3)
-        .collect();
-    let b: Vec<_> = SimulatedSpot::corridor_loop(5, &config)
-        .unwrap()
-        .take(3)
-        .collect();
+    let building = Building::generate(5, &BuildingConfig::default()).unwrap();
+    let lap = Route::corridor_loop(&building);
+    let run = |config: &SimulationConfig| -> Vec<_> {
+        SimulatedSpot::new(building.clone(), &lap, config)
+            .unwrap()
+            .take(3)
+            .collect()
+    };
+    let a = run(&config);
+    let b = run(&config);
     assert!(a == b, "same seeds, same samples");
     let mut other = SimulationConfig::default();
     other.seed = 10;
-    let c: Vec<_> = SimulatedSpot::corridor_loop(5, &other)
-        .unwrap()
-        .take(3)
-        .collect();
+    let c = run(&other);
     assert!(a[2].cloud != c[2].cloud);
     assert_ne!(a[2].odom_t_body, c[2].odom_t_body);
     // The ground truth depends only on the building and the route.
@@ -192,7 +193,8 @@ fn same_seeds_same_samples() {
 
 #[test]
 fn walk_is_a_closed_lap_at_walking_speed() {
-    let sim = SimulatedSpot::corridor_loop(8, &SimulationConfig::default()).unwrap();
+    let config = SimulationConfig::with_seed(8);
+    let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let gt = sim.ground_truth();
     let first = gt[0].pose;
     let last = gt[gt.len() - 1].pose;

@@ -5,10 +5,11 @@
 
 use slam_core::io::StampedPose;
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
-use spot_adapter::{
-    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, SimulatedSpot, SimulationConfig,
-    TrajectoryEvaluation, loam_slam, point_to_plane_slam, slam_config,
+use spot_adapter::eval::{
+    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation,
 };
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// Run `slam` over the seed-3 lap (with the sweep's motion distortion when `skewed`) and assert
 /// the accuracy targets against the simulator's ground truth; returns the segment drift.
@@ -20,7 +21,7 @@ fn meets_the_accuracy_targets<R: MapRegistrator, C: MapRegistrator, O: Optimizer
     let mut config = SimulationConfig::default();
     config.seed = seed;
     config.motion_distortion = skewed;
-    let sim = SimulatedSpot::corridor_loop(seed, &config).unwrap();
+    let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
     let mut odom = Vec::new();

@@ -78,17 +78,30 @@ pub fn read_tum(path: impl AsRef<Path>) -> Result<Vec<StampedPose>, FormatError>
 /// # Errors
 /// [`FormatError::Stream`] when writing fails.
 pub fn write_tum_to(mut w: impl Write, poses: &[StampedPose]) -> Result<(), FormatError> {
-    writeln!(w, "# timestamp tx ty tz qx qy qz qw")?;
+    writeln!(w, "{TUM_HEADER}")?;
     for p in poses {
-        let t = p.pose.translation.vector;
-        let q = quaternion_to_xyzw(&p.pose.rotation);
-        writeln!(
-            w,
-            "{} {} {} {} {} {} {} {}",
-            p.stamp, t.x, t.y, t.z, q[0], q[1], q[2], q[3]
-        )?;
+        write_tum_line(&mut w, p)?;
     }
     w.flush()?;
+    Ok(())
+}
+
+/// The comment line [`write_tum_to`] starts a file with.
+pub const TUM_HEADER: &str = "# timestamp tx ty tz qx qy qz qw";
+
+/// Write one pose as a TUM line (full f64 precision), for writers that stream a trajectory
+/// pose by pose.
+///
+/// # Errors
+/// [`FormatError::Stream`] when writing fails.
+pub fn write_tum_line(mut w: impl Write, pose: &StampedPose) -> Result<(), FormatError> {
+    let t = pose.pose.translation.vector;
+    let q = quaternion_to_xyzw(&pose.pose.rotation);
+    writeln!(
+        w,
+        "{} {} {} {} {} {} {} {}",
+        pose.stamp, t.x, t.y, t.z, q[0], q[1], q[2], q[3]
+    )?;
     Ok(())
 }
 

@@ -4,8 +4,8 @@
 use nalgebra::{Translation3, UnitQuaternion, Vector2, Vector3};
 use slam_core::{Pose2, Pose3};
 
-use crate::building::Building;
 use crate::error::AdapterError;
+use crate::sim::building::Building;
 
 /// Half the length of the chord whose direction gives the heading (metres): the robot starts
 /// turning this far before a corner and finishes this far after it.
@@ -28,8 +28,10 @@ impl Route {
     /// of zero length.
     pub fn new(mut points: Vec<Vector2<f64>>, closed: bool) -> Result<Self, AdapterError> {
         if points.len() < 2 || !points.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
-            return Err(AdapterError::InvalidConfig(
-                "a route needs at least two finite points".into(),
+            return Err(AdapterError::invalid(
+                "points",
+                points.len() as f64,
+                "at least two, all finite",
             ));
         }
         points.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
@@ -41,8 +43,10 @@ impl Route {
             cumulative.push(cumulative[cumulative.len() - 1] + (w[1] - w[0]).norm());
         }
         if cumulative[cumulative.len() - 1] <= 0.0 {
-            return Err(AdapterError::InvalidConfig(
-                "the route has zero length".into(),
+            return Err(AdapterError::invalid(
+                "route length",
+                0.0,
+                "positive (metres)",
             ));
         }
         Ok(Self {
@@ -54,7 +58,7 @@ impl Route {
 
     /// One lap of the building's corridor loop, counter-clockwise, starting and ending in the
     /// middle of the south corridor. Its length is the loop's perimeter (at least 100 m with the
-    /// default [`BuildingConfig`](crate::BuildingConfig)).
+    /// default [`BuildingConfig`](crate::sim::BuildingConfig)).
     #[must_use]
     pub fn corridor_loop(building: &Building) -> Self {
         let c = building.corridor_loop();
@@ -133,10 +137,19 @@ impl Route {
         rate: f64,
         body_height: f64,
     ) -> Result<Vec<(f64, Pose3)>, AdapterError> {
-        if !(speed.is_finite() && speed > 0.0 && rate.is_finite() && rate > 0.0) {
-            return Err(AdapterError::InvalidConfig(format!(
-                "speed {speed} m/s and rate {rate} Hz must be finite and positive"
-            )));
+        if !(speed.is_finite() && speed > 0.0) {
+            return Err(AdapterError::invalid(
+                "speed",
+                speed,
+                "finite and positive (m/s)",
+            ));
+        }
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(AdapterError::invalid(
+                "rate",
+                rate,
+                "finite and positive (hertz)",
+            ));
         }
         let len = self.length();
         let step = speed / rate;

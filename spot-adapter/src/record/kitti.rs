@@ -19,7 +19,7 @@ use slam_core::Pose3;
 use slam_core::io::{parse_kitti_poses, read_kitti_bin, read_kitti_poses};
 
 use crate::error::AdapterError;
-use crate::sample::Sample;
+use crate::robot::Sample;
 
 /// Where a KITTI sequence's odometry comes from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -187,10 +187,43 @@ impl KittiSequence {
 
     /// Every sample in order, each scan read when reached.
     #[must_use]
-    pub fn samples(&self) -> impl ExactSizeIterator<Item = Result<Sample, AdapterError>> + '_ {
-        (0..self.len()).map(|i| {
-            self.sample(i)
-                .unwrap_or_else(|| Err(AdapterError::InvalidConfig("index out of range".into())))
-        })
+    pub fn samples(&self) -> KittiSamples {
+        self.clone().into_iter()
+    }
+}
+
+/// A KITTI sequence's samples read one scan at a time (from [`KittiSequence::into_iter`]).
+#[derive(Clone, Debug)]
+pub struct KittiSamples {
+    sequence: KittiSequence,
+    next: usize,
+}
+
+impl Iterator for KittiSamples {
+    type Item = Result<Sample, AdapterError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let item = self.sequence.sample(self.next)?;
+        self.next += 1;
+        Some(item)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.sequence.len() - self.next;
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for KittiSamples {}
+
+impl IntoIterator for KittiSequence {
+    type Item = Result<Sample, AdapterError>;
+    type IntoIter = KittiSamples;
+
+    fn into_iter(self) -> KittiSamples {
+        KittiSamples {
+            sequence: self,
+            next: 0,
+        }
     }
 }

@@ -4,12 +4,14 @@
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
-use crate::drift::{
+use crate::error::AdapterError;
+use crate::eval::ate::{
+    AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate,
+};
+use crate::eval::drift::{
     EndPointDrift, INDOOR_SEGMENT_LENGTHS, SegmentDrift, end_point_drift, loop_end_point_error,
     segment_drift,
 };
-use crate::error::AdapterError;
 
 /// A trajectory of LiDAR poses (`map_T_lidar` per stamp) as body poses (`map_T_body`).
 #[must_use]

@@ -4,8 +4,8 @@
 use nalgebra::Vector2;
 use slam_core::{BitGrid, GridGeometry};
 
-use crate::building::Building;
 use crate::error::AdapterError;
+use crate::sim::building::Building;
 
 /// Boxes whose bottom lies at or below this height (metres) block a walking robot; lintels above
 /// doors (2.1 m) do not. Spot is 0.84 m tall with its LiDAR, so anything lower than this

@@ -6,8 +6,8 @@ use nalgebra::Point3;
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::alignment::align_rigid;
 use crate::error::AdapterError;
+use crate::eval::alignment::align_rigid;
 
 /// Largest stamp difference (seconds) for two poses to be associated, 0.01 s (evo's default).
 pub const DEFAULT_MAX_STAMP_DIFFERENCE: f64 = 0.01;

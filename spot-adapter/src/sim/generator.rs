@@ -1,83 +1,12 @@
-//! A procedurally generated office building: a ring corridor with rooms on both sides, doors,
-//! corridor pilasters, pillars and furniture, as axis-aligned boxes between a floor and a ceiling.
-//!
-//! Layout (plan view, x east, y north, origin at the outer south-west corner):
-//!
-//! ```text
-//! +------+--------+------+-----+   outer band: rooms between the outer wall and the corridor
-//! |      |        |      |     |
-//! +--D---+---D----+--D---+--D--+
-//! |  ring corridor (loop)      |
-//! |  +---D---+---D----+---+    |
-//! |  | core rooms (two rows) | |
-//! |  +---D---+---D----+---+    |
-//! +--D---+---D----+--D---+--D--+
-//! |      |        |      |     |
-//! +------+--------+------+-----+
-//! ```
-//!
-//! Every room has one door onto the corridor, so the free space is connected. Pillars and
-//! furniture never stand in the corridor or in front of a door.
+//! The building generator: ring corridor, rooms with doors, pilasters, pillars and furniture
+//! drawn from a seed (the layout is drawn in [`Building`]'s documentation).
 
 use nalgebra::{Point3, Vector2};
 
 use crate::error::AdapterError;
-use crate::ray_cast::BoxGrid;
-use crate::rng::SimRng;
-
-/// What a box of the building is (for statistics and pictures; ray casting treats all alike).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum BoxKind {
-    /// A wall segment, floor to ceiling.
-    Wall,
-    /// The wall above a door, from the door's top to the ceiling.
-    Lintel,
-    /// A free-standing pillar or a pilaster against a corridor wall, floor to ceiling.
-    Pillar,
-    /// A desk, table, cabinet or crate standing on the floor.
-    Furniture,
-}
-
-/// An axis-aligned solid box (metres, world frame).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SolidBox {
-    /// Smallest corner.
-    pub min: Point3<f64>,
-    /// Largest corner.
-    pub max: Point3<f64>,
-    /// What it is.
-    pub kind: BoxKind,
-}
-
-impl SolidBox {
-    /// Whether the plan-view point `p` lies inside the box's footprint (borders included).
-    #[must_use]
-    pub fn contains_xy(&self, p: Vector2<f64>) -> bool {
-        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
-    }
-}
-
-/// A room: its rectangle between wall centre lines and its door onto the corridor.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Room {
-    /// South-west corner (wall centre lines, metres).
-    pub min: Vector2<f64>,
-    /// North-east corner (wall centre lines, metres).
-    pub max: Vector2<f64>,
-    /// Centre of the door opening, on the wall shared with the corridor.
-    pub door: Vector2<f64>,
-    /// Unit vector from the door into the room.
-    pub inward: Vector2<f64>,
-}
-
-impl Room {
-    /// A point 1 m inside the room straight through the door; it is always free floor.
-    #[must_use]
-    pub fn entry_point(&self) -> Vector2<f64> {
-        self.door + self.inward
-    }
-}
+use crate::sim::building::{Building, Room};
+use crate::sim::rng::SimRng;
+use crate::sim::solid_box::{BoxKind, SolidBox};
 
 /// Ranges the generator draws from (metres). Defaults give realistic office scales.
 #[derive(Clone, Debug, PartialEq)]
@@ -128,84 +57,107 @@ impl Default for BuildingConfig {
 
 impl BuildingConfig {
     fn validate(&self) -> Result<(), AdapterError> {
+        // (name of the range's low end, of its high end, the range, its floor, the requirement)
         let ranges = [
-            ("corridor_width", self.corridor_width, 1.0),
-            ("outer_room_depth", self.outer_room_depth, 2.5),
-            ("loop_length_x", self.loop_length_x, 10.0),
-            ("loop_length_y", self.loop_length_y, 10.0),
-            ("room_width", self.room_width, 2.5),
-            ("ceiling_height", self.ceiling_height, 2.2),
-            ("door_width", self.door_width, 0.6),
-            ("pilaster_spacing", self.pilaster_spacing, 1.0),
+            (
+                "corridor_width.0",
+                "corridor_width.1",
+                self.corridor_width,
+                1.0,
+                "finite, ordered, at least 1 m",
+            ),
+            (
+                "outer_room_depth.0",
+                "outer_room_depth.1",
+                self.outer_room_depth,
+                2.5,
+                "finite, ordered, at least 2.5 m",
+            ),
+            (
+                "loop_length_x.0",
+                "loop_length_x.1",
+                self.loop_length_x,
+                10.0,
+                "finite, ordered, at least 10 m",
+            ),
+            (
+                "loop_length_y.0",
+                "loop_length_y.1",
+                self.loop_length_y,
+                10.0,
+                "finite, ordered, at least 10 m",
+            ),
+            (
+                "room_width.0",
+                "room_width.1",
+                self.room_width,
+                2.5,
+                "finite, ordered, at least 2.5 m",
+            ),
+            (
+                "ceiling_height.0",
+                "ceiling_height.1",
+                self.ceiling_height,
+                2.2,
+                "finite, ordered, at least 2.2 m",
+            ),
+            (
+                "door_width.0",
+                "door_width.1",
+                self.door_width,
+                0.6,
+                "finite, ordered, at least 0.6 m",
+            ),
+            (
+                "pilaster_spacing.0",
+                "pilaster_spacing.1",
+                self.pilaster_spacing,
+                1.0,
+                "finite, ordered, at least 1 m",
+            ),
         ];
-        for (name, (lo, hi), floor) in ranges {
-            if !(lo.is_finite() && hi.is_finite() && lo >= floor && hi >= lo) {
-                return Err(AdapterError::InvalidConfig(format!(
-                    "{name} = ({lo}, {hi}) must be finite, ordered and at least {floor} m"
-                )));
+        for (low, high, (lo, hi), floor, expected) in ranges {
+            if !(lo.is_finite() && lo >= floor) {
+                return Err(AdapterError::invalid(low, lo, expected));
+            }
+            if !(hi.is_finite() && hi >= lo) {
+                return Err(AdapterError::invalid(high, hi, expected));
             }
         }
         let t = self.wall_thickness;
         if !(t.is_finite() && t > 0.0 && t < 0.5 * self.corridor_width.0) {
-            return Err(AdapterError::InvalidConfig(format!(
-                "wall_thickness = {t} m must be positive and below half the corridor width"
-            )));
+            return Err(AdapterError::invalid(
+                "wall_thickness",
+                t,
+                "positive and below half the corridor width (metres)",
+            ));
         }
         if !(self.door_height.is_finite()
             && self.door_height > 1.0
             && self.door_height < self.ceiling_height.0)
         {
-            return Err(AdapterError::InvalidConfig(format!(
-                "door_height = {} m must lie between 1 m and the ceiling",
-                self.door_height
-            )));
+            return Err(AdapterError::invalid(
+                "door_height",
+                self.door_height,
+                "between 1 m and the lowest ceiling",
+            ));
         }
         if self.door_width.1 + 1.2 > self.room_width.0 {
-            return Err(AdapterError::InvalidConfig(
-                "doors must be at least 1.2 m narrower than the narrowest room".into(),
+            return Err(AdapterError::invalid(
+                "door_width.1",
+                self.door_width.1,
+                "at least 1.2 m below room_width.0",
             ));
         }
         if self.furniture_per_room.0 > self.furniture_per_room.1 {
-            return Err(AdapterError::InvalidConfig(
-                "furniture_per_room must be ordered".into(),
+            return Err(AdapterError::invalid(
+                "furniture_per_room.0",
+                self.furniture_per_room.0 as f64,
+                "at most furniture_per_room.1",
             ));
         }
         Ok(())
     }
-}
-
-/// The generated building: boxes, rooms, the corridor loop and a ray-casting index.
-///
-/// ```
-/// use nalgebra::{Point3, Vector3};
-/// use spot_adapter::{Building, BuildingConfig, HitTarget};
-///
-/// let building = Building::generate(42, &BuildingConfig::default())?;
-/// let corner = building.corridor_loop()[0];
-/// assert!(!building.is_obstacle(corner), "the corridor is free");
-/// assert!(building.is_obstacle(nalgebra::Vector2::new(0.05, 5.0)), "the outer wall is not");
-///
-/// // Straight down from 0.8 m: the floor, 0.8 m away.
-/// let origin = Point3::new(corner.x, corner.y, 0.8);
-/// let hit = building.cast_ray(&origin, &-Vector3::z(), 100.0).unwrap();
-/// assert_eq!(hit.target, HitTarget::Floor);
-/// assert!((hit.range - 0.8).abs() < 1e-12);
-///
-/// // The ground-truth occupancy grid at 10 cm agrees.
-/// let grid = building.occupancy_grid(0.1)?;
-/// let (x, y) = grid.geometry().cell_coords(corner);
-/// assert!(grid.is_free_signed(x, y));
-/// # Ok::<(), spot_adapter::AdapterError>(())
-/// ```
-#[derive(Clone, Debug)]
-pub struct Building {
-    pub(crate) boxes: Vec<SolidBox>,
-    pub(crate) rooms: Vec<Room>,
-    pub(crate) size: Vector2<f64>,
-    pub(crate) ceiling_height: f64,
-    pub(crate) corridor_loop: [Vector2<f64>; 4],
-    pub(crate) corridor_width: f64,
-    pub(crate) index: BoxGrid,
 }
 
 /// Accumulates boxes while the generator runs.
@@ -383,58 +335,19 @@ impl Building {
             furnish(&mut d, &mut rng, room);
         }
 
-        let boxes = d.boxes;
-        let index = BoxGrid::new(&boxes, 1.0);
-        Ok(Self {
-            boxes,
+        Ok(Self::from_generated(
+            d.boxes,
             rooms,
-            size: Vector2::new(w, h),
-            ceiling_height: ceiling,
-            corridor_loop: [
+            Vector2::new(w, h),
+            ceiling,
+            [
                 Vector2::new(cx0 + 0.5 * cw, cy0 + 0.5 * cw),
                 Vector2::new(cx1 - 0.5 * cw, cy0 + 0.5 * cw),
                 Vector2::new(cx1 - 0.5 * cw, cy1 - 0.5 * cw),
                 Vector2::new(cx0 + 0.5 * cw, cy1 - 0.5 * cw),
             ],
-            corridor_width: cw,
-            index,
-        })
-    }
-
-    /// Every box (walls, lintels, pillars, furniture).
-    #[must_use]
-    pub fn boxes(&self) -> &[SolidBox] {
-        &self.boxes
-    }
-
-    /// The rooms, each with its door onto the corridor.
-    #[must_use]
-    pub fn rooms(&self) -> &[Room] {
-        &self.rooms
-    }
-
-    /// Outer size (x, y) in metres; the building spans `[0, size.x] x [0, size.y]`.
-    #[must_use]
-    pub fn size(&self) -> Vector2<f64> {
-        self.size
-    }
-
-    /// Ceiling height (metres); the floor is at z = 0.
-    #[must_use]
-    pub fn ceiling_height(&self) -> f64 {
-        self.ceiling_height
-    }
-
-    /// Corners of the corridor loop's centre line, counter-clockwise from the south-west.
-    #[must_use]
-    pub fn corridor_loop(&self) -> &[Vector2<f64>; 4] {
-        &self.corridor_loop
-    }
-
-    /// Corridor width between wall centre lines (metres).
-    #[must_use]
-    pub fn corridor_width(&self) -> f64 {
-        self.corridor_width
+            cw,
+        ))
     }
 }
 

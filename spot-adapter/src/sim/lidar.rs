@@ -4,9 +4,9 @@
 use nalgebra::{Point3, Vector3};
 use slam_core::{PointCloud, Pose3, interpolate};
 
-use crate::building::Building;
 use crate::error::AdapterError;
-use crate::rng::SimRng;
+use crate::sim::building::Building;
+use crate::sim::rng::SimRng;
 
 /// VLP-16 parameters. Angles in radians, ranges in metres, rates in hertz.
 ///
@@ -57,7 +57,7 @@ impl Default for Vlp16Config {
 ///
 /// ```
 /// use nalgebra::{Translation3, UnitQuaternion};
-/// use spot_adapter::{Building, BuildingConfig, SimRng, Vlp16, Vlp16Config};
+/// use spot_adapter::sim::{Building, BuildingConfig, SimRng, Vlp16, Vlp16Config};
 ///
 /// let building = Building::generate(1, &BuildingConfig::default())?;
 /// let lidar = Vlp16::new(Vlp16Config::default())?;
@@ -82,24 +82,58 @@ impl Vlp16 {
     /// The model for `config`.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for zero rings or columns, non-positive or non-finite
+    /// [`AdapterError::InvalidConfig`] naming the first bad setting: zero rings or columns, non-positive or non-finite
     /// ranges, rates or angles, negative noise, or a dropout probability outside `[0, 1]`.
     pub fn new(config: Vlp16Config) -> Result<Self, AdapterError> {
         let c = &config;
-        let ok = c.rings > 0
-            && c.columns > 0
-            && c.lowest_elevation.is_finite()
-            && c.ring_spacing.is_finite()
-            && c.max_range.is_finite()
-            && c.min_range >= 0.0
-            && c.max_range > c.min_range
-            && c.range_noise.is_finite()
-            && c.range_noise >= 0.0
-            && (0.0..=1.0).contains(&c.dropout_probability)
-            && c.rotation_rate.is_finite()
-            && c.rotation_rate > 0.0;
-        if !ok {
-            return Err(AdapterError::InvalidConfig(format!("{c:?}")));
+        let checks = [
+            ("rings", f64::from(c.rings), c.rings > 0, "at least 1"),
+            ("columns", f64::from(c.columns), c.columns > 0, "at least 1"),
+            (
+                "lowest_elevation",
+                c.lowest_elevation,
+                c.lowest_elevation.is_finite(),
+                "finite (radians)",
+            ),
+            (
+                "ring_spacing",
+                c.ring_spacing,
+                c.ring_spacing.is_finite(),
+                "finite (radians)",
+            ),
+            (
+                "min_range",
+                c.min_range,
+                c.min_range >= 0.0,
+                "non-negative (metres)",
+            ),
+            (
+                "max_range",
+                c.max_range,
+                c.max_range.is_finite() && c.max_range > c.min_range,
+                "finite and above min_range (metres)",
+            ),
+            (
+                "range_noise",
+                c.range_noise,
+                c.range_noise.is_finite() && c.range_noise >= 0.0,
+                "finite and non-negative (metres)",
+            ),
+            (
+                "dropout_probability",
+                c.dropout_probability,
+                (0.0..=1.0).contains(&c.dropout_probability),
+                "within [0, 1]",
+            ),
+            (
+                "rotation_rate",
+                c.rotation_rate,
+                c.rotation_rate.is_finite() && c.rotation_rate > 0.0,
+                "finite and positive (hertz)",
+            ),
+        ];
+        if let Some(&(setting, value, _, expected)) = checks.iter().find(|c| !c.2) {
+            return Err(AdapterError::invalid(setting, value, expected));
         }
         let mut directions = Vec::with_capacity(c.rings as usize * c.columns as usize);
         for col in 0..c.columns {

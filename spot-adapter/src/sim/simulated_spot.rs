@@ -4,22 +4,27 @@
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::building::{Building, BuildingConfig};
 use crate::error::AdapterError;
-use crate::frames::{GaitSway, SpotGeometry};
-use crate::lidar::{Vlp16, Vlp16Config};
-use crate::odometry::{OdometryDriftConfig, OdometryModel};
-use crate::recording::{Recording, RecordingWriter};
-use crate::rng::SimRng;
-use crate::route::Route;
-use crate::sample::Sample;
+use crate::record::{Recording, RecordingWriter};
+use crate::robot::{MotionLimits, Sample, SpotGeometry};
+use crate::sim::building::Building;
+use crate::sim::gait_sway::GaitSway;
+use crate::sim::generator::BuildingConfig;
+use crate::sim::lidar::{Vlp16, Vlp16Config};
+use crate::sim::odometry::{OdometryDriftConfig, OdometryModel};
+use crate::sim::rng::SimRng;
+use crate::sim::route::Route;
 
 /// Settings of a simulated run.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct SimulationConfig {
-    /// Seeds the sensor noise and the odometry drift (the building has its own seed).
+    /// Seeds the sensor noise and the odometry drift, and the building in
+    /// [`SimulatedSpot::corridor_loop`] (a building made with [`Building::generate`] has its
+    /// own seed).
     pub seed: u64,
+    /// The building [`SimulatedSpot::corridor_loop`] generates.
+    pub building: BuildingConfig,
     /// Walking speed, 0.6 m/s (the thesis' runs).
     pub speed: f64,
     /// The LiDAR; one sample per turn, so its `rotation_rate` (5 Hz) is the sample rate.
@@ -28,6 +33,8 @@ pub struct SimulationConfig {
     pub odometry: OdometryDriftConfig,
     /// Body height and LiDAR mounting.
     pub spot: SpotGeometry,
+    /// How fast a [`CommandedSpot`](crate::sim::CommandedSpot) may be commanded to move.
+    pub limits: MotionLimits,
     /// The body's sway while walking (none by default).
     pub gait_sway: GaitSway,
     /// Cast each column from the pose at its firing time (the robot walks 12 cm during a
@@ -40,12 +47,25 @@ impl Default for SimulationConfig {
     fn default() -> Self {
         Self {
             seed: 0,
+            building: BuildingConfig::default(),
             speed: 0.6,
             lidar: Vlp16Config::default(),
             odometry: OdometryDriftConfig::default(),
             spot: SpotGeometry::default(),
+            limits: MotionLimits::default(),
             gait_sway: GaitSway::default(),
             motion_distortion: false,
+        }
+    }
+}
+
+impl SimulationConfig {
+    /// The defaults with `seed` for the noise, the drift and the corridor-loop building.
+    #[must_use]
+    pub fn with_seed(seed: u64) -> Self {
+        Self {
+            seed,
+            ..Self::default()
         }
     }
 }
@@ -53,7 +73,7 @@ impl Default for SimulationConfig {
 /// A simulated run: an iterator of [`Sample`]s with ground truth attached.
 ///
 /// ```
-/// use spot_adapter::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
+/// use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
 ///
 /// let building = Building::generate(3, &BuildingConfig::default())?;
 /// let route = Route::corridor_loop(&building);
@@ -90,11 +110,18 @@ impl SimulatedSpot {
     ) -> Result<Self, AdapterError> {
         let lidar = Vlp16::new(config.lidar.clone())?;
         let sway = &config.gait_sway;
-        if ![sway.height, sway.tilt, sway.frequency]
-            .iter()
-            .all(|v| v.is_finite() && *v >= 0.0)
-        {
-            return Err(AdapterError::InvalidConfig(format!("{sway:?}")));
+        for (setting, value) in [
+            ("gait_sway.height", sway.height),
+            ("gait_sway.tilt", sway.tilt),
+            ("gait_sway.frequency", sway.frequency),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(AdapterError::invalid(
+                    setting,
+                    value,
+                    "finite and non-negative",
+                ));
+            }
         }
         let mut truth = route.walk(
             config.speed,
@@ -116,16 +143,13 @@ impl SimulatedSpot {
         })
     }
 
-    /// The default building for `building_seed` and one lap of its corridor loop, with
-    /// `config` for the rest.
+    /// One lap of the corridor loop of the building `config.building` generates for
+    /// `config.seed`, with the same seed for the sensor noise and the odometry drift.
     ///
     /// # Errors
     /// As [`Building::generate`] and [`SimulatedSpot::new`].
-    pub fn corridor_loop(
-        building_seed: u64,
-        config: &SimulationConfig,
-    ) -> Result<Self, AdapterError> {
-        let building = Building::generate(building_seed, &BuildingConfig::default())?;
+    pub fn corridor_loop(config: &SimulationConfig) -> Result<Self, AdapterError> {
+        let building = Building::generate(config.seed, &config.building)?;
         let route = Route::corridor_loop(&building);
         Self::new(building, &route, config)
     }

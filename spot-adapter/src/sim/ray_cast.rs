@@ -4,12 +4,12 @@
 
 use nalgebra::{Point3, Vector3};
 
-use crate::building::{Building, SolidBox};
+use crate::sim::solid_box::SolidBox;
 
 /// What a ray hit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HitTarget {
-    /// The box with this index in [`Building::boxes`].
+    /// The box with this index in [`Building::boxes`](crate::sim::Building::boxes).
     Box(usize),
     /// The floor (z = 0).
     Floor,
@@ -107,7 +107,12 @@ impl BoxGrid {
     }
 
     /// Nearest box hit with range in `[0, limit)`: (range, box index).
-    fn cast(&self, o: &Point3<f64>, d: &Vector3<f64>, limit: f64) -> Option<(f64, usize)> {
+    pub(crate) fn cast(
+        &self,
+        o: &Point3<f64>,
+        d: &Vector3<f64>,
+        limit: f64,
+    ) -> Option<(f64, usize)> {
         let inv = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         // Clip the ray to the grid's plan-view rectangle.
         let (mut t0, mut t1) = (0.0f64, limit);
@@ -220,42 +225,4 @@ fn slab(b: &[f64; 6], o: &Point3<f64>, d: &Vector3<f64>, inv: &Vector3<f64>) -> 
         }
     }
     Some(t0)
-}
-
-impl Building {
-    /// The nearest surface along a ray from `origin` in the unit direction `dir`, within
-    /// `max_range` metres; `None` when nothing lies that close.
-    #[must_use]
-    pub fn cast_ray(
-        &self,
-        origin: &Point3<f64>,
-        dir: &Vector3<f64>,
-        max_range: f64,
-    ) -> Option<RayHit> {
-        let mut limit = max_range;
-        let mut target = None;
-        if dir.z < 0.0 {
-            let t = -origin.z / dir.z;
-            if t >= 0.0 && t < limit {
-                limit = t;
-                target = Some(HitTarget::Floor);
-            }
-        } else if dir.z > 0.0 {
-            let t = (self.ceiling_height - origin.z) / dir.z;
-            if t >= 0.0 && t < limit {
-                limit = t;
-                target = Some(HitTarget::Ceiling);
-            }
-        }
-        if let Some((t, i)) = self.index.cast(origin, dir, limit) {
-            return Some(RayHit {
-                range: t,
-                target: HitTarget::Box(i),
-            });
-        }
-        target.map(|target| RayHit {
-            range: limit,
-            target,
-        })
-    }
 }

@@ -5,7 +5,7 @@ use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use slam_core::Pose3;
 
 use crate::error::AdapterError;
-use crate::rng::SimRng;
+use crate::sim::rng::SimRng;
 
 /// How the reported odometry drifts.
 ///
@@ -64,12 +64,25 @@ impl OdometryModel {
     /// outside `[-1, 1]`.
     pub fn new(config: OdometryDriftConfig, seed: u64) -> Result<Self, AdapterError> {
         let c = &config;
-        let ok = [c.drift_rate, c.yaw_noise, c.translation_noise]
-            .iter()
-            .all(|v| v.is_finite() && *v >= 0.0)
-            && (-1.0..=1.0).contains(&c.vertical_fraction);
-        if !ok {
-            return Err(AdapterError::InvalidConfig(format!("{c:?}")));
+        for (setting, value) in [
+            ("drift_rate", c.drift_rate),
+            ("yaw_noise", c.yaw_noise),
+            ("translation_noise", c.translation_noise),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(AdapterError::invalid(
+                    setting,
+                    value,
+                    "finite and non-negative",
+                ));
+            }
+        }
+        if !(-1.0..=1.0).contains(&c.vertical_fraction) {
+            return Err(AdapterError::invalid(
+                "vertical_fraction",
+                c.vertical_fraction,
+                "within [-1, 1]",
+            ));
         }
         let mut rng = SimRng::new(seed, 0x0d0e_7e11);
         let heading = rng.range(0.0, std::f64::consts::TAU);

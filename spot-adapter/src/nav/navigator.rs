@@ -5,11 +5,10 @@
 use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
 use nalgebra::Vector2;
 use pathfind::{JumpPointSearch, filter_path};
-use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
+use slam_core::{BitGrid, Cell, PlanError, Planner, PointCloud, Pose3, Registrator};
 
-use crate::commanded_spot::{MAX_YAW_RATE, VelocityCommand};
 use crate::error::AdapterError;
-use crate::sample::Sample;
+use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 
 /// Settings of [`Navigator`]. Lengths in metres, angles in radians, speeds per second.
 #[derive(Clone, Debug, PartialEq)]
@@ -55,22 +54,20 @@ impl NavigatorConfig {
     /// # Errors
     /// [`AdapterError::InvalidConfig`] naming the settings.
     pub fn validate(&self) -> Result<(), AdapterError> {
-        let positive = [
-            self.clearance,
-            self.goal_tolerance,
-            self.turn_in_place_above,
-            self.speed,
-            self.heading_gain,
-            self.max_correction,
-            self.max_correction_angle,
-        ];
-        if positive.iter().all(|v| v.is_finite() && *v > 0.0) {
-            Ok(())
-        } else {
-            Err(AdapterError::InvalidConfig(format!(
-                "navigator settings must be finite and positive: {self:?}"
-            )))
+        for (setting, value) in [
+            ("clearance", self.clearance),
+            ("goal_tolerance", self.goal_tolerance),
+            ("turn_in_place_above", self.turn_in_place_above),
+            ("speed", self.speed),
+            ("heading_gain", self.heading_gain),
+            ("max_correction", self.max_correction),
+            ("max_correction_angle", self.max_correction_angle),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(AdapterError::invalid(setting, value, "finite and positive"));
+            }
         }
+        Ok(())
     }
 }
 
@@ -79,7 +76,8 @@ impl NavigatorConfig {
 /// once per map; the navigator borrows it, so its planner labels the grid once, not per cycle.
 ///
 /// # Errors
-/// [`AdapterError::InvalidConfig`] for invalid settings or a grid that cannot be built.
+/// [`AdapterError::InvalidConfig`] for invalid settings, [`AdapterError::NavigationGrid`]
+/// (with the grid builder's error as its source) for a grid that cannot be built.
 pub fn navigation_grid(
     map: &PointCloud,
     lidar_height: f64,
@@ -88,7 +86,7 @@ pub fn navigation_grid(
     config.validate()?;
     let occupancy = OccupancyGridBuilder::new(config.grid.clone())
         .and_then(|b| b.build(map, lidar_height))
-        .map_err(|e| AdapterError::InvalidConfig(format!("navigator grid: {e}")))?;
+        .map_err(AdapterError::NavigationGrid)?;
     Ok(inflate(occupancy.occupied(), config.clearance))
 }
 
@@ -115,6 +113,7 @@ pub enum NavigationStep {
 /// nothing loops forever.
 pub struct Navigator<'g, R: Registrator> {
     config: NavigatorConfig,
+    limits: MotionLimits,
     registrator: R,
     map: R::Target,
     grid: &'g BitGrid,
@@ -126,24 +125,30 @@ pub struct Navigator<'g, R: Registrator> {
 }
 
 impl<'g, R: Registrator> Navigator<'g, R> {
-    /// A navigator on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) and its `grid`
-    /// ([`navigation_grid`]), localising with `registrator`, starting from `map_t_body`.
+    /// A navigator for `robot` on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) and
+    /// its `grid` ([`navigation_grid`]), localising with `registrator`, starting from
+    /// `map_t_body`. Its commands keep to the robot's motion limits.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid settings or a map the registrator refuses.
+    /// [`AdapterError::InvalidConfig`] for invalid settings or limits,
+    /// [`AdapterError::LocalisationMap`] (with the registrator's error as its source) for a
+    /// map the registrator refuses.
     pub fn new(
         registrator: R,
         map: &PointCloud,
         grid: &'g BitGrid,
         map_t_body: Pose3,
+        robot: &RobotDescription,
         config: NavigatorConfig,
     ) -> Result<Self, AdapterError> {
         config.validate()?;
+        robot.limits.validate()?;
         let target = registrator
             .prepare_target(map)
-            .map_err(|e| AdapterError::InvalidConfig(format!("navigator map: {e}")))?;
+            .map_err(AdapterError::LocalisationMap)?;
         Ok(Self {
             config,
+            limits: robot.limits.clone(),
             registrator,
             map: target,
             grid,
@@ -156,19 +161,34 @@ impl<'g, R: Registrator> Navigator<'g, R> {
     }
 
     /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame, metres).
-    pub fn step(&mut self, sample: &Sample, goal: Vector2<f64>) -> NavigationStep {
+    ///
+    /// # Errors
+    /// [`AdapterError::NonFiniteGoal`] for a goal that is not a finite point (checked before
+    /// anything else); [`AdapterError::Planner`] when the planner refuses its arguments, which
+    /// the navigator's own checks rule out (a defect, not an answer).
+    pub fn step(
+        &mut self,
+        sample: &Sample,
+        goal: Vector2<f64>,
+    ) -> Result<NavigationStep, AdapterError> {
+        if !(goal.x.is_finite() && goal.y.is_finite()) {
+            return Err(AdapterError::NonFiniteGoal {
+                x: goal.x,
+                y: goal.y,
+            });
+        }
         self.localise(sample);
         let position = self.map_t_body.translation.vector.xy();
         if (goal - position).norm() <= self.config.goal_tolerance {
             self.waypoints.clear();
-            return NavigationStep::Arrived;
+            return Ok(NavigationStep::Arrived);
         }
-        let Some(waypoints) = self.plan(position, goal) else {
+        let Some(waypoints) = self.plan(position, goal)? else {
             self.waypoints.clear();
-            return NavigationStep::NoPath;
+            return Ok(NavigationStep::NoPath);
         };
         self.waypoints = waypoints;
-        NavigationStep::Walk(self.command(position))
+        Ok(NavigationStep::Walk(self.command(position)))
     }
 
     /// Predict from the odometry, then correct by registration (the prediction stands when the
@@ -198,16 +218,33 @@ impl<'g, R: Registrator> Navigator<'g, R> {
     }
 
     /// Waypoints (metres) from `position` to `goal` after the start, or `None` when none joins
-    /// them. A start inside the inflated obstacles (the robot brushed a wall) plans from the
-    /// nearest free cell.
-    fn plan(&mut self, position: Vector2<f64>, goal: Vector2<f64>) -> Option<Vec<Vector2<f64>>> {
-        let goal_cell = self
+    /// them (the goal off the map or blocked, the robot off the map, or no path). A start
+    /// inside the inflated obstacles (the robot brushed a wall) plans from the nearest free
+    /// cell.
+    fn plan(
+        &mut self,
+        position: Vector2<f64>,
+        goal: Vector2<f64>,
+    ) -> Result<Option<Vec<Vector2<f64>>>, AdapterError> {
+        let Some(goal_cell) = self
             .grid
             .cell_at(goal)
-            .filter(|&c| !self.grid.is_blocked(c))?;
-        let start = nearest_free(self.grid, self.grid.cell_at(position)?)?;
-        // Both ends are on the grid and free: `NoPath` is the only error left.
-        let path = self.planner.plan(start, goal_cell).ok()?;
+            .filter(|&c| !self.grid.is_blocked(c))
+        else {
+            return Ok(None);
+        };
+        let Some(start) = self
+            .grid
+            .cell_at(position)
+            .and_then(|c| nearest_free(self.grid, c))
+        else {
+            return Ok(None);
+        };
+        let path = match self.planner.plan(start, goal_cell) {
+            Ok(path) => path,
+            Err(PlanError::NoPath) => return Ok(None),
+            Err(e) => return Err(AdapterError::Planner(e)),
+        };
         let filtered = filter_path(self.grid, &path);
         let mut waypoints: Vec<Vector2<f64>> = filtered
             .waypoints
@@ -221,7 +258,7 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         } else {
             waypoints.push(goal);
         }
-        Some(waypoints)
+        Ok(Some(waypoints))
     }
 
     /// The command toward the first waypoint that is not already underfoot.
@@ -237,19 +274,15 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         let to = target - position;
         let yaw = self.map_t_body.rotation.euler_angles().2;
         let error = wrap(to.y.atan2(to.x) - yaw);
-        let yaw_rate = (self.config.heading_gain * error).clamp(-MAX_YAW_RATE, MAX_YAW_RATE);
+        let max_yaw_rate = self.limits.max_yaw_rate;
+        let yaw_rate = (self.config.heading_gain * error).clamp(-max_yaw_rate, max_yaw_rate);
         if error.abs() > self.config.turn_in_place_above {
-            return VelocityCommand {
-                forward: 0.0,
-                yaw_rate,
-            };
+            return VelocityCommand::new(0.0, yaw_rate);
         }
         // Slow down for the last metre so that one 0.2 s step cannot overshoot the tolerance.
         let remaining: f64 = self.waypoints.last().map_or(0.0, |g| (g - position).norm());
-        VelocityCommand {
-            forward: self.config.speed.min(remaining) * error.cos(),
-            yaw_rate,
-        }
+        let speed = self.config.speed.min(self.limits.max_forward_speed);
+        VelocityCommand::new(speed.min(remaining) * error.cos(), yaw_rate)
     }
 
     /// The current estimate of the body pose in the map frame.

@@ -1,0 +1,94 @@
+//! The driving loop: a [`Robot`]'s samples into a [`Navigator`], its commands back out, until
+//! the goal is reached, no path is left, or the cycles run out; the robot is stopped on every
+//! way out, errors included.
+
+use nalgebra::Vector2;
+use slam_core::{Pose3, Registrator};
+
+use crate::error::DriveError;
+use crate::nav::navigator::{NavigationStep, Navigator};
+use crate::robot::{MobilityCommand, Robot, Sample};
+
+/// How a drive ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum DriveOutcome {
+    /// The navigator estimates the body within its goal tolerance.
+    Arrived,
+    /// No collision-free path joins the robot and the goal on the map.
+    NoPath,
+    /// The cycle budget ran out first.
+    GaveUp,
+}
+
+/// What a drive did: how it ended and the cycles it took.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DriveReport {
+    /// How it ended.
+    pub outcome: DriveOutcome,
+    /// Samples taken (navigator cycles).
+    pub cycles: usize,
+}
+
+/// One cycle of a drive, as [`drive`] shows it to its observer.
+#[derive(Clone, Copy, Debug)]
+pub struct DriveCycle<'a> {
+    /// The sample the cycle ran on.
+    pub sample: &'a Sample,
+    /// What the navigator decided.
+    pub step: &'a NavigationStep,
+    /// The navigator's estimate of the body pose after localising (map frame).
+    pub estimate: Pose3,
+}
+
+/// Drive `robot` with `navigator` toward `goal` (map frame, metres) for at most `max_cycles`
+/// samples. `observe` sees every cycle: the sample, the navigator's decision and its estimate
+/// (for logging and evaluation). The robot is sent a stop however the drive ends.
+///
+/// # Errors
+/// [`DriveError::Robot`] when the robot fails to deliver a sample or take a command, and
+/// [`DriveError::Navigation`] when the navigator fails (a non-finite goal); the robot was
+/// sent a stop first (if that fails too, the first error is the one returned).
+pub fn drive<R: Robot, G: Registrator>(
+    robot: &mut R,
+    navigator: &mut Navigator<'_, G>,
+    goal: Vector2<f64>,
+    max_cycles: usize,
+    mut observe: impl FnMut(&DriveCycle<'_>),
+) -> Result<DriveReport, DriveError<R::Error>> {
+    let result = (|| {
+        for cycle in 1..=max_cycles {
+            let sample = robot.next_sample().map_err(DriveError::Robot)?;
+            let step = navigator
+                .step(&sample, goal)
+                .map_err(DriveError::Navigation)?;
+            observe(&DriveCycle {
+                sample: &sample,
+                step: &step,
+                estimate: navigator.pose(),
+            });
+            let outcome = match step {
+                NavigationStep::Walk(command) => {
+                    robot
+                        .send(&MobilityCommand::Velocity(command))
+                        .map_err(DriveError::Robot)?;
+                    continue;
+                }
+                NavigationStep::Arrived => DriveOutcome::Arrived,
+                NavigationStep::NoPath => DriveOutcome::NoPath,
+            };
+            return Ok(DriveReport {
+                outcome,
+                cycles: cycle,
+            });
+        }
+        Ok(DriveReport {
+            outcome: DriveOutcome::GaveUp,
+            cycles: max_cycles,
+        })
+    })();
+    let stopped = robot.stop().map_err(DriveError::Robot);
+    let report = result?;
+    stopped?;
+    Ok(report)
+}

@@ -1,0 +1,12 @@
+//! Navigation on a map: the [`Navigator`] (localise each scan against the map, plan on its
+//! occupancy grid, turn the path into a velocity command) and [`drive`], the loop that runs it
+//! on any [`Robot`](crate::robot::Robot).
+//!
+//! Uses `robot` (samples, commands, limits), `gridmap`, `pathfind` and `slam-core`, never the
+//! simulator: the same code drives a simulated Spot and a real one.
+
+mod drive;
+mod navigator;
+
+pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
+pub use navigator::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};

@@ -1,0 +1,536 @@
+//! Recordings on disk: a folder a simulated or real run is written to and read back from,
+//! scan by scan in both directions, so memory does not grow with the run's length.
+//!
+//! ```text
+//! DIR/index.txt          "# spot-nav recording v1", then one line per scan: index stamp cloud-path
+//! DIR/calibration.txt    "body_T_lidar tx ty tz qx qy qz qw" (metres, TUM quaternion order)
+//! DIR/odometry.tum       odom_T_body per scan (TUM: stamp tx ty tz qx qy qz qw)
+//! DIR/ground_truth.tum   world_T_body per scan, optional
+//! DIR/clouds/000000.pcd  points in the LiDAR frame (binary PCD with ring and time channels)
+//! ```
+//!
+//! Stamps in the index and in the trajectories must agree line by line, and cloud paths must
+//! lie inside the folder; the reader checks both.
+
+use std::fs::{self, File};
+use std::io::{BufRead, BufReader, BufWriter, Lines, Write};
+use std::path::{Component, Path, PathBuf};
+
+use nalgebra::Translation3;
+use slam_core::io::{
+    PcdEncoding, StampedPose, TUM_HEADER, parse_tum, read_pcd, read_tum, write_pcd, write_tum_line,
+};
+use slam_core::{FormatError, Pose3, quaternion_from_xyzw, quaternion_to_xyzw};
+
+use crate::error::AdapterError;
+use crate::robot::Sample;
+
+const INDEX: &str = "index.txt";
+const CALIBRATION: &str = "calibration.txt";
+const ODOMETRY: &str = "odometry.tum";
+const GROUND_TRUTH: &str = "ground_truth.tum";
+const CLOUDS: &str = "clouds";
+const HEADER: &str = "# spot-nav recording v1";
+/// Largest stamp difference (seconds) between the index and a trajectory line.
+const STAMP_TOLERANCE: f64 = 1e-6;
+
+/// A text file being written line by line.
+#[derive(Debug)]
+struct LineFile {
+    path: PathBuf,
+    out: BufWriter<File>,
+}
+
+impl LineFile {
+    fn create(path: PathBuf, header: &str) -> Result<Self, AdapterError> {
+        let file = File::create(&path).map_err(|e| AdapterError::io(&path, e))?;
+        let mut out = BufWriter::new(file);
+        writeln!(out, "{header}").map_err(|e| AdapterError::io(&path, e))?;
+        Ok(Self { path, out })
+    }
+
+    fn pose(&mut self, pose: &StampedPose) -> Result<(), AdapterError> {
+        write_tum_line(&mut self.out, pose).map_err(|e| match e {
+            FormatError::Stream(source) => AdapterError::io(&self.path, source),
+            other => other.into(),
+        })
+    }
+
+    fn line(&mut self, text: &str) -> Result<(), AdapterError> {
+        writeln!(self.out, "{text}").map_err(|e| AdapterError::io(&self.path, e))
+    }
+
+    fn finish(mut self) -> Result<(), AdapterError> {
+        self.out
+            .flush()
+            .map_err(|e| AdapterError::io(&self.path, e))
+    }
+}
+
+/// Writes samples into a recording folder as they come (a cloud file and a line in each
+/// trajectory per sample); call [`RecordingWriter::finish`] at the end.
+#[derive(Debug)]
+pub struct RecordingWriter {
+    dir: PathBuf,
+    body_t_lidar: Pose3,
+    index: LineFile,
+    odometry: LineFile,
+    ground_truth: Option<LineFile>,
+    written: usize,
+    last_stamp: Option<f64>,
+}
+
+impl RecordingWriter {
+    /// Create (or reuse) the folder `dir` for a recording with the LiDAR mounted at
+    /// `body_t_lidar`; writes the calibration at once.
+    ///
+    /// # Errors
+    /// [`AdapterError::Io`] when the folders or files cannot be created.
+    pub fn create(dir: impl AsRef<Path>, body_t_lidar: Pose3) -> Result<Self, AdapterError> {
+        let dir = dir.as_ref().to_path_buf();
+        let clouds = dir.join(CLOUDS);
+        fs::create_dir_all(&clouds).map_err(|e| AdapterError::io(&clouds, e))?;
+        let t = body_t_lidar.translation.vector;
+        let q = quaternion_to_xyzw(&body_t_lidar.rotation);
+        let calib = format!(
+            "# LiDAR pose in Spot's body frame: tx ty tz qx qy qz qw\nbody_T_lidar {} {} {} {} {} {} {}\n",
+            t.x, t.y, t.z, q[0], q[1], q[2], q[3]
+        );
+        let path = dir.join(CALIBRATION);
+        fs::write(&path, calib).map_err(|e| AdapterError::io(&path, e))?;
+        // A stale ground truth from an earlier recording in the same folder would disagree.
+        let stale = dir.join(GROUND_TRUTH);
+        if stale.exists() {
+            fs::remove_file(&stale).map_err(|e| AdapterError::io(&stale, e))?;
+        }
+        Ok(Self {
+            index: LineFile::create(dir.join(INDEX), &format!("{HEADER}\n# index stamp cloud"))?,
+            odometry: LineFile::create(dir.join(ODOMETRY), TUM_HEADER)?,
+            ground_truth: None,
+            dir,
+            body_t_lidar,
+            written: 0,
+            last_stamp: None,
+        })
+    }
+
+    /// Write one sample: its cloud file, its index line and its poses.
+    ///
+    /// # Errors
+    /// [`AdapterError::Recording`] when the sample's mounting differs from the recording's,
+    /// its stamp does not increase, or only some samples carry ground truth;
+    /// [`AdapterError::Format`] or [`AdapterError::Io`] when a file cannot be written.
+    pub fn write(&mut self, sample: &Sample) -> Result<(), AdapterError> {
+        let err = |message: String| AdapterError::Recording {
+            path: self.dir.clone(),
+            message,
+        };
+        let d = self.body_t_lidar.inverse() * sample.body_t_lidar;
+        if d.translation.vector.norm() > 1e-9 || d.rotation.angle() > 1e-9 {
+            return Err(err(format!(
+                "sample {} has another body_T_lidar than the recording",
+                self.written
+            )));
+        }
+        if let Some(last) = self.last_stamp
+            && sample.stamp.partial_cmp(&last) != Some(std::cmp::Ordering::Greater)
+        {
+            return Err(err(format!(
+                "stamp {} does not follow {last}",
+                sample.stamp
+            )));
+        }
+        // The first sample decides whether the recording carries ground truth.
+        if self.written == 0 && sample.ground_truth.is_some() {
+            self.ground_truth = Some(LineFile::create(self.dir.join(GROUND_TRUTH), TUM_HEADER)?);
+        }
+        if sample.ground_truth.is_some() != self.ground_truth.is_some() {
+            return Err(err(
+                "ground truth must be given for all samples or none".into()
+            ));
+        }
+        let name = format!("{CLOUDS}/{:06}.pcd", self.written);
+        write_pcd(self.dir.join(&name), &sample.cloud, PcdEncoding::Binary)?;
+        self.index
+            .line(&format!("{} {} {name}", self.written, sample.stamp))?;
+        self.odometry.pose(&StampedPose {
+            stamp: sample.stamp,
+            pose: sample.odom_t_body,
+        })?;
+        if let (Some(file), Some(pose)) = (&mut self.ground_truth, sample.ground_truth) {
+            file.pose(&StampedPose {
+                stamp: sample.stamp,
+                pose,
+            })?;
+        }
+        self.written += 1;
+        self.last_stamp = Some(sample.stamp);
+        Ok(())
+    }
+
+    /// Flush the index and the trajectories; returns the folder.
+    ///
+    /// # Errors
+    /// [`AdapterError::Io`] when a file cannot be written.
+    pub fn finish(self) -> Result<PathBuf, AdapterError> {
+        self.index.finish()?;
+        self.odometry.finish()?;
+        if let Some(gt) = self.ground_truth {
+            gt.finish()?;
+        }
+        Ok(self.dir)
+    }
+}
+
+/// A recording opened for reading. Opening checks the whole folder line by line (counts,
+/// stamps, cloud paths) without keeping it; [`Recording::samples`] then reads one scan at a
+/// time.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    dir: PathBuf,
+    body_t_lidar: Pose3,
+    len: usize,
+    has_ground_truth: bool,
+}
+
+/// A text file read line by line, with its path and the line number reached.
+struct LineReader {
+    path: PathBuf,
+    lines: Lines<BufReader<File>>,
+    line: usize,
+}
+
+impl std::fmt::Debug for LineReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "LineReader({}, line {})", self.path.display(), self.line)
+    }
+}
+
+impl LineReader {
+    fn open(path: PathBuf) -> Result<Self, AdapterError> {
+        let file = File::open(&path).map_err(|e| AdapterError::io(&path, e))?;
+        Ok(Self {
+            lines: BufReader::new(file).lines(),
+            path,
+            line: 0,
+        })
+    }
+
+    /// The next line that is neither blank nor a comment, with its 1-based number.
+    fn next_entry(&mut self) -> Result<Option<(usize, String)>, AdapterError> {
+        for line in self.lines.by_ref() {
+            self.line += 1;
+            let line = line.map_err(|e| AdapterError::io(&self.path, e))?;
+            let trimmed = line.trim();
+            if !(trimmed.is_empty() || trimmed.starts_with('#')) {
+                return Ok(Some((self.line, trimmed.to_owned())));
+            }
+        }
+        Ok(None)
+    }
+
+    fn error(&self, line: usize, message: impl std::fmt::Display) -> AdapterError {
+        AdapterError::Recording {
+            path: self.path.clone(),
+            message: format!("line {line}: {message}"),
+        }
+    }
+
+    /// The next pose of a TUM file, `None` at its end.
+    fn next_pose(&mut self) -> Result<Option<StampedPose>, AdapterError> {
+        let Some((line, text)) = self.next_entry()? else {
+            return Ok(None);
+        };
+        match parse_tum(&text) {
+            Ok(mut poses) if poses.len() == 1 => Ok(poses.pop()),
+            Ok(_) => Err(self.error(line, "expected one pose")),
+            Err(FormatError::Line { message, .. }) => Err(self.error(line, message)),
+            Err(other) => Err(other.into()),
+        }
+    }
+}
+
+/// One index line: the stamp and the cloud's path inside the folder.
+fn parse_index_line(
+    reader: &LineReader,
+    dir: &Path,
+    line: usize,
+    text: &str,
+) -> Result<(f64, PathBuf), AdapterError> {
+    let fields: Vec<&str> = text.split_whitespace().collect();
+    let [_, stamp, cloud] = fields.as_slice() else {
+        return Err(reader.error(line, "expected: index stamp cloud"));
+    };
+    let stamp = stamp
+        .parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite())
+        .ok_or_else(|| reader.error(line, format!("stamp {stamp:?} is not a finite number")))?;
+    let relative = Path::new(cloud);
+    if !relative
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+    {
+        return Err(reader.error(
+            line,
+            format!("cloud path {cloud:?} must be relative and stay inside the recording"),
+        ));
+    }
+    Ok((stamp, dir.join(relative)))
+}
+
+fn parse_calibration(path: &Path, text: &str) -> Result<Pose3, AdapterError> {
+    let bad = |message: String| AdapterError::Recording {
+        path: path.to_path_buf(),
+        message,
+    };
+    let line = text
+        .lines()
+        .map(str::trim)
+        .find(|l| l.starts_with("body_T_lidar"))
+        .ok_or_else(|| bad("no body_T_lidar line".into()))?;
+    let v: Vec<f64> = line
+        .split_whitespace()
+        .skip(1)
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .map_err(|e| bad(format!("body_T_lidar: {e}")))?;
+    if v.len() != 7 || !v.iter().all(|x| x.is_finite()) {
+        return Err(bad("body_T_lidar needs 7 finite numbers".into()));
+    }
+    let q = quaternion_from_xyzw([v[3], v[4], v[5], v[6]])
+        .ok_or_else(|| bad("body_T_lidar quaternion is not unit".into()))?;
+    Ok(Pose3::from_parts(Translation3::new(v[0], v[1], v[2]), q))
+}
+
+impl Recording {
+    /// Open the recording in `dir`, checking it whole in one streaming pass.
+    ///
+    /// # Errors
+    /// [`AdapterError::Io`] or [`AdapterError::Format`] when a file is missing or malformed,
+    /// [`AdapterError::Recording`] when the files disagree (counts, stamps) or a cloud path
+    /// leaves the folder.
+    pub fn open(dir: impl AsRef<Path>) -> Result<Self, AdapterError> {
+        let dir = dir.as_ref().to_path_buf();
+        let cal_path = dir.join(CALIBRATION);
+        let cal = fs::read_to_string(&cal_path).map_err(|e| AdapterError::io(&cal_path, e))?;
+        let body_t_lidar = parse_calibration(&cal_path, &cal)?;
+        let has_ground_truth = dir.join(GROUND_TRUTH).exists();
+        let mut recording = Self {
+            dir,
+            body_t_lidar,
+            len: 0,
+            has_ground_truth,
+        };
+        let mut len = 0;
+        for sample in recording.entries()? {
+            sample?;
+            len += 1;
+        }
+        recording.len = len;
+        Ok(recording)
+    }
+
+    /// The entries (stamp, cloud path, poses) without reading the clouds.
+    fn entries(&self) -> Result<Entries, AdapterError> {
+        Ok(Entries {
+            dir: self.dir.clone(),
+            index: LineReader::open(self.dir.join(INDEX))?,
+            odometry: LineReader::open(self.dir.join(ODOMETRY))?,
+            ground_truth: if self.has_ground_truth {
+                Some(LineReader::open(self.dir.join(GROUND_TRUTH))?)
+            } else {
+                None
+            },
+            done: false,
+        })
+    }
+
+    /// The folder.
+    #[must_use]
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Number of scans.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the recording has no scan.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The LiDAR mounting.
+    #[must_use]
+    pub fn body_t_lidar(&self) -> Pose3 {
+        self.body_t_lidar
+    }
+
+    /// Whether the recording carries ground truth.
+    #[must_use]
+    pub fn has_ground_truth(&self) -> bool {
+        self.has_ground_truth
+    }
+
+    /// The whole ground-truth trajectory (one pose per scan, for evaluating a run), `None`
+    /// when the recording has none.
+    ///
+    /// # Errors
+    /// [`AdapterError::Format`] when the file cannot be read.
+    pub fn read_ground_truth(&self) -> Result<Option<Vec<StampedPose>>, AdapterError> {
+        if !self.has_ground_truth {
+            return Ok(None);
+        }
+        Ok(Some(read_tum(self.dir.join(GROUND_TRUTH))?))
+    }
+
+    /// The whole odometry trajectory, one pose per scan.
+    ///
+    /// # Errors
+    /// [`AdapterError::Format`] when the file cannot be read.
+    pub fn read_odometry(&self) -> Result<Vec<StampedPose>, AdapterError> {
+        Ok(read_tum(self.dir.join(ODOMETRY))?)
+    }
+
+    /// Every sample in order, each read from disk when reached; the recording stays usable.
+    #[must_use]
+    pub fn samples(&self) -> RecordingSamples {
+        self.clone().into_iter()
+    }
+}
+
+/// Index and trajectory lines read in step.
+#[derive(Debug)]
+struct Entries {
+    dir: PathBuf,
+    index: LineReader,
+    odometry: LineReader,
+    ground_truth: Option<LineReader>,
+    done: bool,
+}
+
+/// One scan's entry: stamp, cloud path, odometry, ground truth.
+struct Entry {
+    stamp: f64,
+    cloud: PathBuf,
+    odom_t_body: Pose3,
+    ground_truth: Option<Pose3>,
+}
+
+impl Entries {
+    fn read(&mut self) -> Result<Option<Entry>, AdapterError> {
+        let Some((line, text)) = self.index.next_entry()? else {
+            // The trajectories must end with the index.
+            for reader in std::iter::once(&mut self.odometry).chain(self.ground_truth.as_mut()) {
+                if let Some((line, _)) = reader.next_entry()? {
+                    return Err(reader.error(line, "more poses than scans in the index"));
+                }
+            }
+            return Ok(None);
+        };
+        let (stamp, cloud) = parse_index_line(&self.index, &self.dir, line, &text)?;
+        let pose_of = |reader: &mut LineReader| -> Result<Pose3, AdapterError> {
+            let at = reader.line;
+            let pose = reader
+                .next_pose()?
+                .ok_or_else(|| reader.error(at + 1, format!("no pose for scan stamped {stamp}")))?;
+            if (pose.stamp - stamp).abs() > STAMP_TOLERANCE {
+                return Err(reader.error(
+                    reader.line,
+                    format!("pose stamped {} but its scan {}", pose.stamp, stamp),
+                ));
+            }
+            Ok(pose.pose)
+        };
+        let odom_t_body = pose_of(&mut self.odometry)?;
+        let ground_truth = match self.ground_truth.as_mut() {
+            Some(reader) => Some(pose_of(reader)?),
+            None => None,
+        };
+        Ok(Some(Entry {
+            stamp,
+            cloud,
+            odom_t_body,
+            ground_truth,
+        }))
+    }
+}
+
+impl Iterator for Entries {
+    type Item = Result<Entry, AdapterError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        let item = self.read().transpose();
+        // After an error or the end, nothing more: a malformed line is not skipped.
+        if !matches!(item, Some(Ok(_))) {
+            self.done = true;
+        }
+        item
+    }
+}
+
+/// A recording's samples read one at a time (from [`Recording::into_iter`] or
+/// [`Recording::samples`]); memory stays that of one scan however long the recording is.
+#[derive(Debug)]
+pub struct RecordingSamples {
+    body_t_lidar: Pose3,
+    entries: Result<Entries, Option<AdapterError>>,
+    left: usize,
+}
+
+impl Iterator for RecordingSamples {
+    type Item = Result<Sample, AdapterError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let entries = match &mut self.entries {
+            Ok(entries) => entries,
+            // The files could not be opened again: say so once.
+            Err(e) => return e.take().map(Err),
+        };
+        let entry = match entries.next()? {
+            Ok(entry) => entry,
+            Err(e) => {
+                self.left = 0;
+                return Some(Err(e));
+            }
+        };
+        self.left = self.left.saturating_sub(1);
+        Some(
+            read_pcd(&entry.cloud)
+                .map_err(AdapterError::from)
+                .map(|cloud| Sample {
+                    stamp: entry.stamp,
+                    odom_t_body: entry.odom_t_body,
+                    body_t_lidar: self.body_t_lidar,
+                    cloud,
+                    ground_truth: entry.ground_truth,
+                }),
+        )
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (0, Some(self.left))
+    }
+}
+
+impl IntoIterator for Recording {
+    type Item = Result<Sample, AdapterError>;
+    type IntoIter = RecordingSamples;
+
+    /// Every sample in order, each cloud read when reached; the iterator owns what it reads
+    /// from, so it can be returned or boxed beside a simulated run.
+    fn into_iter(self) -> RecordingSamples {
+        RecordingSamples {
+            body_t_lidar: self.body_t_lidar,
+            entries: self.entries().map_err(Some),
+            left: self.len,
+        }
+    }
+}

@@ -1,0 +1,267 @@
+//! A simulated Spot driven by motion commands: the closed-loop counterpart of
+//! [`SimulatedSpot`](crate::sim::SimulatedSpot), which walks a route fixed in advance.
+
+use nalgebra::{Translation3, UnitQuaternion, Vector2};
+use slam_core::{Pose2, Pose3};
+
+use crate::error::AdapterError;
+use crate::robot::{
+    MobilityCommand, Robot, RobotDescription, Sample, Se2Trajectory, TrajectoryFrame,
+    VelocityCommand,
+};
+use crate::sim::building::Building;
+use crate::sim::lidar::Vlp16;
+use crate::sim::odometry::OdometryModel;
+use crate::sim::rng::SimRng;
+use crate::sim::simulated_spot::SimulationConfig;
+
+/// The command a [`CommandedSpot`] is carrying out.
+#[derive(Clone, Debug)]
+enum Active {
+    Velocity(VelocityCommand),
+    /// A trajectory in the odometry frame, with the stamp it was sent at.
+    Trajectory(Se2Trajectory, f64),
+}
+
+/// A simulated Spot that walks where it is told: each [`CommandedSpot::step`] holds a velocity
+/// command for one LiDAR turn (0.2 s at 5 Hz), moves the true body, integrates the drifting
+/// odometry and casts the next scan. A step that would put the body centre closer than
+/// `half_width` to an obstacle (the building's own or one added later) leaves the body where
+/// it stands, except for its turn, and counts a collision: a real Spot turns in place where it
+/// cannot walk, and its own obstacle avoidance stops it short of a wall.
+///
+/// It is a [`Robot`]: [`Robot::next_sample`] gives the scan where it stands on the first call
+/// and then advances one LiDAR turn under the command in force; [`Robot::send`] takes velocity
+/// commands and trajectories in the `odom` frame, which it tracks with its own (drifting)
+/// odometry as a real Spot does.
+///
+/// ```
+/// use spot_adapter::robot::VelocityCommand;
+/// use spot_adapter::sim::{Building, BuildingConfig, CommandedSpot, SimulationConfig};
+///
+/// let building = Building::generate(3, &BuildingConfig::default())?;
+/// let start = building.corridor_loop()[0];
+/// let mut spot = CommandedSpot::new(building, start, 0.0, &SimulationConfig::default())?;
+/// let sample = spot.step(VelocityCommand::new(0.5, 0.0));
+/// assert!(sample.cloud.len() > 20_000);
+/// assert!((spot.position() - start).norm() > 0.09);
+/// # Ok::<(), spot_adapter::AdapterError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct CommandedSpot {
+    building: Building,
+    lidar: Vlp16,
+    odometry: OdometryModel,
+    noise: SimRng,
+    description: RobotDescription,
+    period: f64,
+    stamp: f64,
+    world_t_body: Pose2,
+    /// The odometry the robot reported last (`odom_T_body`).
+    odom_t_body: Pose3,
+    collisions: usize,
+    active: Active,
+    sensed: bool,
+}
+
+impl CommandedSpot {
+    /// Spot standing at plan-view `position` (metres) facing `yaw` (radians) in `building`, with
+    /// `config`'s LiDAR, odometry drift, geometry, motion limits and seed.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry or limit settings or a yaw
+    /// that is not finite; [`AdapterError::BlockedEndpoint`] when the start is not free floor
+    /// for the robot.
+    pub fn new(
+        building: Building,
+        position: Vector2<f64>,
+        yaw: f64,
+        config: &SimulationConfig,
+    ) -> Result<Self, AdapterError> {
+        let lidar = Vlp16::new(config.lidar.clone())?;
+        config.limits.validate()?;
+        if !yaw.is_finite() {
+            return Err(AdapterError::invalid("yaw", yaw, "finite (radians)"));
+        }
+        let half_width = config.spot.half_width;
+        if !(position.iter().all(|v| v.is_finite()) && building.clearance(position) >= half_width) {
+            return Err(AdapterError::BlockedEndpoint {
+                which: "start",
+                x: position.x,
+                y: position.y,
+            });
+        }
+        Ok(Self {
+            building,
+            odometry: OdometryModel::new(config.odometry.clone(), config.seed)?,
+            noise: SimRng::new(config.seed, 0xc0_4a4d),
+            description: RobotDescription::new(config.spot.clone(), config.limits.clone()),
+            period: 1.0 / config.lidar.rotation_rate,
+            stamp: 0.0,
+            world_t_body: Pose2::new(position, yaw),
+            odom_t_body: Pose3::identity(),
+            collisions: 0,
+            active: Active::Velocity(VelocityCommand::default()),
+            sensed: false,
+            lidar,
+        })
+    }
+
+    /// The scan and odometry where the robot stands now, without moving it (the first sample
+    /// of a run).
+    pub fn sense(&mut self) -> Sample {
+        let world_t_body = self.body_pose();
+        self.odom_t_body = self.odometry.step(&world_t_body);
+        let body_t_lidar = self.description.geometry.body_t_lidar;
+        let world_t_lidar = world_t_body * body_t_lidar;
+        self.sensed = true;
+        Sample {
+            stamp: self.stamp,
+            odom_t_body: self.odom_t_body,
+            body_t_lidar,
+            cloud: self
+                .lidar
+                .scan_at_rest(&self.building, &world_t_lidar, &mut self.noise),
+            ground_truth: Some(world_t_body),
+        }
+    }
+
+    /// Holds `command` for one LiDAR turn (each component clamped to the motion limits; a
+    /// non-finite command stops the robot), then senses. The body moves along the arc the
+    /// command describes, unless that would bring it closer than half its width to an
+    /// obstacle: then it only turns and a collision is counted.
+    pub fn step(&mut self, command: VelocityCommand) -> Sample {
+        let limits = &self.description.limits;
+        let (v, u, w) = if command.is_finite() {
+            (
+                command
+                    .forward
+                    .clamp(-limits.max_forward_speed, limits.max_forward_speed),
+                command
+                    .lateral
+                    .clamp(-limits.max_lateral_speed, limits.max_lateral_speed),
+                command
+                    .yaw_rate
+                    .clamp(-limits.max_yaw_rate, limits.max_yaw_rate),
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let dt = self.period;
+        // Exact arc of a constant body velocity: the heading turns by w dt, and the forward
+        // and sideways chords follow the mean heading.
+        let (yaw, dyaw) = (self.world_t_body.rotation.angle(), w * dt);
+        let chord = |speed: f64| {
+            if dyaw.abs() < 1e-9 {
+                speed * dt
+            } else {
+                2.0 * speed / w * (0.5 * dyaw).sin()
+            }
+        };
+        let mid = yaw + 0.5 * dyaw;
+        let (c, s) = (mid.cos(), mid.sin());
+        let next = self.world_t_body.translation.vector
+            + chord(v) * Vector2::new(c, s)
+            + chord(u) * Vector2::new(-s, c);
+        if self.building.clearance(next) >= self.description.geometry.half_width {
+            self.world_t_body = Pose2::new(next, yaw + dyaw);
+        } else {
+            self.world_t_body = Pose2::new(self.world_t_body.translation.vector, yaw + dyaw);
+            self.collisions += 1;
+        }
+        self.stamp += dt;
+        self.sense()
+    }
+
+    /// The body velocity that brings the reported odometry onto `trajectory`'s pose one turn
+    /// from now (sent at `sent`).
+    fn track(&self, trajectory: &Se2Trajectory, sent: f64) -> VelocityCommand {
+        let target = trajectory.pose_at(self.stamp + self.period - sent);
+        let yaw = self.odom_t_body.rotation.euler_angles().2;
+        let here = Pose2::new(self.odom_t_body.translation.vector.xy(), yaw);
+        let error = here.inverse() * target;
+        VelocityCommand {
+            forward: error.translation.x / self.period,
+            lateral: error.translation.y / self.period,
+            yaw_rate: error.rotation.angle() / self.period,
+        }
+    }
+
+    /// The true body pose in the world (3D, at the body height).
+    #[must_use]
+    pub fn body_pose(&self) -> Pose3 {
+        let p = self.world_t_body.translation.vector;
+        Pose3::from_parts(
+            Translation3::new(p.x, p.y, self.description.geometry.body_height),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, self.world_t_body.rotation.angle()),
+        )
+    }
+
+    /// The true plan-view position (metres).
+    #[must_use]
+    pub fn position(&self) -> Vector2<f64> {
+        self.world_t_body.translation.vector
+    }
+
+    /// Steps whose walk was refused because it would have hit an obstacle.
+    #[must_use]
+    pub fn collisions(&self) -> usize {
+        self.collisions
+    }
+
+    /// The building walked in.
+    #[must_use]
+    pub fn building(&self) -> &Building {
+        &self.building
+    }
+
+    /// The building, to add or remove obstacles while the robot walks.
+    pub fn building_mut(&mut self) -> &mut Building {
+        &mut self.building
+    }
+
+    /// The LiDAR's pose in the body frame.
+    #[must_use]
+    pub fn body_t_lidar(&self) -> Pose3 {
+        self.description.geometry.body_t_lidar
+    }
+}
+
+impl Robot for CommandedSpot {
+    type Error = AdapterError;
+
+    fn description(&self) -> &RobotDescription {
+        &self.description
+    }
+
+    fn next_sample(&mut self) -> Result<Sample, AdapterError> {
+        if !self.sensed {
+            return Ok(self.sense());
+        }
+        let command = match &self.active {
+            Active::Velocity(command) => *command,
+            Active::Trajectory(trajectory, sent) => self.track(trajectory, *sent),
+        };
+        Ok(self.step(command))
+    }
+
+    fn send(&mut self, command: &MobilityCommand) -> Result<(), AdapterError> {
+        self.active = match command {
+            MobilityCommand::Velocity(v) => Active::Velocity(*v),
+            MobilityCommand::Trajectory(t) => match t.frame() {
+                TrajectoryFrame::Odom => Active::Trajectory(t.clone(), self.stamp),
+                other => {
+                    return Err(AdapterError::UnsupportedFrame {
+                        frame: other.name(),
+                    });
+                }
+            },
+        };
+        Ok(())
+    }
+
+    fn stop(&mut self) -> Result<(), AdapterError> {
+        self.active = Active::Velocity(VelocityCommand::default());
+        Ok(())
+    }
+}

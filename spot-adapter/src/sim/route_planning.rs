@@ -1,0 +1,127 @@
+//! A route between two points over the building's ground-truth floor plan: the floor plan's
+//! grid inflated by the clearance (`gridmap::inflate`), a shortest path on it
+//! (`pathfind::AStar`), and the turning points a straight collision-free segment cannot skip
+//! (`pathfind::filter_path`).
+
+use gridmap::inflate;
+use nalgebra::Vector2;
+use pathfind::{AStar, filter_path};
+use slam_core::{Cell, Planner};
+
+use crate::error::AdapterError;
+use crate::sim::building::Building;
+use crate::sim::route::Route;
+
+/// Settings of [`Route::between`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RouteConfig {
+    /// Grid resolution (metres per cell), 0.1 m.
+    pub resolution: f64,
+    /// Distance kept from every obstacle (metres), 0.30 m: Spot's half-width plus 5 cm.
+    pub clearance: f64,
+}
+
+impl Default for RouteConfig {
+    fn default() -> Self {
+        Self {
+            resolution: 0.1,
+            clearance: 0.30,
+        }
+    }
+}
+
+impl Route {
+    /// A collision-free route from `start` to `goal` (plan-view metres) that keeps
+    /// `config.clearance` from every obstacle: A* over the building's ground-truth grid
+    /// inflated by the clearance, then the filtered path's turning points; the route enters
+    /// and leaves through the centres of the start's and the goal's cells.
+    ///
+    /// # Errors
+    /// [`AdapterError::BlockedEndpoint`] when start or goal is within the clearance of an
+    /// obstacle or outside the building, [`AdapterError::NoRoute`] when they are not connected,
+    /// [`AdapterError::InvalidConfig`] for a clearance that is negative or not finite, and
+    /// [`AdapterError::Grid`] for an unusable resolution.
+    pub fn between(
+        building: &Building,
+        start: Vector2<f64>,
+        goal: Vector2<f64>,
+        config: &RouteConfig,
+    ) -> Result<Self, AdapterError> {
+        if !(config.clearance.is_finite() && config.clearance >= 0.0) {
+            return Err(AdapterError::invalid(
+                "clearance",
+                config.clearance,
+                "finite and non-negative (metres)",
+            ));
+        }
+        // A point of a free cell lies within half a diagonal of its centre, and so does an
+        // obstacle's edge of a blocked cell's: inflating by the clearance plus 1.5 cells keeps
+        // every point of every free cell at least the clearance from every obstacle. The route
+        // runs through cell centres joined by segments whose every touched cell is free, so all
+        // of it lies in free cells.
+        let grid = inflate(
+            &building.occupancy_grid(config.resolution)?,
+            config.clearance + 1.5 * config.resolution,
+        );
+        let to_cell = |which: &'static str, p: Vector2<f64>| {
+            grid.cell_at(p)
+                .filter(|&c| !grid.is_blocked(c))
+                .ok_or(AdapterError::BlockedEndpoint {
+                    which,
+                    x: p.x,
+                    y: p.y,
+                })
+        };
+        let (s, g): (Cell, Cell) = (to_cell("start", start)?, to_cell("goal", goal)?);
+        // Both ends are free cells on the grid, so the planner's only answer left is the path
+        // or none.
+        let path = AStar::new(&grid)
+            .plan(s, g)
+            .map_err(|_| AdapterError::NoRoute)?;
+        let filtered = filter_path(&grid, &path);
+        let mut kept = vec![start];
+        kept.extend(filtered.waypoints.iter().map(|&c| grid.cell_center(c)));
+        kept.push(goal);
+        kept.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
+        if kept.len() < 2 {
+            // A route needs length; stay in place over a tiny step.
+            kept = vec![start, start + Vector2::new(1e-3, 0.0)];
+        }
+        Route::new(kept, false)
+    }
+}
+
+impl Route {
+    /// A collision-free route visiting `waypoints` in order (plan-view metres), each leg planned
+    /// as in [`Route::between`]; with `closed`, a last leg returns to the first waypoint. For
+    /// tours that enter rooms, e.g. through [`Room::entry_point`](crate::sim::Room::entry_point)s.
+    ///
+    /// # Errors
+    /// As [`Route::between`] for any leg; [`AdapterError::InvalidConfig`] for fewer than two
+    /// waypoints.
+    pub fn through(
+        building: &Building,
+        waypoints: &[Vector2<f64>],
+        closed: bool,
+        config: &RouteConfig,
+    ) -> Result<Self, AdapterError> {
+        if waypoints.len() < 2 {
+            return Err(AdapterError::invalid(
+                "waypoints",
+                waypoints.len() as f64,
+                "at least two points for a tour",
+            ));
+        }
+        let mut stops = waypoints.to_vec();
+        if closed {
+            stops.push(waypoints[0]);
+        }
+        let mut points = vec![stops[0]];
+        for leg in stops.windows(2) {
+            let route = Self::between(building, leg[0], leg[1], config)?;
+            points.extend_from_slice(&route.points()[1..]);
+        }
+        Self::new(points, closed)
+    }
+}
