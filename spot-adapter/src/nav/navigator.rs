@@ -1,6 +1,6 @@
 //! `Navigator`: walks the robot to a goal in a mapped building. Each cycle it localises the live
 //! scan against the map, replans on the map's occupancy grid, and turns the first leg of the
-//! filtered path into a velocity command (DESIGN.md's last stage).
+//! filtered path into a velocity command.
 
 use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
 use nalgebra::Vector2;
