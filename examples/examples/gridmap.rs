@@ -33,10 +33,20 @@ struct Args {
     #[arg(long, value_name = "H", allow_negative_numbers = true)]
     lidar_height: f64,
     /// Cell size (metres).
-    #[arg(long, value_name = "R", default_value_t = 0.10)]
+    #[arg(
+        long,
+        value_name = "R",
+        allow_negative_numbers = true,
+        default_value_t = 0.10
+    )]
     resolution: f64,
     /// Inflation radius of the obstacles in the picture (metres).
-    #[arg(long = "inflate", value_name = "M", default_value_t = 0.25)]
+    #[arg(
+        long = "inflate",
+        value_name = "M",
+        allow_negative_numbers = true,
+        default_value_t = 0.25
+    )]
     inflate: f64,
     /// Folder for `map.yaml`, its PGM and `map.png` (created when missing).
     #[arg(long, value_name = "DIR")]

@@ -46,7 +46,12 @@ use spot_nav_examples::{
 #[command(name = "mission")]
 struct Args {
     /// Seed of the building, the sensor noise and the odometry drift.
-    #[arg(long, value_name = "N", default_value_t = 3)]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value_t = 3
+    )]
     seed: u64,
     /// Odometry and loop refinement backend of the mapping lap.
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]

@@ -48,7 +48,12 @@ struct Args {
     #[arg(long, value_enum, default_value_t = Method::PointToPlane)]
     method: Method,
     /// Voxel size of both clouds for ICP (metres).
-    #[arg(long, value_name = "M", default_value_t = 0.25)]
+    #[arg(
+        long,
+        value_name = "M",
+        allow_negative_numbers = true,
+        default_value_t = 0.25
+    )]
     voxel: f32,
     /// Initial guess of `target_T_source`: metres and degrees (roll, pitch, yaw).
     #[arg(
@@ -68,7 +73,12 @@ struct Args {
     reference: Option<PathBuf>,
     /// Run preparation and alignment N times (after one untimed run) and print the best and
     /// median times.
-    #[arg(long, value_name = "N", default_value = "1")]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value = "1"
+    )]
     repeat: NonZeroUsize,
 }
 

@@ -27,7 +27,12 @@ use spot_nav_examples::{Progress, out, simulation_config};
 #[command(name = "simulate")]
 struct Args {
     /// Seed of the building, the sensor noise and the odometry drift.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value_t = 1
+    )]
     seed: u64,
     /// Write the recording to this folder.
     #[arg(long, value_name = "DIR")]

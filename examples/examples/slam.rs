@@ -32,7 +32,12 @@ struct Args {
     #[arg(value_name = "RECORDING_DIR")]
     recording: Option<PathBuf>,
     /// Seed of the simulated building, sensor noise and odometry drift (without a recording).
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value_t = 1
+    )]
     seed: u64,
     /// Odometry and loop refinement backend.
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
