@@ -55,7 +55,7 @@ pub fn write_line(line: fmt::Arguments<'_>) -> anyhow::Result<()> {
 pub fn run(job: impl FnOnce() -> anyhow::Result<()>) -> ExitCode {
     match job() {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.chain().any(|cause| cause.is::<StdoutClosed>()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<StdoutClosed>() => ExitCode::SUCCESS,
         Err(e) => {
             let reason = format!("{e:#}").replace('\n', " ");
             eprintln!("error: {reason}");

@@ -4,6 +4,7 @@
 //!
 //! `cargo test` builds the examples before it runs integration tests, into
 //! `target/<profile>/examples/`, beside the `deps` folder this test runs from.
+#![allow(clippy::expect_used, clippy::panic)]
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
