@@ -21,9 +21,11 @@ use posegraph::{ChordalInitialization, ErrorModel, GaussNewton, LevenbergMarquar
 use slam_core::{GraphPose, OptimizationReport, Optimizer, Pose2, Pose3, PoseGraph, StopReason};
 use spot_nav_examples::{out, value_name};
 
-/// Optimise a g2o (SE(2) or SE(3)) or TORO `.graph` pose graph and print its size, the
-/// optimiser's iterations and stop reason, the cost before and after in both conventions (the
-/// log map's `sum e^T Omega e` and g2o's chi2), and the time.
+/// Optimise a g2o or TORO pose graph and print its cost before and after, and the time.
+///
+/// Reads g2o (SE(2) or SE(3)) or TORO `.graph` files; prints the graph's size, the optimiser's
+/// iterations and stop reason, the cost before and after in both conventions (the log map's
+/// `sum e^T Omega e` and g2o's chi2), and the milliseconds.
 ///
 /// The first node is fixed when the file fixes none. Fails when the optimiser stopped at its
 /// iteration cap (after printing the figures and writing `--out`).

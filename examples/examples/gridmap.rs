@@ -19,9 +19,10 @@ use slam_core::PointCloud;
 use slam_core::io::{read_kitti_bin, read_pcd, read_ply};
 use spot_nav_examples::out;
 
-/// Turn a map cloud into a 2D occupancy grid: writes the ROS map (`map.yaml` + PGM) and a PNG
-/// picture (obstacles inflated for planning drawn over it) to DIR, and prints the cell counts
-/// and times.
+/// Turn a map cloud into an occupancy grid (ROS map and PNG picture).
+///
+/// Writes the ROS map (`map.yaml` + PGM) and a PNG picture (the obstacles inflated for planning
+/// drawn over it) to DIR, and prints the cell counts and times.
 #[derive(Debug, Parser)]
 #[command(name = "gridmap")]
 struct Args {

@@ -34,12 +34,11 @@ use spot_nav_examples::{
     Progress, Registration, Timings, map_and_evaluate, out, parse_goal, simulation_config,
 };
 
-/// The main job on a simulated Spot: map an unknown building with Graph-SLAM in one lap of its
-/// corridor loop, then walk from where the lap ended to a goal on that map with no recorded
-/// route (localising against the map each scan, replanning with Jump Point Search on its
-/// inflated occupancy grid).
+/// The main job on a simulated Spot: map an unknown building, then walk to a goal in it.
 ///
-/// Prints the mapping accuracy and the navigation result against the simulator's ground truth.
+/// Maps the generated building with Graph-SLAM in one lap of its corridor loop, then walks from
+/// where the lap ended to a goal on that map with no recorded route (localising against the map
+/// each scan, replanning with Jump Point Search on its inflated occupancy grid). Prints the mapping accuracy and the navigation result against the simulator's ground truth.
 /// Without `--goal` the robot walks into the room whose door is farthest from the start. Fails
 /// when the robot does not arrive (no path on the map, or the scan limit) or collides.
 #[derive(Debug, Parser)]

@@ -18,10 +18,11 @@ use pathfind::{AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus};
 use slam_core::{BitGrid, Cell, GridPath, Planner};
 use spot_nav_examples::{Timings, out, value_name};
 
-/// Run every scenario of a Moving AI map (`.map` and `.scen`) with spot-nav's planners, check
-/// each path length against the published optimum (too long and too short both fail), and print
-/// per planner: scenarios, matched, mean and p99 microseconds per query, mean expanded nodes and
-/// setup time.
+/// Check spot-nav's planners on every scenario of a Moving AI map against the published optimum.
+///
+/// Runs each scenario of the `.scen` file on the `.map`, checks each path length against the
+/// published optimum (too long and too short both fail), and prints per planner: scenarios,
+/// matched, mean and p99 microseconds per query, mean expanded nodes and setup time.
 ///
 /// Fails when any result differs from the published optimum.
 #[derive(Debug, Parser)]

@@ -29,10 +29,10 @@ use slam_core::io::read_cloud;
 use slam_core::{Alignment, PointCloud, Pose3, Registrator, pose3_from_xyz_rpy};
 use spot_nav_examples::{Timings, data, out, parse_numbers, value_name};
 
-/// Register two LiDAR scans (PCD, PLY or KITTI `.bin`) and print `target_T_source`, the
-/// iterations, inliers, RMSE, degeneracy and times, and the distance to a reference pose.
+/// Register two LiDAR scans and print `target_T_source`.
 ///
-/// With no files it registers the bundled HDL-32E pair (`small_gicp`'s data, MIT) against its
+/// Reads PCD, PLY or KITTI `.bin` files; prints the pose, the iterations, inliers, RMSE,
+/// degeneracy and times, and the distance to a reference pose when one is given. With no files it registers the bundled HDL-32E pair (`small_gicp`'s data, MIT) against its
 /// reference pose. Fails when the alignment stopped at its iteration cap (after printing the
 /// result).
 #[derive(Debug, Parser)]

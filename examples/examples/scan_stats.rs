@@ -14,10 +14,10 @@ use clap::Parser;
 use slam_core::io::read_cloud;
 use spot_nav_examples::{data, out, quantile};
 
-/// Read a LiDAR scan and print its point count, channels, bounds, range percentiles and
-/// voxel-downsampled sizes (5, 10 and 25 cm).
+/// Read a LiDAR scan and print its statistics and voxel-downsampled sizes.
 ///
-/// Fails when the scan has no finite point.
+/// Prints the point count, channels, bounds, range percentiles and the sizes after 5, 10 and
+/// 25 cm voxel downsampling. Fails when the scan has no finite point.
 #[derive(Debug, Parser)]
 #[command(name = "scan_stats")]
 struct Args {

@@ -17,11 +17,11 @@ use spot_adapter::{
 };
 use spot_nav_examples::{Progress, out, simulation_config};
 
-/// Simulate Spot walking one lap of a generated building's corridor loop (VLP-16 scans at 5 Hz,
-/// drifting odometry) and print the building, the scan and timing figures, and the odometry's
-/// error against the ground truth (ATE, loop end-point error, segment drift).
+/// Simulate Spot walking one lap of a generated building's corridor loop.
 ///
-/// With `--out` the run is written as a recording (about 0.5 MB per scan), which the `slam`
+/// VLP-16 scans at 5 Hz and drifting odometry; prints the building, the scan and timing figures,
+/// and the odometry's error against the ground truth (ATE, loop end-point error, segment
+/// drift). With `--out` the run is written as a recording (about 0.5 MB per scan), which the `slam`
 /// example replays.
 #[derive(Debug, Parser)]
 #[command(name = "simulate")]

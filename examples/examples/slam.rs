@@ -18,12 +18,11 @@ use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::{Recording, Sample, SimulatedSpot, loam_slam, point_to_plane_slam, slam_config};
 use spot_nav_examples::{Registration, map_and_evaluate, out, simulation_config};
 
-/// Graph-SLAM on one simulated lap of a generated building (or on a recording): LiDAR odometry
-/// against the local map, loop closure, Levenberg-Marquardt. Prints scans, keyframes, loop
-/// closures, per-scan times and, when the ground truth is known, ATE, drift and loop end-point
-/// error.
+/// Graph-SLAM on one simulated lap of a generated building, or on a recording.
 ///
-/// With `--out` it writes the map (`map.ply`, `map.pcd`), the body trajectory
+/// LiDAR odometry against the local map, loop closure, Levenberg-Marquardt. Prints scans,
+/// keyframes, loop closures, per-scan times and, when the ground truth is known, ATE, drift and
+/// loop end-point error. With `--out` it writes the map (`map.ply`, `map.pcd`), the body trajectory
 /// (`trajectory.tum`) and the pose graph (`graph.g2o`). Fails when the engine accepts no scan.
 #[derive(Debug, Parser)]
 #[command(name = "slam")]
