@@ -11,10 +11,10 @@ use nalgebra::Vector2;
 /// refinement), as `--registration` chooses it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Registration {
-    /// Point-to-plane ICP odometry and refinement (`spot_adapter::point_to_plane_slam`).
+    /// Point-to-plane ICP odometry and loop refinement.
     #[value(name = "p2plane")]
     PointToPlane,
-    /// LOAM edge and planar features (`spot_adapter::loam_slam`).
+    /// LOAM edge and planar features for odometry and loop refinement.
     #[value(name = "loam")]
     Loam,
 }
