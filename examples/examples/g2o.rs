@@ -6,17 +6,86 @@
 //!
 //! The first node is fixed when the file fixes none. `--init chordal` replaces the file's initial
 //! guess by the chordal initialisation before optimising (its time is included). `--error g2o`
-//! minimises g2o's error convention instead of the log map (GTSAM's).
+//! minimises g2o's error convention instead of the log map (GTSAM's). Exits with status 1 when the
+//! optimiser stopped at its iteration cap (the figures are printed, and `--out` written, first).
 
+use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::{Parser, ValueEnum};
 use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o, write_g2o};
 use posegraph::toro::read_toro;
 use posegraph::{ChordalInitialization, ErrorModel, GaussNewton, LevenbergMarquardt, SolverConfig};
-use slam_core::{GraphPose, OptimizationReport, Optimizer, Pose2, Pose3, PoseGraph};
+use slam_core::{GraphPose, OptimizationReport, Optimizer, Pose2, Pose3, PoseGraph, StopReason};
+use spot_nav_examples::{out, value_name};
 
-const USAGE: &str = "usage: g2o FILE [--optimizer gn|lm] [--init file|chordal] [--error logmap|g2o] [--out OUT.g2o]";
+/// Optimise a g2o or TORO pose graph and print its cost before and after, and the time.
+///
+/// Reads g2o (SE(2) or SE(3)) or TORO `.graph` files; prints the graph's size, the optimiser's
+/// iterations and stop reason, the cost before and after in both conventions (the log map's
+/// `sum e^T Omega e` and g2o's chi2), and the milliseconds.
+///
+/// The first node is fixed when the file fixes none. Fails when the optimiser stopped at its
+/// iteration cap (after printing the figures and writing `--out`).
+#[derive(Debug, Parser)]
+#[command(name = "g2o")]
+struct Args {
+    /// The pose graph: g2o (`VERTEX_SE3:QUAT`, `EDGE_SE3:QUAT`, `VERTEX_SE2`, `EDGE_SE2`, `FIX`)
+    /// or TORO (`.graph`).
+    #[arg(value_name = "FILE")]
+    file: PathBuf,
+    /// The optimiser.
+    #[arg(long, value_enum, default_value_t = OptimizerChoice::LevenbergMarquardt)]
+    optimizer: OptimizerChoice,
+    /// Where the optimisation starts (the chordal initialisation's time is included).
+    #[arg(long, value_enum, default_value_t = Init::File)]
+    init: Init,
+    /// The error convention minimised.
+    #[arg(long, value_enum, default_value_t = ErrorChoice::LogMap)]
+    error: ErrorChoice,
+    /// Write the optimised graph here (g2o).
+    #[arg(long, value_name = "OUT.g2o")]
+    out: Option<PathBuf>,
+}
+
+/// `--optimizer`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum OptimizerChoice {
+    /// Gauss-Newton.
+    #[value(name = "gn")]
+    GaussNewton,
+    /// Levenberg-Marquardt.
+    #[value(name = "lm")]
+    LevenbergMarquardt,
+}
+
+/// `--init`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Init {
+    /// The file's own initial guess.
+    #[value(name = "file")]
+    File,
+    /// The chordal initialisation (rotations by the chordal relaxation, then translations).
+    #[value(name = "chordal")]
+    Chordal,
+}
+
+/// `--error`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ErrorChoice {
+    /// The log map of the relative pose error (GTSAM's `BetweenFactor`).
+    #[value(name = "logmap")]
+    LogMap,
+    /// g2o's `[t; q_xyz]` (3D) or `[x, y, theta]` (2D) error.
+    #[value(name = "g2o")]
+    G2o,
+}
+
+fn main() -> ExitCode {
+    spot_nav_examples::run(|| optimise(&Args::parse()))
+}
 
 fn fix_first<P: GraphPose>(g: &mut PoseGraph<P>) -> Result<()> {
     if !g.nodes().iter().any(|n| n.fixed) {
@@ -38,96 +107,83 @@ where
     Ok(optimizer.optimize(g)?)
 }
 
-fn main() -> Result<()> {
-    let mut args = std::env::args().skip(1);
-    let (mut file, mut optimizer, mut init, mut error, mut out) = (
-        None,
-        "lm".to_string(),
-        "file".to_string(),
-        "logmap".to_string(),
-        None,
-    );
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--optimizer" => optimizer = args.next().context(USAGE)?,
-            "--init" => init = args.next().context(USAGE)?,
-            "--error" => error = args.next().context(USAGE)?,
-            "--out" => out = Some(args.next().context(USAGE)?),
-            "-h" | "--help" => {
-                println!("{USAGE}");
-                return Ok(());
-            }
-            _ if file.is_none() => file = Some(a),
-            _ => bail!("unexpected argument {a:?}; {USAGE}"),
-        }
-    }
-    let file = file.context(USAGE)?;
-    let is_toro = std::path::Path::new(&file)
+fn optimise(args: &Args) -> Result<()> {
+    let file = &args.file;
+    let is_toro = file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("graph"));
     let mut graph = if is_toro {
-        G2oGraph::Se2(read_toro(&file)?)
+        G2oGraph::Se2(read_toro(file)?)
     } else {
-        read_g2o(&file).with_context(|| format!("reading {file}"))?
+        read_g2o(file).with_context(|| format!("reading {}", file.display()))?
     };
     let (nodes, edges) = match &graph {
         G2oGraph::Se2(g) => (g.node_count(), g.edge_count()),
         G2oGraph::Se3(g) => (g.node_count(), g.edge_count()),
     };
-    let chordal = match init.as_str() {
-        "file" => false,
-        "chordal" => true,
-        other => bail!("unknown initialisation {other:?}; {USAGE}"),
-    };
+    let chordal = args.init == Init::Chordal;
     let config = SolverConfig {
-        error_model: match error.as_str() {
-            "logmap" => ErrorModel::LogMap,
-            "g2o" => ErrorModel::G2o,
-            other => bail!("unknown error model {other:?}; {USAGE}"),
+        error_model: match args.error {
+            ErrorChoice::LogMap => ErrorModel::LogMap,
+            ErrorChoice::G2o => ErrorModel::G2o,
         },
         ..SolverConfig::default()
     };
     let g2o_before = g2o_chi2(&graph);
     let t = Instant::now();
-    let report = match (&mut graph, optimizer.as_str()) {
-        (G2oGraph::Se3(g), "lm") => {
+    let report = match (&mut graph, args.optimizer) {
+        (G2oGraph::Se3(g), OptimizerChoice::LevenbergMarquardt) => {
             run::<Pose3, _>(g, &mut LevenbergMarquardt::new(config), chordal)?
         }
-        (G2oGraph::Se3(g), "gn") => run::<Pose3, _>(g, &mut GaussNewton::new(config), chordal)?,
-        (G2oGraph::Se2(g), "lm") => {
+        (G2oGraph::Se3(g), OptimizerChoice::GaussNewton) => {
+            run::<Pose3, _>(g, &mut GaussNewton::new(config), chordal)?
+        }
+        (G2oGraph::Se2(g), OptimizerChoice::LevenbergMarquardt) => {
             run::<Pose2, _>(g, &mut LevenbergMarquardt::new(config), chordal)?
         }
-        (G2oGraph::Se2(g), "gn") => run::<Pose2, _>(g, &mut GaussNewton::new(config), chordal)?,
-        (_, other) => bail!("unknown optimizer {other:?}; {USAGE}"),
+        (G2oGraph::Se2(g), OptimizerChoice::GaussNewton) => {
+            run::<Pose2, _>(g, &mut GaussNewton::new(config), chordal)?
+        }
     };
     let ms = t.elapsed().as_secs_f64() * 1e3;
-    println!("file        {file}");
-    println!(
+    out!("file        {}", file.display())?;
+    out!(
         "graph       {nodes} nodes, {edges} edges ({})",
         if matches!(graph, G2oGraph::Se3(_)) {
             "SE(3)"
         } else {
             "SE(2)"
         }
-    );
-    println!(
-        "optimizer   {optimizer} from the {init} guess: {} iterations, {:?}",
-        report.iterations, report.stop_reason
-    );
-    println!(
-        "minimised   {error} cost {:.6} -> {:.6} (from the --init guess)",
-        report.initial_cost, report.final_cost
-    );
+    )?;
+    out!(
+        "optimizer   {} from the {} guess: {} iterations, {:?}",
+        value_name(&args.optimizer),
+        value_name(&args.init),
+        report.iterations,
+        report.stop_reason
+    )?;
+    out!(
+        "minimised   {} cost {:.6} -> {:.6} (from the --init guess)",
+        value_name(&args.error),
+        report.initial_cost,
+        report.final_cost
+    )?;
     let log_map = match &graph {
         G2oGraph::Se2(g) => g.cost(),
         G2oGraph::Se3(g) => g.cost(),
     };
-    println!("log-map     {log_map:.6} (GTSAM's error is half of this)");
-    println!("g2o chi2    {g2o_before:.6} -> {:.6}", g2o_chi2(&graph));
-    println!("time        {ms:.1} ms");
-    if let Some(out) = out {
-        write_g2o(&out, &graph)?;
-        println!("wrote       {out}");
+    out!("log-map     {log_map:.6} (GTSAM's error is half of this)")?;
+    out!("g2o chi2    {g2o_before:.6} -> {:.6}", g2o_chi2(&graph))?;
+    out!("time        {ms:.1} ms")?;
+    if let Some(path) = &args.out {
+        write_g2o(path, &graph)?;
+        out!("wrote       {}", path.display())?;
+    }
+    if report.stop_reason == StopReason::MaxIterations {
+        bail!(
+            "the optimiser stopped at its iteration cap ({} iterations) without converging",
+            report.iterations
+        );
     }
     Ok(())
 }

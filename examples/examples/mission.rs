@@ -14,26 +14,55 @@
 //! `cargo run --release --example mission -- [--seed N] [--registration p2plane|loam]
 //! [--goal X,Y] [--out DIR]` (the goal in metres in the map frame, which is where the lap
 //! started, x ahead; `--out` writes the map (PLY) and the grid with the walked path (PNG)).
+//! Exits with status 1 when the robot does not arrive (no path, or the scan limit) or collides.
 
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::Parser;
 use nalgebra::{Point3, Vector2};
 use registration::PointToPlaneIcp;
 use slam_core::io::{PlyEncoding, write_ply};
-use slam_core::{Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
-use spot_adapter::eval::{
-    DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation, body_trajectory,
-};
+use slam_core::{BitGrid, Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
 use spot_adapter::nav::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
+use spot_nav_examples::{Progress, Registration, Timings, map_and_evaluate, out, parse_goal};
 
-const USAGE: &str =
-    "usage: mission [--seed N] [--registration p2plane|loam] [--goal X,Y] [--out DIR]";
+/// The main job on a simulated Spot: map an unknown building, then walk to a goal in it.
+///
+/// Maps the generated building with Graph-SLAM in one lap of its corridor loop, then walks from
+/// where the lap ended to a goal on that map with no recorded route (localising against the map
+/// each scan, replanning with Jump Point Search on its inflated occupancy grid). Prints the mapping accuracy and the navigation result against the simulator's ground truth.
+/// Without `--goal` the robot walks into the room whose door is farthest from the start. Fails
+/// when the robot does not arrive (no path on the map, or the scan limit) or collides.
+#[derive(Debug, Parser)]
+#[command(name = "mission")]
+struct Args {
+    /// Seed of the building, the sensor noise and the odometry drift.
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value_t = 3
+    )]
+    seed: u64,
+    /// Odometry and loop refinement backend of the mapping lap.
+    #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
+    registration: Registration,
+    /// The goal in metres in the map frame (where the lap started, x ahead) [default: the
+    /// entry of the room farthest from the start].
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = parse_goal)]
+    goal: Option<Vector2<f64>>,
+    /// Write the map (`map.ply`) and the grid with the walked cells (`grid.png`) to this folder.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
 
 /// Scans the navigation may take before it gives up (5 minutes at 5 Hz).
 const MAX_CYCLES: usize = 1500;
@@ -52,28 +81,11 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
 ) -> Result<Mapped> {
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
-    let started = Instant::now();
-    for (n, sample) in sim.enumerate() {
-        slam.process(&sample.scan_input());
-        if (n + 1).is_multiple_of(50) {
-            eprint!(
-                "\rmapping: {} scans, {} keyframes, {} loops",
-                n + 1,
-                slam.keyframe_count(),
-                slam.report().loops_closed
-            );
-        }
-    }
-    eprintln!();
+    let samples = sim.map(Ok::<_, std::convert::Infallible>);
+    let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, Some(&truth), "mapping")?;
+    let e = mapping.evaluation.context("the lap has a ground truth")?;
     let report = slam.report();
-    let estimate = body_trajectory(slam.scan_trajectory(), &body_t_lidar);
-    let e = TrajectoryEvaluation::compute(
-        &estimate,
-        &truth,
-        DEFAULT_MAX_STAMP_DIFFERENCE,
-        &INDOOR_SEGMENT_LENGTHS,
-    )?;
-    println!(
+    out!(
         "mapping     {} scans, {} keyframes, {} loops closed; {:.1} m lap; ATE {:.3} m, loop end-point error {:.3} m; {:.2} ms mean per scan; {:.1} s",
         report.scans,
         report.keyframes,
@@ -82,8 +94,8 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         e.ate.rmse,
         e.loop_end_point_error,
         report.mean_scan_ms(),
-        started.elapsed().as_secs_f64()
-    );
+        mapping.seconds
+    )?;
     let map_t_lidar = slam
         .current_lidar_pose()
         .context("the lap gave the engine no scan")?;
@@ -93,21 +105,27 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     })
 }
 
-fn parse_goal(text: &str) -> Result<Vector2<f64>> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(str::parse)
-        .collect::<Result<_, _>>()
-        .context("--goal X,Y")?;
-    let [x, y] = v[..] else {
-        bail!("--goal needs two numbers");
-    };
-    Ok(Vector2::new(x, y))
+/// How the navigation ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Outcome {
+    Arrived,
+    GaveUp,
+    NoPath,
+}
+
+impl Outcome {
+    fn describe(self) -> &'static str {
+        match self {
+            Self::Arrived => "arrived",
+            Self::GaveUp => "gave up (scan limit)",
+            Self::NoPath => "no path on the map",
+        }
+    }
 }
 
 /// What the navigation did.
 struct Walk {
-    result: &'static str,
+    outcome: Outcome,
     cycles: usize,
     /// Metres walked (ground truth).
     walked: f64,
@@ -131,7 +149,8 @@ fn walk(
     let (mut walked, mut worst, mut cycles) = (0.0f64, 0.0f64, 0usize);
     let mut trail: Vec<Cell> = Vec::new();
     let mut cycle_ms = Vec::new();
-    let result = loop {
+    let mut progress = Progress::new("navigating", "scans", None);
+    let outcome = loop {
         let t = Instant::now();
         let step = nav.step(&sample, goal_map)?;
         cycle_ms.push(t.elapsed().as_secs_f64() * 1e3);
@@ -150,21 +169,22 @@ fn walk(
                 sample = spot.step(command);
                 walked += (spot.position() - before).norm();
                 cycles += 1;
-                if cycles.is_multiple_of(25) {
-                    eprint!(
-                        "\rnavigating: {cycles} scans, {walked:.1} m walked, {:.1} m to go",
+                progress.update(
+                    cycles as u64,
+                    format!(
+                        "{walked:.1} m walked, {:.1} m to go",
                         (goal_world - spot.position()).norm()
-                    );
-                }
+                    ),
+                );
             }
-            NavigationStep::Walk(_) => break "gave up (scan limit)",
-            NavigationStep::Arrived => break "arrived",
-            NavigationStep::NoPath => break "no path on the map",
+            NavigationStep::Walk(_) => break Outcome::GaveUp,
+            NavigationStep::Arrived => break Outcome::Arrived,
+            NavigationStep::NoPath => break Outcome::NoPath,
         }
     };
-    eprintln!();
+    progress.finish();
     Ok(Walk {
-        result,
+        outcome,
         cycles,
         walked,
         worst,
@@ -173,40 +193,12 @@ fn walk(
     })
 }
 
-/// Command-line settings.
-struct Args {
-    seed: u64,
-    method: String,
-    goal: Option<Vector2<f64>>,
-    out: Option<std::path::PathBuf>,
-}
-
-fn parse_args() -> Result<Args> {
-    let mut parsed = Args {
-        seed: 3,
-        method: "p2plane".into(),
-        goal: None,
-        out: None,
-    };
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--seed" => parsed.seed = args.next().context(USAGE)?.parse()?,
-            "--registration" => parsed.method = args.next().context(USAGE)?,
-            "--goal" => parsed.goal = Some(parse_goal(&args.next().context(USAGE)?)?),
-            "--out" => parsed.out = Some(args.next().context(USAGE)?.into()),
-            _ => bail!("unknown argument {a}\n{USAGE}"),
-        }
-    }
-    Ok(parsed)
-}
-
 /// The map (PLY) and its grid with the inflated obstacles and the walked cells (PNG) in `dir`.
 fn write_outputs(
-    dir: &std::path::Path,
+    dir: &Path,
     map: &PointCloud,
     lidar_height: f64,
-    inflated: &slam_core::BitGrid,
+    inflated: &BitGrid,
     trail: &[Cell],
 ) -> Result<()> {
     std::fs::create_dir_all(dir)?;
@@ -214,40 +206,37 @@ fn write_outputs(
     let occupancy = gridmap::OccupancyGridBuilder::new(NavigatorConfig::default().grid)?
         .build(map, lidar_height)?;
     gridmap::write_png(dir.join("grid.png"), &occupancy, Some(inflated), trail, &[])?;
-    println!("wrote       {0}/map.ply, {0}/grid.png", dir.display());
+    out!("wrote       {0}/map.ply, {0}/grid.png", dir.display())?;
     Ok(())
 }
 
-fn main() -> Result<()> {
-    let Args {
-        seed,
-        method,
-        goal,
-        out,
-    } = parse_args()?;
-    let mut config = SimulationConfig::default();
-    config.seed = seed;
+fn main() -> ExitCode {
+    spot_nav_examples::run(|| mission(&Args::parse()))
+}
+
+fn mission(args: &Args) -> Result<()> {
+    let seed = args.seed;
+    let config = SimulationConfig::with_seed(seed);
     let sim = SimulatedSpot::corridor_loop(&config)?;
     let building = sim.building().clone();
     let truth = sim.ground_truth();
     // The map frame is the odometry frame, which starts at the first body pose.
     let world_t_map = truth.first().context("empty lap")?.pose;
     let lap_end = truth.last().context("empty lap")?.pose;
-    println!(
+    out!(
         "building    seed {seed}: {:.1} x {:.1} m, {} rooms",
         building.size().x,
         building.size().y,
         building.rooms().len()
-    );
-    let mapped = match method.as_str() {
-        "p2plane" => map_building(point_to_plane_slam(slam_config()), sim)?,
-        "loam" => map_building(loam_slam(slam_config()), sim)?,
-        other => bail!("unknown registration {other} (p2plane, loam)"),
+    )?;
+    let mapped = match args.registration {
+        Registration::PointToPlane => map_building(point_to_plane_slam(slam_config()), sim)?,
+        Registration::Loam => map_building(loam_slam(slam_config()), sim)?,
     };
 
     // Navigation, from where the lap ended.
     let start = lap_end.translation.vector.xy();
-    let goal_world = match goal {
+    let goal_world = match args.goal {
         Some(g) => (world_t_map * Point3::new(g.x, g.y, 0.0)).coords.xy(),
         None => building
             .rooms()
@@ -273,39 +262,53 @@ fn main() -> Result<()> {
         spot.description(),
         NavigatorConfig::default(),
     )?;
-    println!(
+    out!(
         "grid        {} x {} cells of {:.2} m, obstacles inflated by {:.2} m ({:.1} s)",
         nav.grid().width(),
         nav.grid().height(),
         nav.grid().geometry().resolution,
         NavigatorConfig::default().clearance,
         started.elapsed().as_secs_f64()
-    );
-    println!(
+    )?;
+    out!(
         "goal        ({:.2}, {:.2}) m in the map frame, {:.1} m from the start as the crow flies",
         goal_map.x,
         goal_map.y,
         (goal_world - start).norm()
-    );
+    )?;
     let walk = walk(&mut nav, &mut spot, goal_map, goal_world, &world_t_map)?;
-    let mean_ms = walk.cycle_ms.iter().sum::<f64>() / walk.cycle_ms.len().max(1) as f64;
-    let max_ms = walk.cycle_ms.iter().copied().fold(0.0, f64::max);
-    println!(
-        "navigation  {} after {} scans ({:.1} s walking), {:.1} m walked; ends {:.3} m from the goal (ground truth)",
-        walk.result,
+    let cycles = Timings::new(walk.cycle_ms.iter().copied()).context("no navigation cycle")?;
+    let to_goal = (goal_world - spot.position()).norm();
+    out!(
+        "navigation  {} after {} scans ({:.1} s walking), {:.1} m walked; ends {to_goal:.3} m from the goal (ground truth)",
+        walk.outcome.describe(),
         walk.cycles,
         walk.cycles as f64 / config.lidar.rotation_rate,
         walk.walked,
-        (goal_world - spot.position()).norm()
-    );
-    println!(
-        "            collisions {}, localisation error up to {:.3} m, {} registrations fell back to odometry; {mean_ms:.1} ms mean, {max_ms:.1} ms max per cycle",
+    )?;
+    out!(
+        "            collisions {}, localisation error up to {:.3} m, {} registrations fell back to odometry; {:.1} ms mean, {:.1} ms max per cycle",
         spot.collisions(),
         walk.worst,
-        nav.localisation_failures()
-    );
-    if let Some(dir) = out {
-        write_outputs(&dir, &mapped.map, lidar_height, nav.grid(), &walk.trail)?;
+        nav.localisation_failures(),
+        cycles.mean(),
+        cycles.max()
+    )?;
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &mapped.map, lidar_height, nav.grid(), &walk.trail)?;
+    }
+    if walk.outcome != Outcome::Arrived {
+        bail!(
+            "the robot did not reach the goal: {} after {} scans, {to_goal:.2} m from it",
+            walk.outcome.describe(),
+            walk.cycles
+        );
+    }
+    if spot.collisions() > 0 {
+        bail!(
+            "the robot arrived but collided {} times on the way",
+            spot.collisions()
+        );
     }
     Ok(())
 }

@@ -7,56 +7,118 @@
 //! Exits non-zero on any mismatch. Example:
 //! `cargo run --release --example movingai -- pathfind/tests/data/arena.map pathfind/tests/data/arena.map.scen`
 
+use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::{Parser, ValueEnum};
 use pathfind::movingai::{read_map, read_scenarios};
 use pathfind::{AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus};
-use slam_core::{BitGrid, Planner};
+use slam_core::{BitGrid, Cell, GridPath, Planner};
+use spot_nav_examples::{Timings, out, value_name};
 
-const USAGE: &str = "usage: movingai MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]";
-
-/// The planner called `name` on the command line.
-fn build<'g>(name: &str, grid: &'g BitGrid) -> Result<Box<dyn Planner + 'g>> {
-    Ok(match name {
-        "dijkstra" => Box::new(Dijkstra::new(grid)),
-        "astar" => Box::new(AStar::new(grid)),
-        "jps" => Box::new(JumpPointSearch::new(grid)),
-        "jps-cells" => Box::new(JumpPointSearch::with_cell_scans(grid)),
-        "jps-plus" => Box::new(JumpPointSearchPlus::new(grid)),
-        "jps-plus-tables" => Box::new(JumpPointSearchPlus::with_jump_tables(grid)?),
-        other => bail!("unknown planner {other:?}; {USAGE}"),
-    })
+/// Check spot-nav's planners on every scenario of a Moving AI map against the published optimum.
+///
+/// Runs each scenario of the `.scen` file on the `.map`, checks each path length against the
+/// published optimum (too long and too short both fail), and prints per planner: scenarios,
+/// matched, mean and p99 microseconds per query, mean expanded nodes and setup time.
+///
+/// Fails when any result differs from the published optimum.
+#[derive(Debug, Parser)]
+#[command(name = "movingai")]
+struct Args {
+    /// The map (Moving AI `.map`).
+    #[arg(value_name = "MAP")]
+    map: PathBuf,
+    /// Its scenarios (Moving AI `.scen`, version 1).
+    #[arg(value_name = "SCEN")]
+    scenarios: PathBuf,
+    /// The planner to run, or all of them in turn.
+    #[arg(long, value_enum, default_value_t = PlannerChoice::All)]
+    planner: PlannerChoice,
 }
 
-fn main() -> Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let mut positional = Vec::new();
-    let mut which = "all".to_string();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--planner" => which.clone_from(it.next().context(USAGE)?),
-            "-h" | "--help" => {
-                println!("{USAGE}");
-                return Ok(());
-            }
-            _ => positional.push(a.clone()),
+/// `--planner`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum PlannerChoice {
+    /// Dijkstra's algorithm.
+    #[value(name = "dijkstra")]
+    Dijkstra,
+    /// A* with the octile heuristic.
+    #[value(name = "astar")]
+    AStar,
+    /// Jump Point Search with word-at-a-time scans.
+    #[value(name = "jps")]
+    JumpPointSearch,
+    /// Jump Point Search scanning cell by cell.
+    #[value(name = "jps-cells")]
+    JumpPointSearchCells,
+    /// JPS+ with bitwise scans.
+    #[value(name = "jps-plus")]
+    JumpPointSearchPlus,
+    /// JPS+ with precomputed jump tables.
+    #[value(name = "jps-plus-tables")]
+    JumpPointSearchPlusTables,
+    /// Every planner above in turn.
+    #[value(name = "all")]
+    All,
+}
+
+impl PlannerChoice {
+    /// The planners this choice runs.
+    fn planners(self) -> Vec<Self> {
+        if self == Self::All {
+            Self::value_variants()
+                .iter()
+                .copied()
+                .filter(|&p| p != Self::All)
+                .collect()
+        } else {
+            vec![self]
         }
     }
-    let [map_path, scen_path] = positional.as_slice() else {
-        bail!("{USAGE}")
-    };
-    let map = read_map(map_path).with_context(|| format!("reading {map_path}"))?;
-    let scenarios = read_scenarios(scen_path).with_context(|| format!("reading {scen_path}"))?;
+
+    /// The planner on `grid`.
+    fn build(self, grid: &BitGrid) -> Result<Box<dyn Planner + '_>> {
+        Ok(match self {
+            Self::Dijkstra => Box::new(Dijkstra::new(grid)),
+            Self::AStar => Box::new(AStar::new(grid)),
+            Self::JumpPointSearch => Box::new(JumpPointSearch::new(grid)),
+            Self::JumpPointSearchCells => Box::new(JumpPointSearch::with_cell_scans(grid)),
+            Self::JumpPointSearchPlus => Box::new(JumpPointSearchPlus::new(grid)),
+            Self::JumpPointSearchPlusTables => {
+                Box::new(JumpPointSearchPlus::with_jump_tables(grid)?)
+            }
+            Self::All => bail!("`all` is not one planner"),
+        })
+    }
+}
+
+/// The path from `start` to `goal`, or why there is none: the example's only call of
+/// `Planner::plan`.
+fn plan(planner: &mut dyn Planner, start: Cell, goal: Cell) -> Result<GridPath, String> {
+    planner.plan(start, goal).map_err(|e| e.to_string())
+}
+
+fn main() -> ExitCode {
+    spot_nav_examples::run(|| check(&Args::parse()))
+}
+
+fn check(args: &Args) -> Result<()> {
+    let (map_path, scen_path) = (&args.map, &args.scenarios);
+    let map = read_map(map_path).with_context(|| format!("reading {}", map_path.display()))?;
+    let scenarios =
+        read_scenarios(scen_path).with_context(|| format!("reading {}", scen_path.display()))?;
     let grid = &map.grid;
-    println!(
-        "map {map_path}: {}x{} cells, {} blocked; {} scenarios",
+    out!(
+        "map {}: {}x{} cells, {} blocked; {} scenarios",
+        map_path.display(),
         grid.width(),
         grid.height(),
         grid.count_blocked(),
         scenarios.len()
-    );
+    )?;
     if let Some(s) = scenarios
         .iter()
         .find(|s| (s.map_width, s.map_height) != (grid.width(), grid.height()))
@@ -69,32 +131,27 @@ fn main() -> Result<()> {
             grid.height()
         );
     }
-    let names: Vec<&str> = if which == "all" {
-        vec![
-            "dijkstra",
-            "astar",
-            "jps",
-            "jps-cells",
-            "jps-plus",
-            "jps-plus-tables",
-        ]
-    } else {
-        vec![which.as_str()]
-    };
-    println!(
+    out!(
         "{:<16} {:>9} {:>8} {:>12} {:>12} {:>12} {:>10}",
-        "planner", "scenarios", "matched", "mean us", "p99 us", "expanded", "setup ms"
-    );
+        "planner",
+        "scenarios",
+        "matched",
+        "mean us",
+        "p99 us",
+        "expanded",
+        "setup ms"
+    )?;
     let mut failures = 0usize;
-    for name in names {
+    for choice in args.planner.planners() {
+        let name = value_name(&choice);
         let t = Instant::now();
-        let mut planner = build(name, grid)?;
+        let mut planner = choice.build(grid)?;
         let setup_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut us = Vec::with_capacity(scenarios.len());
         let (mut matched, mut expanded) = (0usize, 0usize);
         for (k, s) in scenarios.iter().enumerate() {
             let t = Instant::now();
-            let result = planner.plan(s.start, s.goal);
+            let result = plan(planner.as_mut(), s.start, s.goal);
             us.push(t.elapsed().as_secs_f64() * 1e6);
             match result {
                 Ok(p) if (p.length - s.optimal_length).abs() <= s.tolerance => {
@@ -114,17 +171,14 @@ fn main() -> Result<()> {
                 }
             }
         }
-        let mean = us.iter().sum::<f64>() / us.len().max(1) as f64;
-        us.sort_by(f64::total_cmp);
-        let p99 = us
-            .get(((us.len().saturating_sub(1)) as f64 * 0.99).round() as usize)
-            .copied()
-            .unwrap_or(0.0);
-        println!(
-            "{name:<16} {:>9} {matched:>8} {mean:>12.1} {p99:>12.1} {:>12.0} {setup_ms:>10.2}",
+        let times = Timings::new(us);
+        out!(
+            "{name:<16} {:>9} {matched:>8} {:>12.1} {:>12.1} {:>12.0} {setup_ms:>10.2}",
             scenarios.len(),
+            times.as_ref().map_or(0.0, Timings::mean),
+            times.as_ref().map_or(0.0, |t| t.quantile(0.99)),
             expanded as f64 / matched.max(1) as f64
-        );
+        )?;
     }
     if failures > 0 {
         bail!("{failures} scenario results did not match the published optimum");

@@ -11,98 +11,153 @@
 //! without a ring field (default VLP-16); `--reference` reads a 4x4 row-major `target_T_source`
 //! and prints the result's distance to it; `--repeat N` runs preparation and alignment N times
 //! (after one untimed run) and prints the best and median times. With no files it registers the bundled HDL-32E pair
-//! (`small_gicp`'s data, MIT) against its reference pose.
+//! (`small_gicp`'s data, MIT) against its reference pose. Exits with status 1 when the alignment
+//! stopped at its iteration cap (after printing the result).
 
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use clap::{Parser, ValueEnum};
 use nalgebra::{Matrix4, UnitQuaternion};
 use registration::{
     IcpConfig, LidarLayout, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
 };
 use slam_core::io::read_cloud;
 use slam_core::{Alignment, PointCloud, Pose3, Registrator, pose3_from_xyz_rpy};
+use spot_nav_examples::{Timings, data, out, parse_numbers, value_name};
 
+/// Register two LiDAR scans and print `target_T_source`.
+///
+/// Reads PCD, PLY or KITTI `.bin` files; prints the pose, the iterations, inliers, RMSE,
+/// degeneracy and times, and the distance to a reference pose when one is given. With no files it registers the bundled HDL-32E pair (`small_gicp`'s data, MIT) against its
+/// reference pose. Fails when the alignment stopped at its iteration cap (after printing the
+/// result).
+#[derive(Debug, Parser)]
+#[command(name = "register")]
 struct Args {
+    /// The scan to move onto the target (with TARGET; neither: the bundled pair).
+    #[arg(value_name = "SOURCE", requires = "target")]
+    source: Option<PathBuf>,
+    /// The scan held fixed.
+    #[arg(value_name = "TARGET")]
+    target: Option<PathBuf>,
+    /// The registration method.
+    #[arg(long, value_enum, default_value_t = Method::PointToPlane)]
+    method: Method,
+    /// Voxel size of both clouds for ICP (metres).
+    #[arg(
+        long,
+        value_name = "M",
+        allow_negative_numbers = true,
+        default_value_t = 0.25
+    )]
+    voxel: f32,
+    /// Initial guess of `target_T_source`: metres and degrees (roll, pitch, yaw).
+    #[arg(
+        long,
+        value_name = "x,y,z,roll,pitch,yaw",
+        allow_hyphen_values = true,
+        value_parser = parse_numbers::<6>
+    )]
+    init: Option<[f64; 6]>,
+    /// Ring layout for LOAM when a cloud has no ring field [default: vlp16; hdl32e for the
+    /// bundled pair].
+    #[arg(long, value_enum)]
+    layout: Option<Layout>,
+    /// A 4x4 row-major `target_T_source` to compare the result with [default: the bundled
+    /// pair's reference, for the bundled pair].
+    #[arg(long, value_name = "FILE")]
+    reference: Option<PathBuf>,
+    /// Run preparation and alignment N times (after one untimed run) and print the best and
+    /// median times.
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        default_value = "1"
+    )]
+    repeat: NonZeroUsize,
+}
+
+/// `--method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Method {
+    /// Point-to-point ICP.
+    #[value(name = "p2p")]
+    PointToPoint,
+    /// Point-to-plane ICP.
+    #[value(name = "p2plane")]
+    PointToPlane,
+    /// LOAM edge and planar features.
+    #[value(name = "loam")]
+    Loam,
+}
+
+/// `--layout`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Layout {
+    /// Velodyne VLP-16.
+    #[value(name = "vlp16")]
+    Vlp16,
+    /// Velodyne HDL-32E.
+    #[value(name = "hdl32e")]
+    Hdl32e,
+    /// Ouster OS1-128.
+    #[value(name = "os1-128")]
+    Os1_128,
+}
+
+impl Layout {
+    fn lidar_layout(self) -> LidarLayout {
+        match self {
+            Self::Vlp16 => LidarLayout::VLP16,
+            Self::Hdl32e => LidarLayout::HDL32E,
+            Self::Os1_128 => LidarLayout::OS1_128,
+        }
+    }
+}
+
+/// The files and settings of one run, defaults filled in.
+struct Job {
     source: PathBuf,
     target: PathBuf,
-    method: String,
-    voxel: f32,
-    init: Pose3,
     layout: LidarLayout,
     reference: Option<PathBuf>,
-    repeat: usize,
+    init: Pose3,
 }
 
-fn bundled(p: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
+impl Job {
+    fn new(args: &Args) -> Self {
+        let init = args
+            .init
+            .map_or_else(Pose3::identity, |[x, y, z, r, p, w]| {
+                pose3_from_xyz_rpy(x, y, z, r.to_radians(), p.to_radians(), w.to_radians())
+            });
+        let layout = |default: Layout| args.layout.unwrap_or(default).lidar_layout();
+        match (&args.source, &args.target) {
+            (Some(source), Some(target)) => Self {
+                source: source.clone(),
+                target: target.clone(),
+                layout: layout(Layout::Vlp16),
+                reference: args.reference.clone(),
+                init,
+            },
+            _ => Self {
+                source: data::pair_source(),
+                target: data::pair_target(),
+                layout: layout(Layout::Hdl32e),
+                reference: Some(args.reference.clone().unwrap_or_else(data::pair_reference)),
+                init,
+            },
+        }
+    }
 }
 
-fn parse_args() -> Result<Args> {
-    let mut files = Vec::new();
-    let mut args = Args {
-        source: PathBuf::new(),
-        target: PathBuf::new(),
-        method: "p2plane".into(),
-        voxel: 0.25,
-        init: Pose3::identity(),
-        layout: LidarLayout::VLP16,
-        reference: None,
-        repeat: 1,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(a) = it.next() {
-        let mut value = || it.next().with_context(|| format!("{a} needs a value"));
-        match a.as_str() {
-            "--method" => args.method = value()?,
-            "--voxel" => args.voxel = value()?.parse().context("--voxel")?,
-            "--init" => {
-                let v: Vec<f64> = value()?
-                    .split(',')
-                    .map(str::parse)
-                    .collect::<Result<_, _>>()
-                    .context("--init x,y,z,roll,pitch,yaw")?;
-                let [x, y, z, r, p, w] = v[..] else {
-                    bail!("--init needs six numbers");
-                };
-                args.init =
-                    pose3_from_xyz_rpy(x, y, z, r.to_radians(), p.to_radians(), w.to_radians());
-            }
-            "--layout" => {
-                args.layout = match value()?.as_str() {
-                    "vlp16" => LidarLayout::VLP16,
-                    "hdl32e" => LidarLayout::HDL32E,
-                    "os1-128" => LidarLayout::OS1_128,
-                    other => bail!("unknown layout {other} (vlp16, hdl32e, os1-128)"),
-                }
-            }
-            "--reference" => args.reference = Some(value()?.into()),
-            "--repeat" => {
-                args.repeat = value()?.parse().context("--repeat")?;
-                if args.repeat == 0 {
-                    bail!("--repeat needs at least 1");
-                }
-            }
-            _ if a.starts_with("--") => bail!("unknown option {a}"),
-            _ => files.push(PathBuf::from(a)),
-        }
-    }
-    match files.len() {
-        0 => {
-            args.source = bundled("../registration/tests/data/source.ply");
-            args.target = bundled("../slam-core/tests/data/hdl32e_pair_target.ply");
-            args.reference
-                .get_or_insert_with(|| bundled("../registration/tests/data/T_target_source.txt"));
-            args.layout = LidarLayout::HDL32E;
-        }
-        2 => {
-            args.target = files.pop().unwrap_or_default();
-            args.source = files.pop().unwrap_or_default();
-        }
-        _ => bail!("give SOURCE and TARGET files, or none for the bundled pair"),
-    }
-    Ok(args)
+fn main() -> ExitCode {
+    spot_nav_examples::run(|| register(&Args::parse()))
 }
 
 fn read_reference(path: &Path) -> Result<Pose3> {
@@ -160,91 +215,98 @@ fn run<R: Registrator>(
     })
 }
 
-/// Smallest and median of `v` (not empty).
-fn best_and_median(mut v: Vec<f64>) -> (f64, f64) {
-    v.sort_by(f64::total_cmp);
-    (v[0], v[v.len() / 2])
-}
-
 /// The time line: one run's two parts, or the best and median of several.
-fn print_times(timed: &Timed, repeat: usize) {
-    if repeat == 1 {
-        println!(
+fn print_times(timed: &Timed) -> Result<()> {
+    let summary = |v: &[f64]| Timings::new(v.iter().copied()).context("no run");
+    let (prepare, align) = (summary(&timed.prepare_ms)?, summary(&timed.align_ms)?);
+    if prepare.len() == 1 {
+        out!(
             "time        {:.1} ms prepare + {:.1} ms align",
-            timed.prepare_ms[0], timed.align_ms[0]
-        );
+            prepare.best(),
+            align.best()
+        )
     } else {
-        let total: Vec<f64> = timed
-            .prepare_ms
-            .iter()
-            .zip(&timed.align_ms)
-            .map(|(p, a)| p + a)
-            .collect();
-        let (best, median) = best_and_median(total);
-        let (prepare, _) = best_and_median(timed.prepare_ms.clone());
-        let (align, _) = best_and_median(timed.align_ms.clone());
-        println!(
-            "time        prepare + align: best {best:.1} ms, median {median:.1} ms of {repeat} runs \
-             (best prepare {prepare:.1} ms, best align {align:.1} ms)"
-        );
+        let total = Timings::new(
+            timed
+                .prepare_ms
+                .iter()
+                .zip(&timed.align_ms)
+                .map(|(p, a)| p + a),
+        )
+        .context("no run")?;
+        out!(
+            "time        prepare + align: best {:.1} ms, median {:.1} ms of {} runs \
+             (best prepare {:.1} ms, best align {:.1} ms)",
+            total.best(),
+            total.median(),
+            total.len(),
+            prepare.best(),
+            align.best()
+        )
     }
 }
 
-fn main() -> Result<()> {
-    let args = parse_args()?;
-    let source = read_cloud(&args.source).with_context(|| args.source.display().to_string())?;
-    let target = read_cloud(&args.target).with_context(|| args.target.display().to_string())?;
+fn register(args: &Args) -> Result<()> {
+    let job = Job::new(args);
+    let repeat = args.repeat.get();
+    let source = read_cloud(&job.source).with_context(|| job.source.display().to_string())?;
+    let target = read_cloud(&job.target).with_context(|| job.target.display().to_string())?;
     let icp = IcpConfig {
         source_voxel: args.voxel,
         target_voxel: args.voxel,
         ..IcpConfig::default()
     };
     let mut loam = LoamConfig::default();
-    loam.features.layout = args.layout;
+    loam.features.layout = job.layout;
     // A pair may start far from its answer: begin with a wide robust threshold.
     loam.initial_tukey_threshold = 1.0;
-    let timed = match args.method.as_str() {
-        "p2p" => run(
+    let timed = match args.method {
+        Method::PointToPoint => run(
             &PointToPointIcp { config: icp },
             &source,
             &target,
-            &args.init,
-            args.repeat,
+            &job.init,
+            repeat,
         )?,
-        "p2plane" => run(
+        Method::PointToPlane => run(
             &PointToPlaneIcp { config: icp },
             &source,
             &target,
-            &args.init,
-            args.repeat,
+            &job.init,
+            repeat,
         )?,
-        "loam" => run(
+        Method::Loam => run(
             &LoamRegistrator { config: loam },
             &source,
             &target,
-            &args.init,
-            args.repeat,
+            &job.init,
+            repeat,
         )?,
-        other => bail!("unknown method {other} (p2p, p2plane, loam)"),
     };
     let a = &timed.alignment;
     let (t, q) = (a.pose.translation.vector, a.pose.rotation.coords);
-    println!(
+    out!(
         "source      {} ({} points)",
-        args.source.display(),
+        job.source.display(),
         source.len()
-    );
-    println!(
+    )?;
+    out!(
         "target      {} ({} points)",
-        args.target.display(),
+        job.target.display(),
         target.len()
-    );
-    println!("method      {}", args.method);
-    println!(
+    )?;
+    out!("method      {}", value_name(&args.method))?;
+    out!(
         "target_T_source (x y z qx qy qz qw)\n            {:.6} {:.6} {:.6} {:.6} {:.6} {:.6} {:.6}",
-        t.x, t.y, t.z, q.x, q.y, q.z, q.w
-    );
-    println!(
+        t.x,
+        t.y,
+        t.z,
+        q.x,
+        q.y,
+        q.z,
+        q.w
+    )?;
+    out!(
         "iterations  {} ({})",
         a.iterations,
         if a.converged {
@@ -252,24 +314,30 @@ fn main() -> Result<()> {
         } else {
             "iteration cap"
         }
-    );
-    println!(
+    )?;
+    out!(
         "inliers     {} ({:.1} %)",
         a.inliers,
         100.0 * a.inlier_ratio
-    );
-    println!("rmse        {:.4} m", a.rmse);
-    println!(
+    )?;
+    out!("rmse        {:.4} m", a.rmse)?;
+    out!(
         "degeneracy  smallest/largest information eigenvalue {:.2e}",
         a.min_eigenvalue_ratio
-    );
-    print_times(&timed, args.repeat);
-    if let Some(path) = &args.reference {
+    )?;
+    print_times(&timed)?;
+    if let Some(path) = &job.reference {
         let e = read_reference(path)?.inverse() * a.pose;
-        println!(
+        out!(
             "vs reference {:.3} deg, {:.2} cm",
             e.rotation.angle().to_degrees(),
             100.0 * e.translation.vector.norm()
+        )?;
+    }
+    if !a.converged {
+        bail!(
+            "the alignment stopped at its iteration cap ({} iterations) without converging",
+            a.iterations
         );
     }
     Ok(())

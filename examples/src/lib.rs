@@ -1,1 +1,34 @@
-//! Shared helpers for the examples (data paths).
+//! What the spot-nav examples share: where the bundled data lives, command-line pieces (backend
+//! choices, `X,Y` goals), standard output that ends quietly on a closed pipe, progress on stderr,
+//! timing summaries, and the map-and-evaluate loop of the `slam` and `mission` examples.
+//!
+//! Every example's `main` is a one-liner around [`run`], which gives each failure an exit
+//! status of 1 and a one-line reason on stderr:
+//!
+//! ```no_run
+//! use std::process::ExitCode;
+//!
+//! use spot_nav_examples::out;
+//!
+//! fn main() -> ExitCode {
+//!     spot_nav_examples::run(|| {
+//!         out!("hello")?; // `println!` would panic when stdout is a closed pipe
+//!         Ok(())
+//!     })
+//! }
+//! ```
+//!
+//! Not a library to build on: its functions print, exit and read the bundled files by path.
+
+pub mod args;
+pub mod data;
+pub mod mapping;
+pub mod output;
+pub mod progress;
+pub mod stats;
+
+pub use args::{Registration, parse_goal, parse_numbers, value_name};
+pub use mapping::{Mapping, map_and_evaluate};
+pub use output::{StdoutClosed, run, write_line};
+pub use progress::Progress;
+pub use stats::{Timings, quantile};

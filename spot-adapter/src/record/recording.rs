@@ -489,10 +489,18 @@ impl Iterator for RecordingSamples {
     type Item = Result<Sample, AdapterError>;
 
     fn next(&mut self) -> Option<Self::Item> {
+        // As many samples as the recording had when it was opened (the exact length), unless an
+        // error ends the reading early.
+        if self.left == 0 {
+            return None;
+        }
         let entries = match &mut self.entries {
             Ok(entries) => entries,
             // The files could not be opened again: say so once.
-            Err(e) => return e.take().map(Err),
+            Err(e) => {
+                self.left = 0;
+                return e.take().map(Err);
+            }
         };
         let entry = match entries.next()? {
             Ok(entry) => entry,
@@ -516,9 +524,11 @@ impl Iterator for RecordingSamples {
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
-        (0, Some(self.left))
+        (self.left, Some(self.left))
     }
 }
+
+impl ExactSizeIterator for RecordingSamples {}
 
 impl IntoIterator for Recording {
     type Item = Result<Sample, AdapterError>;

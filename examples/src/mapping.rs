@@ -1,0 +1,88 @@
+//! The map-and-evaluate loop of the `slam` and `mission` examples: feed every sample to the
+//! Graph-SLAM engine with progress on stderr, then evaluate the body trajectory against the
+//! ground truth when the source knows it.
+
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use slam_core::io::StampedPose;
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, ScanOutcome};
+use spot_adapter::eval::{TrajectoryEvaluation, body_trajectory};
+use spot_adapter::robot::Sample;
+
+use crate::progress::Progress;
+
+/// What one mapping run gave besides the engine's own state and report.
+#[derive(Clone, Debug)]
+pub struct Mapping {
+    /// The body trajectory estimate (`map_T_body` per scan), for writing out.
+    pub estimate: Vec<StampedPose>,
+    /// The estimate against the ground truth (ATE, drifts, loop end-point error), when known.
+    pub evaluation: Option<TrajectoryEvaluation>,
+    /// Wall-clock seconds of feeding the samples (reading or simulating them included).
+    pub seconds: f64,
+}
+
+/// Feeds every sample to `slam` (progress labelled `label` on stderr, a line for each skipped
+/// scan), then evaluates the body trajectory (`body_t_lidar`: the LiDAR mounting) against `truth`
+/// (`world_T_body`) when given.
+///
+/// # Errors
+/// The first sample that could not be read, a failed evaluation (fewer than 3 poses matched by
+/// stamp), or an engine that accepted no scan at all.
+pub fn map_and_evaluate<R, C, O, I, E>(
+    slam: &mut GraphSlam<R, C, O>,
+    samples: I,
+    body_t_lidar: &Pose3,
+    truth: Option<&[StampedPose]>,
+    label: &str,
+) -> Result<Mapping>
+where
+    R: MapRegistrator,
+    C: MapRegistrator,
+    O: Optimizer<Pose3>,
+    I: ExactSizeIterator<Item = Result<Sample, E>>,
+    E: Into<anyhow::Error>,
+{
+    let mut progress = Progress::new(label, "scans", Some(samples.len() as u64));
+    let started = Instant::now();
+    for (n, sample) in (1u64..).zip(samples) {
+        let sample = sample.map_err(Into::into)?;
+        if let ScanOutcome::Skipped(reason) = slam.process(&sample.scan_input()) {
+            progress.note(&format!("scan {n} skipped: {reason:?}"));
+        }
+        progress.update(
+            n,
+            format!(
+                "{} keyframes, {} loops",
+                slam.keyframe_count(),
+                slam.report().loops_closed
+            ),
+        );
+    }
+    progress.finish();
+    let seconds = started.elapsed().as_secs_f64();
+    let report = slam.report();
+    if report.keyframes == 0 {
+        bail!(
+            "the engine accepted none of the {} scans (see the skipped scans above)",
+            report.scans
+        );
+    }
+    let (evaluation, estimate) = match truth {
+        Some(truth) => {
+            let (evaluation, estimate) = TrajectoryEvaluation::of_lidar_trajectory(
+                slam.scan_trajectory(),
+                body_t_lidar,
+                truth,
+            )?;
+            (Some(evaluation), estimate)
+        }
+        None => (None, body_trajectory(slam.scan_trajectory(), body_t_lidar)),
+    };
+    Ok(Mapping {
+        estimate,
+        evaluation,
+        seconds,
+    })
+}
