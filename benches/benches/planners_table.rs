@@ -66,7 +66,8 @@ impl<'g> Entry<'g> {
             bytes_per_cell,
             setup_ms,
             query: Box::new(move |s: &Scenario| match planner.plan(s.start, s.goal) {
-                Ok(p) => (p.length, p.expanded),
+                Ok(Some(p)) => (p.length, p.expanded),
+                Ok(None) => panic!("{name}: no path, but the scenario has one"),
                 Err(e) => panic!("{name}: {e}"),
             }),
             us: Vec::new(),

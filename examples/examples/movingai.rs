@@ -97,16 +97,14 @@ fn main() -> Result<()> {
             let result = planner.plan(s.start, s.goal);
             us.push(t.elapsed().as_secs_f64() * 1e6);
             match result {
-                Ok(p) if (p.length - s.optimal_length).abs() <= s.tolerance => {
+                Ok(Some(p)) if (p.length - s.optimal_length).abs() <= s.tolerance => {
                     matched += 1;
                     expanded += p.expanded;
                 }
                 Ok(p) => {
                     failures += 1;
-                    eprintln!(
-                        "{name}: scenario {k}: length {} but the optimum is {}",
-                        p.length, s.optimal_length
-                    );
+                    let got = p.map_or("no path".into(), |p| format!("length {}", p.length));
+                    eprintln!("{name}: scenario {k}: {got}, optimum {}", s.optimal_length);
                 }
                 Err(e) => {
                     failures += 1;

@@ -118,7 +118,7 @@ impl Jumper for CellJumper<'_> {
 }
 
 impl Planner for JumpPointSearch<'_> {
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
         match &self.scans {
             Scans::Words(j) => {
                 jump_search(self.grid, &self.components, &mut self.space, j, start, goal)

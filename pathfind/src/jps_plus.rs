@@ -70,7 +70,7 @@ impl<'g> JumpPointSearchPlus<'g> {
 }
 
 impl Planner for JumpPointSearchPlus<'_> {
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
         match &self.mode {
             Mode::Blocks(j) => {
                 jump_search(self.grid, &self.components, &mut self.space, j, start, goal)

@@ -95,7 +95,8 @@ pub(crate) trait Jumper {
     fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell>;
 }
 
-/// Best-first search over jump points; returns the jump points as the path's cells.
+/// Best-first search over jump points; returns the jump points as the path's cells, or `None`
+/// when the goal is unreachable.
 pub(crate) fn jump_search(
     grid: &BitGrid,
     components: &Components,
@@ -103,10 +104,10 @@ pub(crate) fn jump_search(
     jumper: &impl Jumper,
     start: Cell,
     goal: Cell,
-) -> Result<GridPath, PlanError> {
+) -> Result<Option<GridPath>, PlanError> {
     validate_endpoints(grid, start, goal)?;
     if !components.connected(start, goal) {
-        return Err(PlanError::NoPath);
+        return Ok(None);
     }
     let (s, t) = (space.index(start), space.index(goal));
     space.start(s, octile(start, goal));
@@ -114,7 +115,7 @@ pub(crate) fn jump_search(
     while let Some((i, g, arrive)) = space.pop() {
         expanded += 1;
         if i == t {
-            return Ok(space.path(s, t, expanded));
+            return Ok(Some(space.path(s, t, expanded)));
         }
         let c = space.cell(i);
         let mut dirs = pruned_directions(grid, i64::from(c.x), i64::from(c.y), arrive);
@@ -126,5 +127,6 @@ pub(crate) fn jump_search(
             }
         }
     }
-    Err(PlanError::NoPath)
+    // The open list ran dry: unreachable (the component check above normally answers first).
+    Ok(None)
 }

@@ -21,7 +21,8 @@ fn run(name: &str, planner: &mut dyn Planner, grid: &BitGrid, map: &str) -> usiz
         assert_eq!((s.map_width, s.map_height), (grid.width(), grid.height()));
         let p = planner
             .plan(s.start, s.goal)
-            .unwrap_or_else(|e| panic!("{name} {map} #{k}: {e}"));
+            .unwrap_or_else(|e| panic!("{name} {map} #{k}: {e}"))
+            .unwrap_or_else(|| panic!("{name} {map} #{k}: no path, but the scenario has one"));
         assert!(
             (p.length - s.optimal_length).abs() <= s.tolerance,
             "{name} on {map} scenario {k}: {} but the optimum is {} (tolerance {})",

@@ -176,13 +176,11 @@ pub enum OptimizeError {
     Factorization(String),
 }
 
-/// Errors of a [`Planner`](crate::Planner). [`PlanError::NoPath`] is an answer, not a failure.
+/// Errors of a [`Planner`](crate::Planner): bad arguments only. An unreachable goal is not an
+/// error but the answer `Ok(None)` of [`Planner::plan`](crate::Planner::plan).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 #[non_exhaustive]
 pub enum PlanError {
-    /// The goal cannot be reached from the start.
-    #[error("no path from the start to the goal")]
-    NoPath,
     /// Start or goal is off the grid.
     #[error("{which} ({x}, {y}) is outside the {width}x{height} grid")]
     OutOfBounds {

@@ -206,8 +206,9 @@ impl<'g, R: Registrator> Navigator<'g, R> {
             .cell_at(goal)
             .filter(|&c| !self.grid.is_blocked(c))?;
         let start = nearest_free(self.grid, self.grid.cell_at(position)?)?;
-        // Both ends are on the grid and free: `NoPath` is the only error left.
-        let path = self.planner.plan(start, goal_cell).ok()?;
+        // TODO(merge): both ends are checked above, so a planner error is a broken invariant and
+        // must become a navigator fault once `step` can report one; `None` is the only answer.
+        let path = self.planner.plan(start, goal_cell).ok().flatten()?;
         let filtered = filter_path(self.grid, &path);
         let mut waypoints: Vec<Vector2<f64>> = filtered
             .waypoints
