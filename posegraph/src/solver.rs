@@ -2,7 +2,7 @@
 //! [`LevenbergMarquardt`](crate::LevenbergMarquardt).
 
 use nalgebra::SVector;
-use slam_core::{OptimizationReport, OptimizeError, PoseGraph, StopReason};
+use slam_core::{FactorizationFailure, OptimizationReport, OptimizeError, PoseGraph, StopReason};
 
 use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
@@ -67,11 +67,9 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let model = config.error_model;
     let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
     let initial_cost = cost_with(graph, &poses, model);
-    if !cache.as_ref().is_some_and(|c| c.fits(graph)) {
-        *cache = Some(NormalEquations::new(graph)?);
-    }
-    let Some(ne) = cache.as_mut() else {
-        return Err(OptimizeError::Factorization("no normal equations".into()));
+    let ne = match cache.take() {
+        Some(ne) if ne.fits(graph) => cache.insert(ne),
+        _ => cache.insert(NormalEquations::new(graph)?),
     };
     if ne.dimension() == 0 || graph.edge_count() == 0 {
         return Ok(OptimizationReport {
@@ -131,7 +129,10 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             }
         }
         if !step_max.is_finite() {
-            return Err(OptimizeError::Factorization("non-finite step".into()));
+            return Err(OptimizeError::Factorization {
+                stage: "step solve",
+                cause: FactorizationFailure::NonFiniteSolution,
+            });
         }
         let new_cost = cost_with(graph, &trial, model);
         // NaN costs count as worse.

@@ -2,7 +2,9 @@
 //! from the backend, convergence tests, and the final report.
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
-use slam_core::{Alignment, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat};
+use slam_core::{
+    Alignment, Degeneracy, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat,
+};
 
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{NeighbourCache, Neighbours};
@@ -111,12 +113,14 @@ fn update<S: IcpStep>(
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
     let Some(delta) = S::step(pairs, weights) else {
-        return Err(RegistrationError::Degenerate(
-            "singular normal equations".into(),
-        ));
+        return Err(RegistrationError::Degenerate {
+            cause: Degeneracy::SingularNormalEquations,
+        });
     };
     if !delta.iter().all(|v| v.is_finite()) {
-        return Err(RegistrationError::Degenerate("non-finite update".into()));
+        return Err(RegistrationError::Degenerate {
+            cause: Degeneracy::NonFiniteUpdate,
+        });
     }
     *pose = se3_exp(&delta) * *pose;
     Ok((

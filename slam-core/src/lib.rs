@@ -43,7 +43,10 @@ pub mod traits;
 mod voxel;
 
 pub use cloud::{Aabb, PointCloud};
-pub use error::{CloudError, FormatError, GridError, OptimizeError, PlanError, RegistrationError};
+pub use error::{
+    CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
+    OptimizeError, PlanError, RegistrationError,
+};
 pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};
 pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};

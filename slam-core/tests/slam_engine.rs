@@ -11,10 +11,10 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, EdgeInformation, GraphPose, GraphSlam, GraphSlamConfig, MapRegistrator,
-    OptimizationReport, OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph, RegistrationError,
-    Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy, se3_exp,
-    se3_left_jacobian, se3_log,
+    Alignment, EdgeInformation, FactorizationFailure, GraphPose, GraphSlam, GraphSlamConfig,
+    MapRegistrator, OptimizationReport, OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph,
+    RegistrationError, Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy,
+    se3_exp, se3_left_jacobian, se3_log,
 };
 
 /// Point-to-point ICP with brute-force nearest neighbours (Arun/Umeyama step).
@@ -185,7 +185,10 @@ impl Optimizer<Pose3> for DenseGaussNewton {
             }
             let dx = h
                 .cholesky()
-                .ok_or(OptimizeError::Factorization("not positive definite".into()))?
+                .ok_or(OptimizeError::Factorization {
+                    stage: "dense Cholesky",
+                    cause: FactorizationFailure::NotPositiveDefinite,
+                })?
                 .solve(&(-b));
             for i in 0..n {
                 let d = Vector6::from_iterator(dx.rows(6 * i, 6).iter().copied());

@@ -228,10 +228,9 @@ fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
                 .any(|s: &(Channel, usize, Scalar, usize, usize)| s.0 == ch)
         {
             if ch == Channel::Ring && !f.scalar.is_integer() {
-                return Err(FormatError::Unsupported(format!(
-                    "ring field {} is not an integer type",
-                    f.name
-                )));
+                return Err(FormatError::NonIntegerRing {
+                    field: f.name.clone(),
+                });
             }
             slots.push((ch, offset, f.scalar, value_index, fi));
         }
@@ -240,14 +239,12 @@ fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
             .size()
             .checked_mul(f.count)
             .and_then(|s| s.checked_add(offset))
-            .ok_or_else(|| FormatError::Unsupported("record size overflows".into()))?;
+            .ok_or(FormatError::RecordTooLarge)?;
         value_index += f.count;
     }
     for ch in [Channel::X, Channel::Y, Channel::Z] {
         if !slots.iter().any(|s| s.0 == ch) {
-            return Err(FormatError::Unsupported(
-                format!("no {ch:?} field").to_lowercase(),
-            ));
+            return Err(FormatError::MissingField { field: ch.name() });
         }
     }
     Ok(Layout {
@@ -362,7 +359,8 @@ fn lzf_decompress(input: &[u8], out_len: usize, base: usize) -> Result<Vec<u8>, 
 ///
 /// # Errors
 /// [`FormatError::Line`] for header and ascii errors, [`FormatError::Byte`] for binary data that
-/// is truncated or malformed, [`FormatError::Unsupported`] for files without x, y, z.
+/// is truncated or malformed, [`FormatError::MissingField`] for files without x, y, z,
+/// [`FormatError::NonIntegerRing`] for a floating-point ring field.
 pub fn parse_pcd(bytes: &[u8]) -> Result<PointCloud, FormatError> {
     let header = parse_header(bytes)?;
     let layout = layout(&header.fields)?;

@@ -167,18 +167,16 @@ fn vertex_slots(el: &Element) -> Result<Vec<(Channel, usize)>, FormatError> {
             && !slots.iter().any(|s| s.0 == ch)
         {
             if ch == Channel::Ring && !scalar.is_integer() {
-                return Err(FormatError::Unsupported(format!(
-                    "ring property {name} is not an integer type"
-                )));
+                return Err(FormatError::NonIntegerRing {
+                    field: name.clone(),
+                });
             }
             slots.push((ch, i));
         }
     }
     for ch in [Channel::X, Channel::Y, Channel::Z] {
         if !slots.iter().any(|s| s.0 == ch) {
-            return Err(FormatError::Unsupported(
-                format!("vertex element has no {ch:?} property").to_lowercase(),
-            ));
+            return Err(FormatError::MissingField { field: ch.name() });
         }
     }
     Ok(slots)
@@ -208,8 +206,9 @@ fn store(sink: &mut ChannelSink, slots: &[(Channel, usize)], values: &[f64]) -> 
 ///
 /// # Errors
 /// [`FormatError::Line`] for header and ascii errors, [`FormatError::Byte`] for truncated or
-/// malformed binary data, [`FormatError::Unsupported`] when there is no vertex element with x, y,
-/// z.
+/// malformed binary data, [`FormatError::NoVertexElement`] or [`FormatError::MissingField`] when
+/// there is no vertex element with x, y, z, [`FormatError::NonIntegerRing`] for a floating-point
+/// ring property.
 // One walk over the header's elements, in binary or text; splitting it would scatter the cursor.
 #[allow(clippy::too_many_lines)]
 pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
@@ -218,7 +217,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
         .elements
         .iter()
         .position(|e| e.name == "vertex")
-        .ok_or_else(|| FormatError::Unsupported("no vertex element".into()))?;
+        .ok_or(FormatError::NoVertexElement)?;
     let slots = vertex_slots(&header.elements[vi])?;
     let vcount = header.elements[vi].count;
     let has = |c| slots.iter().any(|s| s.0 == c);
