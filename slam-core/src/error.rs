@@ -163,6 +163,9 @@ pub enum RegistrationError {
         /// What made it degenerate.
         cause: Degeneracy,
     },
+    /// The closed-form rigid fit of the correspondences failed (point-to-point ICP).
+    #[error(transparent)]
+    RigidFit(#[from] RigidFitError),
     /// A setting is out of its valid range.
     #[error("{setting} = {value}: must be {expected}")]
     InvalidConfig {
@@ -191,6 +194,43 @@ pub enum Degeneracy {
     CoincidentPoints {
         /// The axis (0 = x, 1 = y, 2 = z).
         axis: usize,
+    },
+}
+
+/// Errors of [`fit_rigid_transform`](crate::geometry::fit_rigid_transform) and
+/// [`fit_weighted_rigid_transform`](crate::geometry::fit_weighted_rigid_transform).
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[non_exhaustive]
+pub enum RigidFitError {
+    /// The two point sets differ in length.
+    #[error("rigid fit: {from} points to move but {to} to land on")]
+    LengthMismatch {
+        /// Points to move.
+        from: usize,
+        /// Points to land on.
+        to: usize,
+    },
+    /// Fewer pairs than a rotation needs.
+    #[error("rigid fit: {pairs} pairs of positive weight, at least {required} are needed")]
+    TooFewPairs {
+        /// Pairs of positive weight given.
+        pairs: usize,
+        /// Pairs needed (3).
+        required: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("rigid fit: pair {index} has a non-finite coordinate")]
+    NonFinitePoint {
+        /// Index of the pair.
+        index: usize,
+    },
+    /// A weight is negative, NaN or infinite.
+    #[error("rigid fit: weight {index} is {weight}: must be finite and not negative")]
+    InvalidWeight {
+        /// Index of the pair.
+        index: usize,
+        /// The weight.
+        weight: f64,
     },
 }
 
