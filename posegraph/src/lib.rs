@@ -50,4 +50,4 @@ pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
-pub use solver::SolverConfig;
+pub use solver::{SolverConfig, SolverPose};

@@ -2,7 +2,9 @@
 //! [`LevenbergMarquardt`](crate::LevenbergMarquardt).
 
 use nalgebra::SVector;
-use slam_core::{FactorizationFailure, OptimizationReport, OptimizeError, PoseGraph, StopReason};
+use slam_core::{
+    FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph, StopReason,
+};
 
 use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
@@ -51,6 +53,64 @@ fn cost_with<P: Linearize<D>, const D: usize>(
 
 /// Cached structure of an optimiser.
 pub(crate) type Cache<const D: usize> = Option<NormalEquations<D>>;
+
+/// A pose type the optimisers solve for: [`Pose3`] (6 degrees of freedom) and [`Pose2`] (3).
+/// [`GaussNewton`](crate::GaussNewton) and [`LevenbergMarquardt`](crate::LevenbergMarquardt)
+/// implement [`Optimizer<P>`](slam_core::Optimizer) once for every `P: SolverPose`. Sealed: each
+/// optimiser keeps a cache slot per pose type.
+pub trait SolverPose: sealed::Sealed {}
+
+impl SolverPose for Pose3 {}
+impl SolverPose for Pose2 {}
+
+pub(crate) mod sealed {
+    use slam_core::{OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph};
+
+    use super::{Cache, SolverConfig, optimize};
+
+    /// The normal equations an optimiser keeps between calls, one slot per pose type.
+    #[derive(Default)]
+    pub struct Caches {
+        se3: Cache<6>,
+        se2: Cache<3>,
+    }
+
+    /// The loop of [`optimize`] with the cache slot of the pose type.
+    pub trait Sealed: slam_core::GraphPose {
+        /// Run the loop (see [`optimize`]) with this pose type's slot of `caches`.
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError>;
+    }
+
+    impl Sealed for Pose3 {
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError> {
+            optimize(graph, &mut caches.se3, config, levenberg, initial_lambda)
+        }
+    }
+
+    impl Sealed for Pose2 {
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError> {
+            optimize(graph, &mut caches.se2, config, levenberg, initial_lambda)
+        }
+    }
+}
 
 // One loop with the damping state machine in plain sight; splitting it would hide the control flow.
 #[allow(clippy::too_many_lines)]
