@@ -72,12 +72,8 @@ fn planners(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("JumpPointSearch_cells", name), |b| {
             b.iter(|| run(&mut jps_cells, &sample));
         });
-        let mut blocks = JumpPointSearchPlus::new(grid);
-        group.bench_function(BenchmarkId::new("JumpPointSearchPlus_blocks", name), |b| {
-            b.iter(|| run(&mut blocks, &sample));
-        });
-        if let Ok(mut tables) = JumpPointSearchPlus::with_jump_tables(grid) {
-            group.bench_function(BenchmarkId::new("JumpPointSearchPlus_tables", name), |b| {
+        if let Ok(mut tables) = JumpPointSearchPlus::new(grid) {
+            group.bench_function(BenchmarkId::new("JumpPointSearchPlus", name), |b| {
                 b.iter(|| run(&mut tables, &sample));
             });
         }

@@ -2,7 +2,7 @@
 //! published optimum (too long and too short both fail), and print per planner: scenarios,
 //! matched, mean and p99 microseconds per query, mean expanded nodes.
 //!
-//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]`
+//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|all]`
 //!
 //! Exits non-zero on any mismatch. Example:
 //! `cargo run --release --example movingai -- pathfind/tests/data/arena.map pathfind/tests/data/arena.map.scen`
@@ -14,7 +14,8 @@ use pathfind::movingai::{read_map, read_scenarios};
 use pathfind::{AStar, Dijkstra, JumpPointSearch, JumpPointSearchPlus};
 use slam_core::{BitGrid, Planner};
 
-const USAGE: &str = "usage: movingai MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]";
+const USAGE: &str =
+    "usage: movingai MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|all]";
 
 /// The planner called `name` on the command line.
 fn build<'g>(name: &str, grid: &'g BitGrid) -> Result<Box<dyn Planner + 'g>> {
@@ -23,8 +24,7 @@ fn build<'g>(name: &str, grid: &'g BitGrid) -> Result<Box<dyn Planner + 'g>> {
         "astar" => Box::new(AStar::new(grid)),
         "jps" => Box::new(JumpPointSearch::new(grid)),
         "jps-cells" => Box::new(JumpPointSearch::with_cell_scans(grid)),
-        "jps-plus" => Box::new(JumpPointSearchPlus::new(grid)),
-        "jps-plus-tables" => Box::new(JumpPointSearchPlus::with_jump_tables(grid)?),
+        "jps-plus" => Box::new(JumpPointSearchPlus::new(grid)?),
         other => bail!("unknown planner {other:?}; {USAGE}"),
     })
 }
@@ -70,14 +70,7 @@ fn main() -> Result<()> {
         );
     }
     let names: Vec<&str> = if which == "all" {
-        vec![
-            "dijkstra",
-            "astar",
-            "jps",
-            "jps-cells",
-            "jps-plus",
-            "jps-plus-tables",
-        ]
+        vec!["dijkstra", "astar", "jps", "jps-cells", "jps-plus"]
     } else {
         vec![which.as_str()]
     };

@@ -95,9 +95,46 @@ pub(crate) trait Jumper {
     fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell>;
 }
 
+/// What every jump-point planner holds besides its jumper: the grid, its component labels and
+/// the search records, built once per grid.
+pub(crate) struct JumpSearch<'g> {
+    grid: &'g BitGrid,
+    components: Components,
+    space: SearchSpace,
+}
+
+impl<'g> JumpSearch<'g> {
+    /// The search state for `grid` (labels its connected components).
+    pub(crate) fn new(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            components: Components::new(grid),
+            space: SearchSpace::new(grid.width(), grid.height()),
+        }
+    }
+
+    /// A shortest path from `start` to `goal` with successors from `jumper` (see
+    /// [`jump_search`]).
+    pub(crate) fn plan(
+        &mut self,
+        jumper: &impl Jumper,
+        start: Cell,
+        goal: Cell,
+    ) -> Result<Option<GridPath>, PlanError> {
+        jump_search(
+            self.grid,
+            &self.components,
+            &mut self.space,
+            jumper,
+            start,
+            goal,
+        )
+    }
+}
+
 /// Best-first search over jump points; returns the jump points as the path's cells, or `None`
 /// when the goal is unreachable.
-pub(crate) fn jump_search(
+fn jump_search(
     grid: &BitGrid,
     components: &Components,
     space: &mut SearchSpace,

@@ -7,8 +7,8 @@
 //! - [`JumpPointSearch`]: online JPS (Harabor & Grastien, AAAI 2011) with pruning rules derived
 //!   for no corner cutting; straight jumps scan 64 cells per word (Harabor & Grastien, ICAPS
 //!   2014), or one cell at a time with [`JumpPointSearch::with_cell_scans`].
-//! - [`JumpPointSearchPlus`]: the same word scans, or JPS+ jump tables precomputed per grid
-//!   ([`JumpPointSearchPlus::with_jump_tables`]), chosen at construction.
+//! - [`JumpPointSearchPlus`]: JPS+ (Harabor & Grastien, ICAPS 2014), the same search with jump
+//!   distances precomputed per grid, O(1) per jump.
 //! - [`filter_path`]: the thesis' path filter, keeping only the waypoints a straight
 //!   collision-free segment cannot skip ([`line_of_sight`] walks every touched cell).
 //! - [`movingai`]: readers for the Moving AI `.map` and `.scen` benchmark files.
@@ -25,7 +25,7 @@
 //! // A 20 x 10 room with a wall that has a gap at the top.
 //! let grid = BitGrid::from_fn(20, 10, |x, y| x == 10 && y < 8)?;
 //! let (start, goal) = (Cell::new(2, 2), Cell::new(17, 2));
-//! let mut jps = JumpPointSearchPlus::with_jump_tables(&grid)?;
+//! let mut jps = JumpPointSearchPlus::new(&grid)?;
 //! let path = jps.plan(start, goal)?.expect("the gap joins the two halves");
 //! let reference = AStar::new(&grid).plan(start, goal)?.expect("the same answer");
 //! assert!((path.length - reference.length).abs() < 1e-9);

@@ -44,13 +44,7 @@ fn all_planners(map: &str, with_slow: bool) {
         g,
         map,
     );
-    run("JPS blocks", &mut JumpPointSearchPlus::new(g), g, map);
-    run(
-        "JPS+ tables",
-        &mut JumpPointSearchPlus::with_jump_tables(g).unwrap(),
-        g,
-        map,
-    );
+    run("JPS+", &mut JumpPointSearchPlus::new(g).unwrap(), g, map);
     if with_slow {
         run("A*", &mut AStar::new(g), g, map);
         run("Dijkstra", &mut Dijkstra::new(g), g, map);

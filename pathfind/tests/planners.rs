@@ -91,8 +91,7 @@ proptest! {
         let mut astar = AStar::new(&grid);
         let mut jps = JumpPointSearch::new(&grid);
         let mut jps_cells = JumpPointSearch::with_cell_scans(&grid);
-        let mut blocks = JumpPointSearchPlus::new(&grid);
-        let mut tables = JumpPointSearchPlus::with_jump_tables(&grid).unwrap();
+        let mut tables = JumpPointSearchPlus::new(&grid).unwrap();
         for (a, b) in picks {
             let (Some(start), Some(goal)) = (free_cell(&grid, a), free_cell(&grid, b)) else { continue };
             for goal in [goal, start] {
@@ -100,7 +99,6 @@ proptest! {
                 check(&grid, &astar.plan(start, goal), &want, start, goal, "A*");
                 check(&grid, &jps.plan(start, goal), &want, start, goal, "JPS");
                 check(&grid, &jps_cells.plan(start, goal), &want, start, goal, "JPS cells");
-                check(&grid, &blocks.plan(start, goal), &want, start, goal, "JPS blocks");
                 check(&grid, &tables.plan(start, goal), &want, start, goal, "JPS+ tables");
                 if let Ok(Some(p)) = &want {
                     validate_dense_path(&grid, &p.cells).unwrap();
@@ -121,10 +119,7 @@ fn diagonal_wall_blocks_everything() {
         AStar::new(&grid).plan(a, b),
         JumpPointSearch::new(&grid).plan(a, b),
         JumpPointSearch::with_cell_scans(&grid).plan(a, b),
-        JumpPointSearchPlus::new(&grid).plan(a, b),
-        JumpPointSearchPlus::with_jump_tables(&grid)
-            .unwrap()
-            .plan(a, b),
+        JumpPointSearchPlus::new(&grid).unwrap().plan(a, b),
     ] {
         assert_eq!(r, Ok(None));
     }
@@ -138,7 +133,7 @@ fn diagonal_wall_blocks_everything() {
 #[test]
 fn bad_endpoints_are_errors() {
     let grid = BitGrid::from_fn(10, 10, |x, _| x == 5).unwrap();
-    let mut p = JumpPointSearchPlus::new(&grid);
+    let mut p = JumpPointSearchPlus::new(&grid).unwrap();
     assert!(matches!(
         p.plan(Cell::new(5, 0), Cell::new(0, 0)),
         Err(PlanError::BlockedCell { which: "start", .. })
@@ -160,8 +155,8 @@ fn bad_endpoints_are_errors() {
 fn word_scans_stop_at_the_goal() {
     for w in [63u32, 64, 65, 127, 128, 129, 300] {
         let grid = BitGrid::from_fn(w, 3, |x, y| y == 0 && x % 50 == 25).unwrap();
-        let mut p = JumpPointSearchPlus::new(&grid);
-        let mut t = JumpPointSearchPlus::with_jump_tables(&grid).unwrap();
+        let mut p = JumpPointSearch::new(&grid);
+        let mut t = JumpPointSearchPlus::new(&grid).unwrap();
         let mut d = Dijkstra::new(&grid);
         for (sx, gx) in [(0, w - 1), (w - 1, 0), (1, w / 2), (w / 2, 1)] {
             for y in 1..3 {
