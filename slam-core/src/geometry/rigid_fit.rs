@@ -26,8 +26,10 @@ pub struct WeightedPair {
 /// The rigid transform `to_T_from` minimising `sum |to_i - T from_i|^2`, so that
 /// `to[i] ≈ T * from[i]`.
 ///
-/// Collinear points leave the rotation about their line undetermined; the fit then returns one
-/// of the minimisers (check the spread of the points when that matters).
+/// Collinear points leave the rotation about their line undetermined (the fit then returns one
+/// of the minimisers), and nearly collinear ones determine it poorly: for three exact pairs
+/// whose second principal spread is a tenth of the first the pose comes back within about
+/// 1e-11, at a hundredth within about 1e-7. Check the spread of the points when that matters.
 ///
 /// ```
 /// use nalgebra::Point3;
