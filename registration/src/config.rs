@@ -79,7 +79,7 @@ impl IcpConfig {
             ("IcpConfig::source_voxel", c.source_voxel),
             ("IcpConfig::target_voxel", c.target_voxel),
         ] {
-            check(v.is_finite() && v >= 0.0, setting, v.into(), NON_NEGATIVE)?;
+            check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
         let reach = c.max_correspondence_distance;
         check(
@@ -166,4 +166,20 @@ pub(crate) fn check(
             expected,
         })
     }
+}
+
+/// [`check`] for an `f32` setting, whose value the error gives as written (`-0.1`, not the
+/// `-0.10000000149011612` of its exact `f64` conversion).
+pub(crate) fn check_f32(
+    ok: bool,
+    setting: &'static str,
+    value: f32,
+    expected: &'static str,
+) -> Result<(), RegistrationError> {
+    if ok {
+        return Ok(());
+    }
+    // The shortest decimal that reads back as the f32 ("NaN" and "inf" included).
+    let value = value.to_string().parse().unwrap_or(f64::from(value));
+    check(false, setting, value, expected)
 }

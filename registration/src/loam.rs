@@ -8,7 +8,7 @@ use slam_core::{
     pose3_is_finite, se3_exp,
 };
 
-use crate::config::{NON_NEGATIVE, POSITIVE, check};
+use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
 use crate::icp::min_eigenvalue_ratio;
 use crate::kernel::IcpKernel;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
@@ -359,7 +359,7 @@ impl LoamConfig {
                 self.local_map_plane_voxel,
             ),
         ] {
-            check(v >= 0.0, setting, v.into(), "not negative")?;
+            check_f32(v >= 0.0, setting, v, "not negative")?;
         }
         Ok(())
     }

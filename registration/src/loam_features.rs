@@ -4,7 +4,7 @@
 use nalgebra::{Point3, Vector3};
 use slam_core::{PointCloud, RegistrationError};
 
-use crate::config::{NON_NEGATIVE, check};
+use crate::config::{NON_NEGATIVE, check, check_f32};
 use crate::lidar_layout::LidarLayout;
 
 /// Settings of [`LoamFeatures::extract`]. Lengths in metres.
@@ -99,22 +99,20 @@ impl LoamFeatureConfig {
                 "LoamFeatureConfig::parallel_gap_ratio",
                 self.parallel_gap_ratio,
             ),
-            ("LoamFeatureConfig::min_range", self.min_range.into()),
-            (
-                "LoamFeatureConfig::map_edge_voxel",
-                self.map_edge_voxel.into(),
-            ),
-            (
-                "LoamFeatureConfig::map_plane_voxel",
-                self.map_plane_voxel.into(),
-            ),
         ] {
             check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
-        check(
+        for (setting, v) in [
+            ("LoamFeatureConfig::min_range", self.min_range),
+            ("LoamFeatureConfig::map_edge_voxel", self.map_edge_voxel),
+            ("LoamFeatureConfig::map_plane_voxel", self.map_plane_voxel),
+        ] {
+            check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
+        }
+        check_f32(
             self.max_range.partial_cmp(&self.min_range) == Some(std::cmp::Ordering::Greater),
             "LoamFeatureConfig::max_range",
-            self.max_range.into(),
+            self.max_range,
             "greater than min_range",
         )
     }

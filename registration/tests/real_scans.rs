@@ -257,6 +257,15 @@ fn invalid_settings_are_errors() {
             "{config:?}"
         );
     }
+    // The message names the setting, its value as written and the valid range.
+    let config = IcpConfig {
+        source_voxel: -0.1,
+        ..good
+    };
+    assert_eq!(
+        config.validate().unwrap_err().to_string(),
+        "IcpConfig::source_voxel = -0.1: must be finite and not negative"
+    );
 }
 
 #[test]
