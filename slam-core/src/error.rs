@@ -169,7 +169,8 @@ pub enum RegistrationError {
     /// A setting is out of its valid range.
     #[error("{setting} = {value}: must be {expected}")]
     InvalidConfig {
-        /// The setting, as `Type::field`.
+        /// The setting, as `Type::field` (`Type::function argument` for a constructor's
+        /// argument).
         setting: &'static str,
         /// Its value (integers converted).
         value: f64,
