@@ -66,7 +66,8 @@ impl<'g> Entry<'g> {
             bytes_per_cell,
             setup_ms,
             query: Box::new(move |s: &Scenario| match planner.plan(s.start, s.goal) {
-                Ok(p) => (p.length, p.expanded),
+                Ok(Some(p)) => (p.length, p.expanded),
+                Ok(None) => panic!("{name}: no path, but the scenario has one"),
                 Err(e) => panic!("{name}: {e}"),
             }),
             us: Vec::new(),
@@ -143,17 +144,11 @@ fn print_map(name: &str, grid: &BitGrid, scenarios: &[Scenario]) {
             JumpPointSearch::preprocessed_bytes,
             cells,
         ),
-        Entry::ours(
-            "JumpPointSearchPlus (word scans)",
-            || JumpPointSearchPlus::new(grid),
-            JumpPointSearchPlus::preprocessed_bytes,
-            cells,
-        ),
     ];
     if grid.width() <= 32_767 && grid.height() <= 32_767 {
         entries.push(Entry::ours(
             "JumpPointSearchPlus (JPS+ tables)",
-            || JumpPointSearchPlus::with_jump_tables(grid).unwrap_or_else(|e| panic!("{e}")),
+            || JumpPointSearchPlus::new(grid).unwrap_or_else(|e| panic!("{e}")),
             JumpPointSearchPlus::preprocessed_bytes,
             cells,
         ));

@@ -14,6 +14,7 @@
 //! `cargo bench -p spot-nav-benches --bench slam` (about 6 minutes; `SLAM_BENCH_SEEDS=1,3`,
 //! `SLAM_BENCH_SETUPS=loam` and `SLAM_BENCH_REPEATS=5` pick runs; 3 laps by default)
 
+use slam_core::io::StampedPose;
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, SlamReport};
 use spot_adapter::eval::TrajectoryEvaluation;
 use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
@@ -22,7 +23,7 @@ use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 /// One lap: the engine's report and its trajectory.
 struct Lap {
     report: SlamReport,
-    trajectory: Vec<(f64, Pose3)>,
+    trajectory: Vec<StampedPose>,
 }
 
 /// Runs one lap of `sim` through `slam`.

@@ -2,7 +2,7 @@
 //! published optimum (too long and too short both fail), and print per planner: scenarios,
 //! matched, mean and p99 microseconds per query, mean expanded nodes.
 //!
-//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|jps-plus-tables|all]`
+//! `cargo run --release --example movingai -- MAP SCEN [--planner dijkstra|astar|jps|jps-cells|jps-plus|all]`
 //!
 //! Exits non-zero on any mismatch. Example:
 //! `cargo run --release --example movingai -- pathfind/tests/data/arena.map pathfind/tests/data/arena.map.scen`
@@ -54,12 +54,9 @@ enum PlannerChoice {
     /// Jump Point Search scanning cell by cell.
     #[value(name = "jps-cells")]
     JumpPointSearchCells,
-    /// JPS+ with bitwise scans.
+    /// JPS+: jump tables precomputed for the grid, then table lookups.
     #[value(name = "jps-plus")]
     JumpPointSearchPlus,
-    /// JPS+ with precomputed jump tables.
-    #[value(name = "jps-plus-tables")]
-    JumpPointSearchPlusTables,
     /// Every planner above in turn.
     #[value(name = "all")]
     All,
@@ -86,10 +83,7 @@ impl PlannerChoice {
             Self::AStar => Box::new(AStar::new(grid)),
             Self::JumpPointSearch => Box::new(JumpPointSearch::new(grid)),
             Self::JumpPointSearchCells => Box::new(JumpPointSearch::with_cell_scans(grid)),
-            Self::JumpPointSearchPlus => Box::new(JumpPointSearchPlus::new(grid)),
-            Self::JumpPointSearchPlusTables => {
-                Box::new(JumpPointSearchPlus::with_jump_tables(grid)?)
-            }
+            Self::JumpPointSearchPlus => Box::new(JumpPointSearchPlus::new(grid)?),
             Self::All => bail!("`all` is not one planner"),
         })
     }
@@ -98,7 +92,11 @@ impl PlannerChoice {
 /// The path from `start` to `goal`, or why there is none: the example's only call of
 /// `Planner::plan`.
 fn plan(planner: &mut dyn Planner, start: Cell, goal: Cell) -> Result<GridPath, String> {
-    planner.plan(start, goal).map_err(|e| e.to_string())
+    match planner.plan(start, goal) {
+        Ok(Some(path)) => Ok(path),
+        Ok(None) => Err("no path".into()),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 fn main() -> ExitCode {

@@ -47,10 +47,7 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "loam",
         ],
     ),
-    (
-        "movingai",
-        &["MAP", "SCEN", "--planner", "jps-plus-tables", "all"],
-    ),
+    ("movingai", &["MAP", "SCEN", "--planner", "jps-plus", "all"]),
     (
         "register",
         &[

@@ -5,7 +5,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{Cell, GridGeometry, PointCloud, Pose3};
 
 use crate::config::OccupancyGridConfig;
-use crate::error::GridMapError;
+use crate::error::{GridMapError, check};
 use crate::occupancy::{CellState, OccupancyGrid};
 
 /// Builds [`OccupancyGrid`]s from map clouds. The thesis tested each cell with a k-d tree search
@@ -23,28 +23,30 @@ impl OccupancyGridBuilder {
     /// non-negative (resolution positive), or `min_points == 0`.
     pub fn new(config: OccupancyGridConfig) -> Result<Self, GridMapError> {
         let c = &config;
-        if !(c.resolution.is_finite() && c.resolution > 0.0) {
-            return Err(GridMapError::InvalidConfig(format!(
-                "resolution {} m must be positive",
-                c.resolution
-            )));
-        }
-        for (name, v) in [
-            ("slice_below", c.slice_below),
-            ("slice_above", c.slice_above),
-            ("margin", c.margin),
+        check(
+            c.resolution.is_finite() && c.resolution > 0.0,
+            "OccupancyGridConfig::resolution",
+            c.resolution,
+            "finite and positive",
+        )?;
+        for (setting, v) in [
+            ("OccupancyGridConfig::slice_below", c.slice_below),
+            ("OccupancyGridConfig::slice_above", c.slice_above),
+            ("OccupancyGridConfig::margin", c.margin),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(GridMapError::InvalidConfig(format!(
-                    "{name} {v} m must be finite and non-negative"
-                )));
-            }
+            check(
+                v.is_finite() && v >= 0.0,
+                setting,
+                v,
+                "finite and not negative",
+            )?;
         }
-        if c.min_points == 0 {
-            return Err(GridMapError::InvalidConfig(
-                "min_points must be at least 1".into(),
-            ));
-        }
+        check(
+            c.min_points > 0,
+            "OccupancyGridConfig::min_points",
+            f64::from(c.min_points),
+            "at least 1",
+        )?;
         Ok(Self { config })
     }
 
@@ -70,11 +72,12 @@ impl OccupancyGridBuilder {
     }
 
     fn slice_bounds(&self, lidar_height: f64) -> Result<(f64, f64), GridMapError> {
-        if !lidar_height.is_finite() {
-            return Err(GridMapError::InvalidConfig(
-                "LiDAR height is not finite".into(),
-            ));
-        }
+        check(
+            lidar_height.is_finite(),
+            "lidar_height",
+            lidar_height,
+            "finite",
+        )?;
         Ok((
             lidar_height - self.config.slice_below,
             lidar_height + self.config.slice_above,

@@ -25,9 +25,26 @@ pub enum GridMapError {
         /// Upper bound of the slice.
         max_z: f64,
     },
-    /// A setting is out of range.
-    #[error("invalid setting: {0}")]
-    InvalidConfig(String),
+    /// A setting or argument is out of its valid range.
+    #[error("{setting} = {value}: must be {expected}")]
+    InvalidConfig {
+        /// The setting, as `Type::field` (or the argument's name).
+        setting: &'static str,
+        /// Its value (integers converted).
+        value: f64,
+        /// The valid range, in words.
+        expected: &'static str,
+    },
+    /// A local grid's cell list does not match its size.
+    #[error("local grid has {cells} cells for {width}x{height}")]
+    LocalGridCells {
+        /// Cells given.
+        cells: usize,
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+    },
     /// The grid would have more cells than the configured budget.
     #[error("a {width}x{height} grid exceeds the budget of {max_cells} cells")]
     TooManyCells {
@@ -60,14 +77,32 @@ pub enum GridMapError {
         message: String,
     },
     /// The image codec failed.
-    #[error("image {path}: {message}")]
+    #[error("image {path}: {source}")]
     Image {
         /// The file.
         path: PathBuf,
-        /// What the codec said.
-        message: String,
+        /// The codec's error.
+        source: image::ImageError,
     },
     /// A grid operation failed.
     #[error(transparent)]
     Grid(#[from] slam_core::GridError),
+}
+
+/// [`GridMapError::InvalidConfig`] for `setting` unless `ok`.
+pub(crate) fn check(
+    ok: bool,
+    setting: &'static str,
+    value: f64,
+    expected: &'static str,
+) -> Result<(), GridMapError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(GridMapError::InvalidConfig {
+            setting,
+            value,
+            expected,
+        })
+    }
 }

@@ -4,7 +4,7 @@
 use nalgebra::{Point2, Vector2};
 use slam_core::{Cell, Pose2};
 
-use crate::error::GridMapError;
+use crate::error::{GridMapError, check};
 use crate::occupancy::{CellState, OccupancyGrid};
 
 /// What a local grid says of one of its cells.
@@ -94,25 +94,25 @@ pub struct FusionReport {
 /// are untouched. Only the global cells under the local grid's bounding box are visited.
 ///
 /// # Errors
-/// [`GridMapError::InvalidConfig`] for a local grid whose cell count or resolution is wrong.
+/// [`GridMapError::LocalGridCells`] for a local grid whose cell count is wrong,
+/// [`GridMapError::InvalidConfig`] for one whose resolution is not finite and positive.
 pub fn fuse_local_grid(
     global: &mut OccupancyGrid,
     local: &LocalGrid,
 ) -> Result<FusionReport, GridMapError> {
     if local.cells.len() != local.width as usize * local.height as usize {
-        return Err(GridMapError::InvalidConfig(format!(
-            "local grid has {} cells for {}x{}",
-            local.cells.len(),
-            local.width,
-            local.height
-        )));
+        return Err(GridMapError::LocalGridCells {
+            cells: local.cells.len(),
+            width: local.width,
+            height: local.height,
+        });
     }
-    if !(local.resolution.is_finite() && local.resolution > 0.0) {
-        return Err(GridMapError::InvalidConfig(format!(
-            "local resolution {}",
-            local.resolution
-        )));
-    }
+    check(
+        local.resolution.is_finite() && local.resolution > 0.0,
+        "LocalGrid::resolution",
+        local.resolution,
+        "finite and positive",
+    )?;
     let g = *global.geometry();
     let (lw, lh) = (
         f64::from(local.width) * local.resolution,

@@ -65,8 +65,8 @@ pub fn write_png(
     let path = path.as_ref();
     render(grid, inflated, cells, waypoints)
         .save_with_format(path, image::ImageFormat::Png)
-        .map_err(|e| GridMapError::Image {
+        .map_err(|source| GridMapError::Image {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            source,
         })
 }

@@ -48,9 +48,9 @@ pub fn write_ros_map(
     PnmEncoder::new(std::io::BufWriter::new(file))
         .with_subtype(PnmSubtype::Graymap(SampleEncoding::Binary))
         .write_image(img.as_raw(), w, h, ExtendedColorType::L8)
-        .map_err(|e| GridMapError::Image {
+        .map_err(|source| GridMapError::Image {
             path: pgm_path.clone(),
-            message: e.to_string(),
+            source,
         })?;
     let g = grid.geometry();
     let name = pgm_path
@@ -136,9 +136,9 @@ pub fn read_ros_map(yaml_path: impl AsRef<Path>) -> Result<OccupancyGrid, GridMa
     let geometry = GridGeometry::try_new(origin, resolution)?;
     let image_path = yaml_path.parent().unwrap_or(Path::new(".")).join(&image);
     let img = image::open(&image_path)
-        .map_err(|e| GridMapError::Image {
+        .map_err(|source| GridMapError::Image {
             path: image_path.clone(),
-            message: e.to_string(),
+            source,
         })?
         .into_luma8();
     let (w, h) = img.dimensions();

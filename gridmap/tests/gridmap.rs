@@ -343,7 +343,10 @@ fn bad_input_gives_clear_errors() {
     for r in [0.0, -0.1, f64::NAN] {
         assert!(matches!(
             OccupancyGridBuilder::new(config(r)),
-            Err(GridMapError::InvalidConfig(_))
+            Err(GridMapError::InvalidConfig {
+                setting: "OccupancyGridConfig::resolution",
+                ..
+            })
         ));
     }
     let far = PointCloud::from_points(vec![

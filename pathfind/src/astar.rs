@@ -32,7 +32,7 @@ impl<'g> AStar<'g> {
 }
 
 impl Planner for AStar<'_> {
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
         best_first(
             self.grid,
             &self.components,

@@ -11,7 +11,7 @@ use crate::open_list::BucketRing;
 use crate::search_space::SearchSpace;
 
 /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
-/// `g + heuristic(cell)`.
+/// `g + heuristic(cell)`; `None` when the goal is unreachable.
 pub(crate) fn best_first(
     grid: &BitGrid,
     components: &Components,
@@ -20,10 +20,10 @@ pub(crate) fn best_first(
     start: Cell,
     goal: Cell,
     heuristic: impl Fn(Cell) -> Cost,
-) -> Result<GridPath, PlanError> {
+) -> Result<Option<GridPath>, PlanError> {
     validate_endpoints(grid, start, goal)?;
     if !components.connected(start, goal) {
-        return Err(PlanError::NoPath);
+        return Ok(None);
     }
     closed.reset();
     let (s, t) = (space.index(start), space.index(goal));
@@ -38,7 +38,7 @@ pub(crate) fn best_first(
     while let Some((i, g, _)) = space.pop() {
         expanded += 1;
         if i == t {
-            return Ok(space.path(s, t, expanded));
+            return Ok(Some(space.path(s, t, expanded)));
         }
         let c = space.cell(i);
         closed.insert(c);
@@ -52,5 +52,6 @@ pub(crate) fn best_first(
             space.relax(j, g + STEP[d], || heuristic(n()), i, d as u8);
         }
     }
-    Err(PlanError::NoPath)
+    // The open list ran dry: unreachable (the component check above normally answers first).
+    Ok(None)
 }

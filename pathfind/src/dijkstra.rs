@@ -31,7 +31,7 @@ impl<'g> Dijkstra<'g> {
 }
 
 impl Planner for Dijkstra<'_> {
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
         best_first(
             self.grid,
             &self.components,

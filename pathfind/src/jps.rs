@@ -3,10 +3,8 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::block_scan::BlockJumper;
-use crate::components::Components;
-use crate::jump_search::{Jumper, jump_search};
+use crate::jump_search::{JumpSearch, Jumper};
 use crate::movement::{DIRECTIONS, can_step, free};
-use crate::search_space::SearchSpace;
 
 /// Jump Point Search: A* over jump points found online, with no per-grid tables.
 ///
@@ -14,11 +12,9 @@ use crate::search_space::SearchSpace;
 /// scanning of Harabor & Grastien 2014; vertical runs read a transposed copy of the grid, one
 /// more bit per cell). [`JumpPointSearch::with_cell_scans`] steps one cell at a time as in the
 /// 2011 paper: slower, kept as the textbook reference and for ablation. For precomputed jump
-/// distances see [`JumpPointSearchPlus::with_jump_tables`](crate::JumpPointSearchPlus).
+/// distances (JPS+) see [`JumpPointSearchPlus`](crate::JumpPointSearchPlus).
 pub struct JumpPointSearch<'g> {
-    grid: &'g BitGrid,
-    components: Components,
-    space: SearchSpace,
+    search: JumpSearch<'g>,
     scans: Scans<'g>,
 }
 
@@ -33,9 +29,7 @@ impl<'g> JumpPointSearch<'g> {
     #[must_use]
     pub fn new(grid: &'g BitGrid) -> Self {
         Self {
-            grid,
-            components: Components::new(grid),
-            space: SearchSpace::new(grid.width(), grid.height()),
+            search: JumpSearch::new(grid),
             scans: Scans::Words(BlockJumper::new(grid)),
         }
     }
@@ -44,9 +38,7 @@ impl<'g> JumpPointSearch<'g> {
     #[must_use]
     pub fn with_cell_scans(grid: &'g BitGrid) -> Self {
         Self {
-            grid,
-            components: Components::new(grid),
-            space: SearchSpace::new(grid.width(), grid.height()),
+            search: JumpSearch::new(grid),
             scans: Scans::Cells(CellJumper(grid)),
         }
     }
@@ -118,14 +110,10 @@ impl Jumper for CellJumper<'_> {
 }
 
 impl Planner for JumpPointSearch<'_> {
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
         match &self.scans {
-            Scans::Words(j) => {
-                jump_search(self.grid, &self.components, &mut self.space, j, start, goal)
-            }
-            Scans::Cells(j) => {
-                jump_search(self.grid, &self.components, &mut self.space, j, start, goal)
-            }
+            Scans::Words(j) => self.search.plan(j, start, goal),
+            Scans::Cells(j) => self.search.plan(j, start, goal),
         }
     }
 }

@@ -95,18 +95,56 @@ pub(crate) trait Jumper {
     fn jump(&self, c: Cell, d: u8, goal: Cell) -> Option<Cell>;
 }
 
-/// Best-first search over jump points; returns the jump points as the path's cells.
-pub(crate) fn jump_search(
+/// What every jump-point planner holds besides its jumper: the grid, its component labels and
+/// the search records, built once per grid.
+pub(crate) struct JumpSearch<'g> {
+    grid: &'g BitGrid,
+    components: Components,
+    space: SearchSpace,
+}
+
+impl<'g> JumpSearch<'g> {
+    /// The search state for `grid` (labels its connected components).
+    pub(crate) fn new(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            components: Components::new(grid),
+            space: SearchSpace::new(grid.width(), grid.height()),
+        }
+    }
+
+    /// A shortest path from `start` to `goal` with successors from `jumper` (see
+    /// [`jump_search`]).
+    pub(crate) fn plan(
+        &mut self,
+        jumper: &impl Jumper,
+        start: Cell,
+        goal: Cell,
+    ) -> Result<Option<GridPath>, PlanError> {
+        jump_search(
+            self.grid,
+            &self.components,
+            &mut self.space,
+            jumper,
+            start,
+            goal,
+        )
+    }
+}
+
+/// Best-first search over jump points; returns the jump points as the path's cells, or `None`
+/// when the goal is unreachable.
+fn jump_search(
     grid: &BitGrid,
     components: &Components,
     space: &mut SearchSpace,
     jumper: &impl Jumper,
     start: Cell,
     goal: Cell,
-) -> Result<GridPath, PlanError> {
+) -> Result<Option<GridPath>, PlanError> {
     validate_endpoints(grid, start, goal)?;
     if !components.connected(start, goal) {
-        return Err(PlanError::NoPath);
+        return Ok(None);
     }
     let (s, t) = (space.index(start), space.index(goal));
     space.start(s, octile(start, goal));
@@ -114,7 +152,7 @@ pub(crate) fn jump_search(
     while let Some((i, g, arrive)) = space.pop() {
         expanded += 1;
         if i == t {
-            return Ok(space.path(s, t, expanded));
+            return Ok(Some(space.path(s, t, expanded)));
         }
         let c = space.cell(i);
         let mut dirs = pruned_directions(grid, i64::from(c.x), i64::from(c.y), arrive);
@@ -126,5 +164,6 @@ pub(crate) fn jump_search(
             }
         }
     }
-    Err(PlanError::NoPath)
+    // The open list ran dry: unreachable (the component check above normally answers first).
+    Ok(None)
 }

@@ -7,15 +7,16 @@
 //! - [`JumpPointSearch`]: online JPS (Harabor & Grastien, AAAI 2011) with pruning rules derived
 //!   for no corner cutting; straight jumps scan 64 cells per word (Harabor & Grastien, ICAPS
 //!   2014), or one cell at a time with [`JumpPointSearch::with_cell_scans`].
-//! - [`JumpPointSearchPlus`]: the same word scans, or JPS+ jump tables precomputed per grid
-//!   ([`JumpPointSearchPlus::with_jump_tables`]), chosen at construction.
+//! - [`JumpPointSearchPlus`]: JPS+ (Harabor & Grastien, ICAPS 2014), the same search with jump
+//!   distances precomputed per grid, O(1) per jump.
 //! - [`filter_path`]: the thesis' path filter, keeping only the waypoints a straight
 //!   collision-free segment cannot skip ([`line_of_sight`] walks every touched cell).
 //! - [`movingai`]: readers for the Moving AI `.map` and `.scen` benchmark files.
 //!
 //! Every planner labels the grid's connected components at construction, so an unreachable goal
-//! is answered without a search; [`PlanError::NoPath`](slam_core::PlanError::NoPath) is an answer,
-//! not a failure.
+//! is answered without a search. That answer is `Ok(None)`, not an error:
+//! [`Planner::plan`](slam_core::Planner::plan) fails only for a start or goal off the grid or on
+//! a blocked cell ([`PlanError`](slam_core::PlanError)).
 //!
 //! ```
 //! use pathfind::{AStar, JumpPointSearchPlus, filter_path};
@@ -24,12 +25,15 @@
 //! // A 20 x 10 room with a wall that has a gap at the top.
 //! let grid = BitGrid::from_fn(20, 10, |x, y| x == 10 && y < 8)?;
 //! let (start, goal) = (Cell::new(2, 2), Cell::new(17, 2));
-//! let mut jps = JumpPointSearchPlus::with_jump_tables(&grid)?;
-//! let path = jps.plan(start, goal)?;
-//! let reference = AStar::new(&grid).plan(start, goal)?;
+//! let mut jps = JumpPointSearchPlus::new(&grid)?;
+//! let path = jps.plan(start, goal)?.expect("the gap joins the two halves");
+//! let reference = AStar::new(&grid).plan(start, goal)?.expect("the same answer");
 //! assert!((path.length - reference.length).abs() < 1e-9);
 //! let filtered = filter_path(&grid, &path);
 //! assert!(filtered.waypoints.len() <= 4);
+//! // A wall without a gap: the goal is unreachable, an answer and not an error.
+//! let walled = BitGrid::from_fn(20, 10, |x, _| x == 10)?;
+//! assert_eq!(AStar::new(&walled).plan(start, goal)?, None);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!

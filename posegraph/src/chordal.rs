@@ -18,7 +18,7 @@ use nalgebra::{
     Matrix2, Matrix3, Rotation2, Rotation3, SMatrix, SVector, Translation3, UnitComplex,
     UnitQuaternion, Vector2, Vector3,
 };
-use slam_core::{GraphPose, OptimizeError, Pose2, Pose3, PoseGraph};
+use slam_core::{FactorizationFailure, GraphPose, OptimizeError, Pose2, Pose3, PoseGraph};
 
 use crate::normal_equations::NormalEquations;
 
@@ -187,9 +187,10 @@ fn solve_linear<P: GraphPose, const B: usize, const K: usize>(
     let factorized = ne.factorize(&values);
     ne.values = values;
     if !factorized {
-        return Err(OptimizeError::Factorization(
-            "chordal relaxation: the normal matrix is not positive definite".into(),
-        ));
+        return Err(OptimizeError::Factorization {
+            stage: "chordal relaxation",
+            cause: FactorizationFailure::NotPositiveDefinite,
+        });
     }
     ne.solve_in_place(rhs.as_mut());
     let mut out = known.to_vec();
@@ -201,9 +202,10 @@ fn solve_linear<P: GraphPose, const B: usize, const K: usize>(
     if out.iter().all(|x| x.iter().all(|v| v.is_finite())) {
         Ok(out)
     } else {
-        Err(OptimizeError::Factorization(
-            "chordal relaxation: non-finite solution".into(),
-        ))
+        Err(OptimizeError::Factorization {
+            stage: "chordal relaxation",
+            cause: FactorizationFailure::NonFiniteSolution,
+        })
     }
 }
 

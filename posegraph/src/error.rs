@@ -25,10 +25,10 @@ pub enum GraphFileError {
         message: String,
     },
     /// Tags this reader does not know (reported rather than silently dropped).
-    #[error("unknown tags: {}", .tags.iter().map(|(l, t)| format!("{t} (line {l})")).collect::<Vec<_>>().join(", "))]
+    #[error("unknown tags: {}", .tags.iter().map(ToString::to_string).collect::<Vec<_>>().join(", "))]
     UnknownTags {
-        /// (line, tag) of each distinct unknown tag's first use.
-        tags: Vec<(usize, String)>,
+        /// Each distinct unknown tag at its first use.
+        tags: Vec<UnknownTag>,
     },
     /// SE(2) and SE(3) elements in one file.
     #[error("line {line}: the file mixes 2D and 3D elements")]
@@ -44,4 +44,19 @@ pub enum GraphFileError {
         /// The cause.
         source: slam_core::OptimizeError,
     },
+}
+
+/// A tag of a graph file that the reader does not implement, at its first use.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownTag {
+    /// 1-based line number.
+    pub line: usize,
+    /// The tag (`VERTEX_XY`, `EDGE_SE3_PRIOR`, ...).
+    pub tag: String,
+}
+
+impl std::fmt::Display for UnknownTag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (line {})", self.tag, self.line)
+    }
 }

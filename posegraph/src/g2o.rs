@@ -9,7 +9,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Matrix6, Translation3, Vector2};
 use slam_core::{GraphPose, Pose2, Pose3, PoseGraph, quaternion_from_xyzw, quaternion_to_xyzw};
 
-use crate::error::GraphFileError;
+use crate::error::{GraphFileError, UnknownTag};
 
 /// A graph read from a g2o file: 2D or 3D.
 #[derive(Clone, Debug)]
@@ -67,7 +67,7 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
     let mut g2: Option<PoseGraph<Pose2>> = None;
     let mut g3: Option<PoseGraph<Pose3>> = None;
     let mut fixes: Vec<(usize, u64)> = Vec::new();
-    let mut unknown: Vec<(usize, String)> = Vec::new();
+    let mut unknown: Vec<UnknownTag> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words: Vec<&str> = raw.split_whitespace().collect();
@@ -156,8 +156,11 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
                 }
             }
             other => {
-                if !unknown.iter().any(|(_, t)| t == other) {
-                    unknown.push((line, other.to_string()));
+                if !unknown.iter().any(|u| u.tag == other) {
+                    unknown.push(UnknownTag {
+                        line,
+                        tag: other.to_string(),
+                    });
                 }
             }
         }

@@ -1,8 +1,9 @@
 //! Gauss-Newton.
 
-use slam_core::{OptimizationReport, OptimizeError, Optimizer, Pose2, Pose3, PoseGraph};
+use slam_core::{OptimizationReport, OptimizeError, Optimizer, PoseGraph};
 
-use crate::solver::{Cache, SolverConfig, optimize};
+use crate::solver::sealed::Caches;
+use crate::solver::{SolverConfig, SolverPose};
 
 /// Gauss-Newton on the sparse normal equations: every step is taken; a factorisation that meets a
 /// non-positive pivot is retried with a small damping. Fast near the optimum, may diverge from a
@@ -12,8 +13,7 @@ use crate::solver::{Cache, SolverConfig, optimize};
 pub struct GaussNewton {
     /// Stopping rules.
     pub config: SolverConfig,
-    cache3: Cache<6>,
-    cache2: Cache<3>,
+    caches: Caches,
 }
 
 impl GaussNewton {
@@ -22,26 +22,13 @@ impl GaussNewton {
     pub fn new(config: SolverConfig) -> Self {
         Self {
             config,
-            cache3: None,
-            cache2: None,
+            caches: Caches::default(),
         }
     }
 }
 
-impl Optimizer<Pose3> for GaussNewton {
-    fn optimize(
-        &mut self,
-        graph: &mut PoseGraph<Pose3>,
-    ) -> Result<OptimizationReport, OptimizeError> {
-        optimize(graph, &mut self.cache3, &self.config, false, 0.0)
-    }
-}
-
-impl Optimizer<Pose2> for GaussNewton {
-    fn optimize(
-        &mut self,
-        graph: &mut PoseGraph<Pose2>,
-    ) -> Result<OptimizationReport, OptimizeError> {
-        optimize(graph, &mut self.cache2, &self.config, false, 0.0)
+impl<P: SolverPose> Optimizer<P> for GaussNewton {
+    fn optimize(&mut self, graph: &mut PoseGraph<P>) -> Result<OptimizationReport, OptimizeError> {
+        P::optimize_cached(graph, &mut self.caches, &self.config, false, 0.0)
     }
 }

@@ -1,8 +1,9 @@
 //! Levenberg-Marquardt.
 
-use slam_core::{OptimizationReport, OptimizeError, Optimizer, Pose2, Pose3, PoseGraph};
+use slam_core::{OptimizationReport, OptimizeError, Optimizer, PoseGraph};
 
-use crate::solver::{Cache, SolverConfig, optimize};
+use crate::solver::sealed::Caches;
+use crate::solver::{SolverConfig, SolverPose};
 
 /// Levenberg-Marquardt: Gauss-Newton steps on `H + lambda diag(H)`; a step that raises the cost is
 /// rejected and the damping raised (times 2, 4, 8, ...), an accepted one lowers it (divided by 10).
@@ -16,8 +17,7 @@ pub struct LevenbergMarquardt {
     /// Initial damping (relative to the diagonal), default 1e-8 (1e-5 took 8 iterations instead
     /// of 5 on parking-garage and `input_M3500_g2o`, the same optimum).
     pub initial_lambda: f64,
-    cache3: Cache<6>,
-    cache2: Cache<3>,
+    caches: Caches,
 }
 
 impl Default for LevenbergMarquardt {
@@ -33,35 +33,16 @@ impl LevenbergMarquardt {
         Self {
             config,
             initial_lambda: 1e-8,
-            cache3: None,
-            cache2: None,
+            caches: Caches::default(),
         }
     }
 }
 
-impl Optimizer<Pose3> for LevenbergMarquardt {
-    fn optimize(
-        &mut self,
-        graph: &mut PoseGraph<Pose3>,
-    ) -> Result<OptimizationReport, OptimizeError> {
-        optimize(
+impl<P: SolverPose> Optimizer<P> for LevenbergMarquardt {
+    fn optimize(&mut self, graph: &mut PoseGraph<P>) -> Result<OptimizationReport, OptimizeError> {
+        P::optimize_cached(
             graph,
-            &mut self.cache3,
-            &self.config,
-            true,
-            self.initial_lambda,
-        )
-    }
-}
-
-impl Optimizer<Pose2> for LevenbergMarquardt {
-    fn optimize(
-        &mut self,
-        graph: &mut PoseGraph<Pose2>,
-    ) -> Result<OptimizationReport, OptimizeError> {
-        optimize(
-            graph,
-            &mut self.cache2,
+            &mut self.caches,
             &self.config,
             true,
             self.initial_lambda,

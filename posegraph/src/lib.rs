@@ -46,8 +46,8 @@ mod sparse_cholesky;
 pub mod toro;
 
 pub use chordal::{ChordalInitialization, initialize_chordal};
-pub use error::GraphFileError;
+pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
-pub use solver::SolverConfig;
+pub use solver::{SolverConfig, SolverPose};

@@ -2,7 +2,9 @@
 //! [`LevenbergMarquardt`](crate::LevenbergMarquardt).
 
 use nalgebra::SVector;
-use slam_core::{OptimizationReport, OptimizeError, PoseGraph, StopReason};
+use slam_core::{
+    FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph, StopReason,
+};
 
 use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
@@ -52,6 +54,64 @@ fn cost_with<P: Linearize<D>, const D: usize>(
 /// Cached structure of an optimiser.
 pub(crate) type Cache<const D: usize> = Option<NormalEquations<D>>;
 
+/// A pose type the optimisers solve for: [`Pose3`] (6 degrees of freedom) and [`Pose2`] (3).
+/// [`GaussNewton`](crate::GaussNewton) and [`LevenbergMarquardt`](crate::LevenbergMarquardt)
+/// implement [`Optimizer<P>`](slam_core::Optimizer) once for every `P: SolverPose`. Sealed: each
+/// optimiser keeps a cache slot per pose type.
+pub trait SolverPose: sealed::Sealed {}
+
+impl SolverPose for Pose3 {}
+impl SolverPose for Pose2 {}
+
+pub(crate) mod sealed {
+    use slam_core::{OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph};
+
+    use super::{Cache, SolverConfig, optimize};
+
+    /// The normal equations an optimiser keeps between calls, one slot per pose type.
+    #[derive(Default)]
+    pub struct Caches {
+        se3: Cache<6>,
+        se2: Cache<3>,
+    }
+
+    /// The loop of [`optimize`] with the cache slot of the pose type.
+    pub trait Sealed: slam_core::GraphPose {
+        /// Run the loop (see [`optimize`]) with this pose type's slot of `caches`.
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError>;
+    }
+
+    impl Sealed for Pose3 {
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError> {
+            optimize(graph, &mut caches.se3, config, levenberg, initial_lambda)
+        }
+    }
+
+    impl Sealed for Pose2 {
+        fn optimize_cached(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &SolverConfig,
+            levenberg: bool,
+            initial_lambda: f64,
+        ) -> Result<OptimizationReport, OptimizeError> {
+            optimize(graph, &mut caches.se2, config, levenberg, initial_lambda)
+        }
+    }
+}
+
 // One loop with the damping state machine in plain sight; splitting it would hide the control flow.
 #[allow(clippy::too_many_lines)]
 /// Run the loop. `levenberg` chooses LM (adaptive damping, rejected steps) or GN (no damping
@@ -67,11 +127,9 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let model = config.error_model;
     let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
     let initial_cost = cost_with(graph, &poses, model);
-    if !cache.as_ref().is_some_and(|c| c.fits(graph)) {
-        *cache = Some(NormalEquations::new(graph)?);
-    }
-    let Some(ne) = cache.as_mut() else {
-        return Err(OptimizeError::Factorization("no normal equations".into()));
+    let ne = match cache.take() {
+        Some(ne) if ne.fits(graph) => cache.insert(ne),
+        _ => cache.insert(NormalEquations::new(graph)?),
     };
     if ne.dimension() == 0 || graph.edge_count() == 0 {
         return Ok(OptimizationReport {
@@ -131,7 +189,10 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             }
         }
         if !step_max.is_finite() {
-            return Err(OptimizeError::Factorization("non-finite step".into()));
+            return Err(OptimizeError::Factorization {
+                stage: "step solve",
+                cause: FactorizationFailure::NonFiniteSolution,
+            });
         }
         let new_cost = cost_with(graph, &trial, model);
         // NaN costs count as worse.

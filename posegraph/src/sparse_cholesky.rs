@@ -11,9 +11,9 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::{SupernodalThreshold, amd};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
-use slam_core::OptimizeError;
+use slam_core::{FactorizationFailure, OptimizeError};
 
 /// A reusable sparse `L L^T` of matrices with one upper-triangular pattern.
 pub(crate) struct SparseCholesky {
@@ -22,8 +22,22 @@ pub(crate) struct SparseCholesky {
     scratch: MemBuffer,
 }
 
-fn factorization_error(what: &str, e: impl std::fmt::Debug) -> OptimizeError {
-    OptimizeError::Factorization(format!("{what}: {e:?}"))
+/// faer's error in `stage` as ours (its variants carry nothing more than their name).
+fn sparse_error(stage: &'static str, e: FaerError) -> OptimizeError {
+    let cause = match e {
+        FaerError::OutOfMemory => FactorizationFailure::OutOfMemory,
+        FaerError::IndexOverflow => FactorizationFailure::IndexOverflow,
+        _ => FactorizationFailure::Unrecognised,
+    };
+    OptimizeError::Factorization { stage, cause }
+}
+
+/// A failed scratch allocation in `stage`.
+fn allocation_error(stage: &'static str) -> OptimizeError {
+    OptimizeError::Factorization {
+        stage,
+        cause: FactorizationFailure::OutOfMemory,
+    }
 }
 
 impl SparseCholesky {
@@ -38,7 +52,7 @@ impl SparseCholesky {
         let nb = blocks.nrows();
         let (mut fwd_b, mut inv_b) = (vec![0usize; nb], vec![0usize; nb]);
         let mut amd_mem = MemBuffer::try_new(amd::order_scratch::<usize>(nb, blocks.compute_nnz()))
-            .map_err(|e| factorization_error("ordering scratch", e))?;
+            .map_err(|_| allocation_error("ordering scratch"))?;
         amd::order(
             &mut fwd_b,
             &mut inv_b,
@@ -46,7 +60,7 @@ impl SparseCholesky {
             amd::Control::default(),
             MemStack::new(&mut amd_mem),
         )
-        .map_err(|e| factorization_error("ordering", e))?;
+        .map_err(|e| sparse_error("ordering", e))?;
         let n = nb * D;
         let mut fwd = vec![0usize; n];
         for (new, &old) in fwd_b.iter().enumerate() {
@@ -71,12 +85,12 @@ impl SparseCholesky {
                 ..CholeskySymbolicParams::default()
             },
         )
-        .map_err(|e| factorization_error("symbolic Cholesky", e))?;
+        .map_err(|e| sparse_error("symbolic Cholesky", e))?;
         let scratch = MemBuffer::try_new(StackReq::or(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::default()),
             symbolic.solve_in_place_scratch::<f64>(max_rhs, Par::Seq),
         ))
-        .map_err(|e| factorization_error("Cholesky scratch", e))?;
+        .map_err(|_| allocation_error("Cholesky scratch"))?;
         Ok(Self {
             l_values: vec![0.0; symbolic.len_val()],
             symbolic,

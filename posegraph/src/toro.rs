@@ -6,7 +6,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector2};
 use slam_core::{Pose2, PoseGraph};
 
-use crate::error::GraphFileError;
+use crate::error::{GraphFileError, UnknownTag};
 
 fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
     GraphFileError::Line {
@@ -21,7 +21,7 @@ fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
 /// [`GraphFileError::Line`], [`GraphFileError::Graph`] or [`GraphFileError::UnknownTags`].
 pub fn parse_toro(text: &str) -> Result<PoseGraph<Pose2>, GraphFileError> {
     let mut g = PoseGraph::new();
-    let mut unknown: Vec<(usize, String)> = Vec::new();
+    let mut unknown: Vec<UnknownTag> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words: Vec<&str> = raw.split_whitespace().collect();
@@ -69,8 +69,11 @@ pub fn parse_toro(text: &str) -> Result<PoseGraph<Pose2>, GraphFileError> {
                     .map_err(graph_err)?;
             }
             other => {
-                if !unknown.iter().any(|(_, t)| t == other) {
-                    unknown.push((line, other.to_string()));
+                if !unknown.iter().any(|u| u.tag == other) {
+                    unknown.push(UnknownTag {
+                        line,
+                        tag: other.to_string(),
+                    });
                 }
             }
         }

@@ -124,7 +124,7 @@ fn larger_datasets() {
 
 #[test]
 fn malformed_files_and_bad_graphs_are_errors() {
-    use posegraph::GraphFileError;
+    use posegraph::{GraphFileError, UnknownTag};
     assert!(matches!(
         parse_g2o("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 0 1 0 0\n"),
         Err(GraphFileError::Graph { line: 2, .. })
@@ -138,7 +138,7 @@ fn malformed_files_and_bad_graphs_are_errors() {
         Err(GraphFileError::Line { line: 1, .. })
     ));
     assert!(
-        matches!(parse_g2o("VERTEX_SE2 0 0 0 0\nVERTEX_XY 1 0 0\nVERTEX_XY 2 0 0\n"), Err(GraphFileError::UnknownTags { tags }) if tags == vec![(2, "VERTEX_XY".to_string())])
+        matches!(parse_g2o("VERTEX_SE2 0 0 0 0\nVERTEX_XY 1 0 0\nVERTEX_XY 2 0 0\n"), Err(GraphFileError::UnknownTags { tags }) if tags == vec![UnknownTag { line: 2, tag: "VERTEX_XY".to_string() }])
     );
     assert!(matches!(
         parse_g2o("VERTEX_SE2 0 0 0 0\nVERTEX_SE3:QUAT 1 0 0 0 0 0 0 1\n"),

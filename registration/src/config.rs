@@ -74,36 +74,112 @@ impl IcpConfig {
     /// # Errors
     /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
     pub fn validate(&self) -> Result<(), RegistrationError> {
-        let bad = |what: &str| Err(RegistrationError::InvalidConfig(format!("ICP: {what}")));
-        let voxel_ok = |v: f32| v.is_finite() && v >= 0.0;
-        if !(voxel_ok(self.source_voxel) && voxel_ok(self.target_voxel)) {
-            return bad("voxel sizes must be finite and not negative");
+        let c = self;
+        for (setting, v) in [
+            ("IcpConfig::source_voxel", c.source_voxel),
+            ("IcpConfig::target_voxel", c.target_voxel),
+        ] {
+            check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
-        if !(self.max_correspondence_distance.is_finite() && self.max_correspondence_distance > 0.0)
-        {
-            return bad("max_correspondence_distance must be finite and positive");
+        let reach = c.max_correspondence_distance;
+        check(
+            reach.is_finite() && reach > 0.0,
+            "IcpConfig::max_correspondence_distance",
+            reach,
+            POSITIVE,
+        )?;
+        for (setting, v) in [
+            ("IcpConfig::translation_tolerance", c.translation_tolerance),
+            ("IcpConfig::rotation_tolerance", c.rotation_tolerance),
+        ] {
+            check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
-        let tolerance_ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !(tolerance_ok(self.translation_tolerance) && tolerance_ok(self.rotation_tolerance)) {
-            return bad("tolerances must be finite and not negative");
+        if let IcpKernel::Huber { k } | IcpKernel::Tukey { k } = c.kernel {
+            check(
+                k.is_finite() && k > 0.0,
+                "IcpConfig::kernel",
+                k,
+                "a finite and positive threshold",
+            )?;
         }
-        if let IcpKernel::Huber { k } | IcpKernel::Tukey { k } = self.kernel
-            && !(k.is_finite() && k > 0.0)
-        {
-            return bad("kernel threshold must be finite and positive");
+        for (setting, v, least, expected) in [
+            (
+                "IcpConfig::max_iterations",
+                c.max_iterations,
+                1,
+                "at least 1",
+            ),
+            (
+                "IcpConfig::min_correspondences",
+                c.min_correspondences,
+                1,
+                "at least 1",
+            ),
+            (
+                "IcpConfig::normal_neighbours",
+                c.normal_neighbours,
+                3,
+                "at least 3",
+            ),
+            (
+                "IcpConfig::pair_target_points",
+                c.pair_target_points,
+                1,
+                "1 to 16",
+            ),
+            (
+                "IcpConfig::coarse_stride",
+                c.coarse_stride,
+                1,
+                "at least 1 (1 skips the coarse stage)",
+            ),
+        ] {
+            check(v >= least, setting, v as f64, expected)?;
         }
-        if self.max_iterations == 0 || self.min_correspondences == 0 {
-            return bad("max_iterations and min_correspondences must be at least 1");
-        }
-        if self.normal_neighbours < 3 {
-            return bad("normal_neighbours must be at least 3");
-        }
-        if !(1..=16).contains(&self.pair_target_points) {
-            return bad("pair_target_points must be 1 to 16");
-        }
-        if self.coarse_stride == 0 {
-            return bad("coarse_stride must be at least 1 (1 skips the coarse stage)");
-        }
-        Ok(())
+        check(
+            c.pair_target_points <= 16,
+            "IcpConfig::pair_target_points",
+            c.pair_target_points as f64,
+            "1 to 16",
+        )
     }
+}
+
+/// "Finite and not negative", the range of voxel sizes and tolerances.
+pub(crate) const NON_NEGATIVE: &str = "finite and not negative";
+/// "Finite and positive", the range of distances and thresholds.
+pub(crate) const POSITIVE: &str = "finite and positive";
+
+/// [`RegistrationError::InvalidConfig`] for `setting` unless `ok`.
+pub(crate) fn check(
+    ok: bool,
+    setting: &'static str,
+    value: f64,
+    expected: &'static str,
+) -> Result<(), RegistrationError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(RegistrationError::InvalidConfig {
+            setting,
+            value,
+            expected,
+        })
+    }
+}
+
+/// [`check`] for an `f32` setting, whose value the error gives as written (`-0.1`, not the
+/// `-0.10000000149011612` of its exact `f64` conversion).
+pub(crate) fn check_f32(
+    ok: bool,
+    setting: &'static str,
+    value: f32,
+    expected: &'static str,
+) -> Result<(), RegistrationError> {
+    if ok {
+        return Ok(());
+    }
+    // The shortest decimal that reads back as the f32 ("NaN" and "inf" included).
+    let value = value.to_string().parse().unwrap_or(f64::from(value));
+    check(false, setting, value, expected)
 }

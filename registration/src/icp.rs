@@ -2,7 +2,9 @@
 //! from the backend, convergence tests, and the final report.
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
-use slam_core::{Alignment, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat};
+use slam_core::{
+    Alignment, Degeneracy, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat,
+};
 
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{NeighbourCache, Neighbours};
@@ -20,8 +22,11 @@ pub(crate) struct Pair {
 pub(crate) trait IcpStep {
     /// The residual of a pair (metres).
     fn residual(pair: &Pair) -> f64;
-    /// The update `delta` with `pose <- exp(delta) pose`, or `None` when the system is singular.
-    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>>;
+    /// The update `delta` with `pose <- exp(delta) pose`.
+    ///
+    /// # Errors
+    /// When the pairs do not determine an update (a singular system, too few weighted pairs).
+    fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError>;
     /// `J^T W J` of the pairs (left perturbation, `[rho; phi]`).
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64>;
 }
@@ -110,13 +115,11 @@ fn update<S: IcpStep>(
 ) -> Result<(f64, f64), RegistrationError> {
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
-    let Some(delta) = S::step(pairs, weights) else {
-        return Err(RegistrationError::Degenerate(
-            "singular normal equations".into(),
-        ));
-    };
+    let delta = S::step(pairs, weights)?;
     if !delta.iter().all(|v| v.is_finite()) {
-        return Err(RegistrationError::Degenerate("non-finite update".into()));
+        return Err(RegistrationError::Degenerate {
+            cause: Degeneracy::NonFiniteUpdate,
+        });
     }
     *pose = se3_exp(&delta) * *pose;
     Ok((

@@ -1,6 +1,9 @@
 //! The ring layout of a spinning LiDAR, for clouds that carry no ring field.
 
 use nalgebra::Point3;
+use slam_core::RegistrationError;
+
+use crate::config::check;
 
 /// Rings evenly spread between two elevations: enough to recover a point's ring (laser) from its
 /// vertical angle when the cloud has no ring field.
@@ -37,10 +40,34 @@ impl LidarLayout {
     /// Whether the layout can assign rings (at least one ring, finite increasing elevations).
     #[must_use]
     pub fn is_valid(&self) -> bool {
-        self.rings > 0
-            && self.lowest_elevation_deg.is_finite()
-            && self.highest_elevation_deg.is_finite()
-            && (self.rings == 1 || self.highest_elevation_deg > self.lowest_elevation_deg)
+        self.validate().is_ok()
+    }
+
+    /// Checks that the layout can assign rings: at least one ring, finite elevations, the
+    /// highest above the lowest when there are several rings.
+    ///
+    /// # Errors
+    /// [`RegistrationError::InvalidConfig`] naming the first bad field.
+    pub fn validate(&self) -> Result<(), RegistrationError> {
+        check(
+            self.rings > 0,
+            "LidarLayout::rings",
+            self.rings.into(),
+            "at least 1",
+        )?;
+        check(
+            self.lowest_elevation_deg.is_finite(),
+            "LidarLayout::lowest_elevation_deg",
+            self.lowest_elevation_deg,
+            "finite",
+        )?;
+        check(
+            self.highest_elevation_deg.is_finite()
+                && (self.rings == 1 || self.highest_elevation_deg > self.lowest_elevation_deg),
+            "LidarLayout::highest_elevation_deg",
+            self.highest_elevation_deg,
+            "finite, and above lowest_elevation_deg when there are several rings",
+        )
     }
 
     /// The ring of a point in the sensor frame: the nearest ring by elevation, or `None` for a

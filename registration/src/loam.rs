@@ -4,10 +4,11 @@
 
 use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, pose3_is_finite,
-    se3_exp,
+    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator,
+    pose3_is_finite, se3_exp,
 };
 
+use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
 use crate::icp::min_eigenvalue_ratio;
 use crate::kernel::IcpKernel;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
@@ -317,27 +318,48 @@ fn normal_equations(
 
 impl LoamConfig {
     fn validate(&self) -> Result<(), RegistrationError> {
-        let positive = [
-            self.max_neighbour_distance,
-            self.line_eigenvalue_ratio,
-            self.plane_fit_tolerance,
-            self.tukey_threshold,
-            self.initial_tukey_threshold,
-            self.search_cell,
-        ];
-        if !(self.rematch_motion.is_finite() && self.rematch_motion >= 0.0) {
-            return Err(RegistrationError::InvalidConfig(
-                "LOAM rematch_motion must be finite and non-negative".into(),
-            ));
+        check(
+            self.rematch_motion.is_finite() && self.rematch_motion >= 0.0,
+            "LoamConfig::rematch_motion",
+            self.rematch_motion,
+            NON_NEGATIVE,
+        )?;
+        for (setting, v) in [
+            (
+                "LoamConfig::max_neighbour_distance",
+                self.max_neighbour_distance,
+            ),
+            (
+                "LoamConfig::line_eigenvalue_ratio",
+                self.line_eigenvalue_ratio,
+            ),
+            ("LoamConfig::plane_fit_tolerance", self.plane_fit_tolerance),
+            ("LoamConfig::tukey_threshold", self.tukey_threshold),
+            (
+                "LoamConfig::initial_tukey_threshold",
+                self.initial_tukey_threshold,
+            ),
+            ("LoamConfig::search_cell", self.search_cell),
+        ] {
+            check(v.is_finite() && v > 0.0, setting, v, POSITIVE)?;
         }
-        if positive.iter().any(|v| !(v.is_finite() && *v > 0.0))
-            || self.neighbours < 3
-            || !(self.local_map_edge_voxel >= 0.0 && self.local_map_plane_voxel >= 0.0)
-        {
-            return Err(RegistrationError::InvalidConfig(
-                "LOAM distances, ratios and thresholds must be positive, neighbours at least 3"
-                    .into(),
-            ));
+        check(
+            self.neighbours >= 3,
+            "LoamConfig::neighbours",
+            self.neighbours as f64,
+            "at least 3",
+        )?;
+        for (setting, v) in [
+            (
+                "LoamConfig::local_map_edge_voxel",
+                self.local_map_edge_voxel,
+            ),
+            (
+                "LoamConfig::local_map_plane_voxel",
+                self.local_map_plane_voxel,
+            ),
+        ] {
+            check_f32(v >= 0.0, setting, v, "not negative")?;
         }
         Ok(())
     }
@@ -441,12 +463,14 @@ impl Registrator for LoamRegistrator {
                 return Err(too_few(used));
             }
             let Some(delta) = h.cholesky().map(|c| -c.solve(&b)) else {
-                return Err(RegistrationError::Degenerate(
-                    "singular normal equations".into(),
-                ));
+                return Err(RegistrationError::Degenerate {
+                    cause: Degeneracy::SingularNormalEquations,
+                });
             };
             if !delta.iter().all(|v| v.is_finite()) {
-                return Err(RegistrationError::Degenerate("non-finite update".into()));
+                return Err(RegistrationError::Degenerate {
+                    cause: Degeneracy::NonFiniteUpdate,
+                });
             }
             pose = se3_exp(&delta) * pose;
             let (dt, dr) = (

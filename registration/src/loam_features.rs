@@ -4,6 +4,7 @@
 use nalgebra::{Point3, Vector3};
 use slam_core::{PointCloud, RegistrationError};
 
+use crate::config::{NON_NEGATIVE, check, check_f32};
 use crate::lidar_layout::LidarLayout;
 
 /// Settings of [`LoamFeatures::extract`]. Lengths in metres.
@@ -73,31 +74,47 @@ impl Default for LoamFeatureConfig {
 
 impl LoamFeatureConfig {
     fn validate(&self) -> Result<(), RegistrationError> {
-        let bad = |what: &str| Err(RegistrationError::InvalidConfig(what.to_owned()));
-        if !self.layout.is_valid() {
-            return bad("LiDAR layout needs rings and increasing finite elevations");
+        self.layout.validate()?;
+        for (setting, v) in [
+            ("LoamFeatureConfig::neighbours", self.neighbours),
+            ("LoamFeatureConfig::sectors", self.sectors),
+        ] {
+            check(v >= 1, setting, v as f64, "at least 1")?;
         }
-        if self.neighbours == 0 || self.sectors == 0 {
-            return bad("LOAM neighbours and sectors must be at least 1");
+        for (setting, v) in [
+            (
+                "LoamFeatureConfig::edge_min_roughness",
+                self.edge_min_roughness,
+            ),
+            (
+                "LoamFeatureConfig::edge_min_sharpness",
+                self.edge_min_sharpness,
+            ),
+            (
+                "LoamFeatureConfig::plane_max_roughness",
+                self.plane_max_roughness,
+            ),
+            ("LoamFeatureConfig::break_distance", self.break_distance),
+            (
+                "LoamFeatureConfig::parallel_gap_ratio",
+                self.parallel_gap_ratio,
+            ),
+        ] {
+            check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
-        let finite_non_negative = [
-            self.edge_min_roughness,
-            self.edge_min_sharpness,
-            self.plane_max_roughness,
-            self.break_distance,
-            self.parallel_gap_ratio,
-            f64::from(self.min_range),
-            f64::from(self.map_edge_voxel),
-            f64::from(self.map_plane_voxel),
-        ];
-        if finite_non_negative
-            .iter()
-            .any(|v| !(v.is_finite() && *v >= 0.0))
-            || self.max_range.partial_cmp(&self.min_range) != Some(std::cmp::Ordering::Greater)
-        {
-            return bad("LOAM thresholds must be finite and non-negative, max_range > min_range");
+        for (setting, v) in [
+            ("LoamFeatureConfig::min_range", self.min_range),
+            ("LoamFeatureConfig::map_edge_voxel", self.map_edge_voxel),
+            ("LoamFeatureConfig::map_plane_voxel", self.map_plane_voxel),
+        ] {
+            check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
-        Ok(())
+        check_f32(
+            self.max_range.partial_cmp(&self.min_range) == Some(std::cmp::Ordering::Greater),
+            "LoamFeatureConfig::max_range",
+            self.max_range,
+            "greater than min_range",
+        )
     }
 }
 

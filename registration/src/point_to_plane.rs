@@ -1,7 +1,9 @@
 //! Point-to-plane ICP: Gauss-Newton on SE(3) with target normals from PCA.
 
 use nalgebra::{Matrix6, Point3, Vector6};
-use slam_core::{Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator};
+use slam_core::{
+    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator,
+};
 
 use crate::config::IcpConfig;
 use crate::icp::{IcpStep, Pair, align};
@@ -29,7 +31,7 @@ impl IcpStep for GaussNewtonPlane {
         pair.n.map_or(f64::INFINITY, |n| n.dot(&(pair.p - pair.q)))
     }
 
-    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>> {
+    fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError> {
         let mut h = Matrix6::zeros();
         let mut b = Vector6::zeros();
         for (p, w) in pairs.iter().zip(weights) {
@@ -40,7 +42,11 @@ impl IcpStep for GaussNewtonPlane {
             h += j * j.transpose() * *w;
             b += j * (Self::residual(p) * w);
         }
-        h.cholesky().map(|c| -c.solve(&b))
+        h.cholesky()
+            .map(|c| -c.solve(&b))
+            .ok_or(RegistrationError::Degenerate {
+                cause: Degeneracy::SingularNormalEquations,
+            })
     }
 
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {

@@ -1,8 +1,10 @@
-//! Point-to-point ICP with a closed-form weighted SVD (Arun/Umeyama) step.
+//! Point-to-point ICP with a closed-form weighted SVD (Arun/Umeyama) step
+//! ([`slam_core::fit_weighted_rigid_transform`]).
 
-use nalgebra::{Matrix3, Matrix6, Point3, Rotation3, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{Matrix6, Point3, Vector6};
 use slam_core::{
-    Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, se3_log,
+    Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, WeightedPair,
+    fit_weighted_rigid_transform, se3_log,
 };
 
 use crate::config::IcpConfig;
@@ -24,35 +26,15 @@ impl IcpStep for Svd {
         (pair.p - pair.q).norm()
     }
 
-    fn step(pairs: &[Pair], weights: &[f64]) -> Option<Vector6<f64>> {
-        let wsum: f64 = weights.iter().sum();
-        if wsum <= 0.0 {
-            return None;
-        }
-        let ca = pairs
-            .iter()
-            .zip(weights)
-            .fold(Vector3::zeros(), |a, (p, w)| a + p.p.coords * *w)
-            / wsum;
-        let cb = pairs
-            .iter()
-            .zip(weights)
-            .fold(Vector3::zeros(), |a, (p, w)| a + p.q.coords * *w)
-            / wsum;
-        let h = pairs
-            .iter()
-            .zip(weights)
-            .fold(Matrix3::zeros(), |m, (p, w)| {
-                m + (p.p.coords - ca) * (p.q.coords - cb).transpose() * *w
-            });
-        let svd = h.svd(true, true);
-        let (u, vt) = (svd.u?, svd.v_t?);
-        let mut d = Matrix3::identity();
-        d[(2, 2)] = (vt.transpose() * u.transpose()).determinant().signum();
-        let r = vt.transpose() * d * u.transpose();
-        let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
-        let step = Pose3::from_parts((cb - rot * ca).into(), rot);
-        Some(se3_log(&step))
+    fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError> {
+        let step = fit_weighted_rigid_transform(pairs.iter().zip(weights).map(|(p, &weight)| {
+            WeightedPair {
+                from: p.p,
+                to: p.q,
+                weight,
+            }
+        }))?;
+        Ok(se3_log(&step))
     }
 
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {

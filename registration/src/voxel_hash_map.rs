@@ -8,6 +8,7 @@ use rustc_hash::FxHashMap;
 use slam_core::RegistrationError;
 use std::collections::hash_map::Entry as MapEntry;
 
+use crate::config::{NON_NEGATIVE, POSITIVE, check};
 use crate::neighbour_cache::{Candidate, NearestSearch};
 
 /// One stored point: f32 coordinates (half the memory traffic of f64; a local map spans far less
@@ -144,11 +145,18 @@ impl VoxelHashMap {
     /// [`RegistrationError::InvalidConfig`] when `cell` is not positive and finite, `thin` is
     /// negative or not finite.
     pub fn new(cell: f64, thin: f64) -> Result<Self, RegistrationError> {
-        if !(cell.is_finite() && cell > 0.0 && thin.is_finite() && thin >= 0.0) {
-            return Err(RegistrationError::InvalidConfig(format!(
-                "voxel hash map: cell {cell} must be positive and thin {thin} non-negative"
-            )));
-        }
+        check(
+            cell.is_finite() && cell > 0.0,
+            "VoxelHashMap::new cell",
+            cell,
+            POSITIVE,
+        )?;
+        check(
+            thin.is_finite() && thin >= 0.0,
+            "VoxelHashMap::new thin",
+            thin,
+            NON_NEGATIVE,
+        )?;
         let cell = if thin > 0.0 {
             thin * (cell / thin).round().max(1.0)
         } else {

@@ -134,7 +134,10 @@ fn degenerate_input_is_an_error_or_flagged() {
     bad.config.tukey_threshold = -1.0;
     assert!(matches!(
         bad.prepare_target(&target_scan()),
-        Err(RegistrationError::InvalidConfig(_))
+        Err(RegistrationError::InvalidConfig {
+            setting: "LoamConfig::tukey_threshold",
+            ..
+        })
     ));
     let source = loam.prepare_source(&target_scan()).unwrap();
     let target = loam.prepare_target(&target_scan()).unwrap();

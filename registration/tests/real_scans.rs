@@ -170,6 +170,56 @@ fn same_pose(what: &str, a: &Pose3, b: &Pose3) {
     assert!(rot < 0.01 && trans < 0.001, "{what}: {rot} deg, {trans} m");
 }
 
+/// Settings that must be refused, each with the setting the error names.
+fn bad_settings(good: IcpConfig) -> Vec<(&'static str, IcpConfig)> {
+    let with = |change: fn(&mut IcpConfig)| {
+        let mut c = good;
+        change(&mut c);
+        c
+    };
+    vec![
+        ("IcpConfig::source_voxel", with(|c| c.source_voxel = -0.1)),
+        (
+            "IcpConfig::target_voxel",
+            with(|c| c.target_voxel = f32::NAN),
+        ),
+        (
+            "IcpConfig::max_correspondence_distance",
+            with(|c| c.max_correspondence_distance = 0.0),
+        ),
+        (
+            "IcpConfig::max_correspondence_distance",
+            with(|c| c.max_correspondence_distance = f64::INFINITY),
+        ),
+        (
+            "IcpConfig::translation_tolerance",
+            with(|c| c.translation_tolerance = -1.0),
+        ),
+        (
+            "IcpConfig::kernel",
+            with(|c| c.kernel = IcpKernel::Tukey { k: 0.0 }),
+        ),
+        (
+            "IcpConfig::kernel",
+            with(|c| c.kernel = IcpKernel::Huber { k: f64::NAN }),
+        ),
+        ("IcpConfig::max_iterations", with(|c| c.max_iterations = 0)),
+        (
+            "IcpConfig::normal_neighbours",
+            with(|c| c.normal_neighbours = 2),
+        ),
+        (
+            "IcpConfig::pair_target_points",
+            with(|c| c.pair_target_points = 0),
+        ),
+        (
+            "IcpConfig::pair_target_points",
+            with(|c| c.pair_target_points = 17),
+        ),
+        ("IcpConfig::coarse_stride", with(|c| c.coarse_stride = 0)),
+    ]
+}
+
 /// Every bad setting is refused by preparation and by alignment, never silently changed.
 #[test]
 fn invalid_settings_are_errors() {
@@ -180,59 +230,11 @@ fn invalid_settings_are_errors() {
         p2p.prepare_source(&cloud).unwrap(),
         p2p.prepare_target(&cloud).unwrap(),
     );
-    let bad = [
-        IcpConfig {
-            source_voxel: -0.1,
-            ..good
-        },
-        IcpConfig {
-            target_voxel: f32::NAN,
-            ..good
-        },
-        IcpConfig {
-            max_correspondence_distance: 0.0,
-            ..good
-        },
-        IcpConfig {
-            max_correspondence_distance: f64::INFINITY,
-            ..good
-        },
-        IcpConfig {
-            translation_tolerance: -1.0,
-            ..good
-        },
-        IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.0 },
-            ..good
-        },
-        IcpConfig {
-            kernel: IcpKernel::Huber { k: f64::NAN },
-            ..good
-        },
-        IcpConfig {
-            max_iterations: 0,
-            ..good
-        },
-        IcpConfig {
-            normal_neighbours: 2,
-            ..good
-        },
-        IcpConfig {
-            pair_target_points: 0,
-            ..good
-        },
-        IcpConfig {
-            pair_target_points: 17,
-            ..good
-        },
-        IcpConfig {
-            coarse_stride: 0,
-            ..good
-        },
-    ];
-    let invalid =
-        |r: Result<_, RegistrationError>| matches!(r, Err(RegistrationError::InvalidConfig(_)));
-    for config in bad {
+    for (setting, config) in bad_settings(good) {
+        let invalid = |r: Result<(), RegistrationError>| match r {
+            Err(RegistrationError::InvalidConfig { setting: s, .. }) => s == setting,
+            _ => false,
+        };
         let (plane, point) = (PointToPlaneIcp { config }, PointToPointIcp { config });
         assert!(
             invalid(plane.prepare_source(&cloud).map(|_| ())),
@@ -255,6 +257,15 @@ fn invalid_settings_are_errors() {
             "{config:?}"
         );
     }
+    // The message names the setting, its value as written and the valid range.
+    let config = IcpConfig {
+        source_voxel: -0.1,
+        ..good
+    };
+    assert_eq!(
+        config.validate().unwrap_err().to_string(),
+        "IcpConfig::source_voxel = -0.1: must be finite and not negative"
+    );
 }
 
 #[test]
@@ -277,7 +288,7 @@ fn degenerate_input_is_an_error_or_flagged() {
                 a.min_eigenvalue_ratio
             );
         }
-        Err(e) => assert!(matches!(e, RegistrationError::Degenerate(_))),
+        Err(e) => assert!(matches!(e, RegistrationError::Degenerate { .. })),
     }
     let bad = Pose3::translation(f64::NAN, 0.0, 0.0);
     assert!(matches!(

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use thiserror::Error;
 
+use crate::robust_kernel::RobustKernel;
+
 /// Errors building or addressing a [`BitGrid`](crate::BitGrid).
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 #[non_exhaustive]
@@ -88,9 +90,36 @@ pub enum FormatError {
         /// What is wrong.
         message: String,
     },
-    /// The file is valid but uses a feature this reader does not implement.
-    #[error("unsupported: {0}")]
-    Unsupported(String),
+    /// The file name's extension is not one of a cloud format this crate reads.
+    #[error("{path}: cloud extension {extension:?} is not pcd, ply or bin")]
+    UnknownExtension {
+        /// The file.
+        path: PathBuf,
+        /// Its extension (lower case, empty when it has none).
+        extension: String,
+    },
+    /// A field every cloud needs (x, y or z) is missing: a PCD field or a PLY vertex property.
+    #[error("no {field} field")]
+    MissingField {
+        /// `"x"`, `"y"` or `"z"`.
+        field: &'static str,
+    },
+    /// A PLY file without a vertex element.
+    #[error("no vertex element")]
+    NoVertexElement,
+    /// The ring channel is stored as a floating-point type, which this reader does not accept.
+    #[error("ring field {field} is not of an integer type")]
+    NonIntegerRing {
+        /// The field's name in the file.
+        field: String,
+    },
+    /// The fields of one point record add up to more bytes than memory can address.
+    #[error("the point record size overflows")]
+    RecordTooLarge,
+    /// The decoded channels do not make a cloud (a reader fault: one value per point and
+    /// channel is pushed).
+    #[error(transparent)]
+    Cloud(#[from] CloudError),
 }
 
 /// Errors of a [`Registrator`](crate::Registrator).
@@ -110,6 +139,16 @@ pub enum RegistrationError {
     /// The initial guess is not a finite rigid transform.
     #[error("initial pose is not finite")]
     NonFiniteInitialGuess,
+    /// More points than the spatial index can number.
+    #[error("{what} has {points} points, at most {max} can be indexed")]
+    TooManyPoints {
+        /// "source" or "target".
+        what: &'static str,
+        /// Points given.
+        points: usize,
+        /// The index's limit.
+        max: usize,
+    },
     /// Fewer correspondences than needed survived outlier rejection.
     #[error("only {found} correspondences, at least {required} are needed")]
     TooFewCorrespondences {
@@ -118,12 +157,82 @@ pub enum RegistrationError {
         /// Correspondences needed.
         required: usize,
     },
-    /// The linear system was singular or produced a non-finite step.
-    #[error("degenerate problem: {0}")]
-    Degenerate(String),
-    /// A configuration value is out of its valid range.
-    #[error("invalid configuration: {0}")]
-    InvalidConfig(String),
+    /// The problem does not determine a pose.
+    #[error("degenerate problem: {cause}")]
+    Degenerate {
+        /// What made it degenerate.
+        cause: Degeneracy,
+    },
+    /// The closed-form rigid fit of the correspondences failed (point-to-point ICP).
+    #[error(transparent)]
+    RigidFit(#[from] RigidFitError),
+    /// A setting is out of its valid range.
+    #[error("{setting} = {value}: must be {expected}")]
+    InvalidConfig {
+        /// The setting, as `Type::field` (`Type::function argument` for a constructor's
+        /// argument).
+        setting: &'static str,
+        /// Its value (integers converted).
+        value: f64,
+        /// The valid range, in words.
+        expected: &'static str,
+    },
+}
+
+/// What made a registration problem [`RegistrationError::Degenerate`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum Degeneracy {
+    /// The normal equations are singular: the correspondences do not fix all six degrees of
+    /// freedom.
+    #[error("singular normal equations")]
+    SingularNormalEquations,
+    /// The solved update is not finite.
+    #[error("non-finite update")]
+    NonFiniteUpdate,
+    /// More points than a k-d tree bucket share one coordinate, so the bucket cannot be split.
+    #[error("too many points share one coordinate on axis {axis} to split them")]
+    CoincidentPoints {
+        /// The axis (0 = x, 1 = y, 2 = z).
+        axis: usize,
+    },
+}
+
+/// Errors of [`fit_rigid_transform`](crate::geometry::fit_rigid_transform) and
+/// [`fit_weighted_rigid_transform`](crate::geometry::fit_weighted_rigid_transform).
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[non_exhaustive]
+pub enum RigidFitError {
+    /// The two point sets differ in length.
+    #[error("rigid fit: {from} points to move but {to} to land on")]
+    LengthMismatch {
+        /// Points to move.
+        from: usize,
+        /// Points to land on.
+        to: usize,
+    },
+    /// Fewer pairs than a rotation needs.
+    #[error("rigid fit: {pairs} pairs of positive weight, at least {required} are needed")]
+    TooFewPairs {
+        /// Pairs of positive weight given.
+        pairs: usize,
+        /// Pairs needed (3).
+        required: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("rigid fit: pair {index} has a non-finite coordinate")]
+    NonFinitePoint {
+        /// Index of the pair.
+        index: usize,
+    },
+    /// A weight is negative, NaN or infinite.
+    #[error("rigid fit: weight {index} is {weight}: must be finite and not negative")]
+    InvalidWeight {
+        /// Index of the pair.
+        index: usize,
+        /// The weight.
+        weight: f64,
+    },
 }
 
 /// Errors of an [`Optimizer`](crate::Optimizer) or of building a [`PoseGraph`](crate::PoseGraph).
@@ -148,9 +257,20 @@ pub enum OptimizeError {
         /// The node.
         id: u64,
     },
-    /// A pose, measurement or information value is not finite.
-    #[error("non-finite value in {0}")]
-    NonFinite(String),
+    /// A pose or a measurement is not finite.
+    #[error("non-finite {what}")]
+    NonFinite {
+        /// Which one.
+        what: GraphValue,
+    },
+    /// A robust kernel's parameter is not finite and positive.
+    #[error("robust kernel {kernel:?} of edge {edge}: its parameter must be finite and positive")]
+    InvalidRobustKernel {
+        /// Index the edge would have had.
+        edge: usize,
+        /// The kernel.
+        kernel: RobustKernel,
+    },
     /// An information matrix is not symmetric positive definite.
     #[error("information matrix of edge {edge} is not symmetric positive definite")]
     InformationNotPositiveDefinite {
@@ -171,18 +291,75 @@ pub enum OptimizeError {
     /// The graph has no nodes.
     #[error("the graph has no nodes")]
     EmptyGraph,
-    /// The sparse factorisation failed beyond recovery.
-    #[error("factorisation failed: {0}")]
-    Factorization(String),
+    /// A factorisation or linear solve failed beyond recovery.
+    #[error("factorisation failed in {stage}: {cause}")]
+    Factorization {
+        /// The step that failed (`"symbolic Cholesky"`, `"chordal relaxation"`, ...).
+        stage: &'static str,
+        /// Why.
+        cause: FactorizationFailure,
+    },
 }
 
-/// Errors of a [`Planner`](crate::Planner). [`PlanError::NoPath`] is an answer, not a failure.
+/// Which value of a [`PoseGraph`](crate::PoseGraph) an [`OptimizeError::NonFinite`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum GraphValue {
+    /// The pose of a node.
+    NodePose {
+        /// The node's id.
+        id: u64,
+    },
+    /// The measurement of an edge.
+    Measurement {
+        /// Index the edge would have had.
+        edge: usize,
+        /// Id of the node it starts at.
+        from: u64,
+        /// Id of the node it ends at.
+        to: u64,
+    },
+}
+
+impl std::fmt::Display for GraphValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NodePose { id } => write!(f, "pose of node {id}"),
+            Self::Measurement { edge, from, to } => {
+                write!(f, "measurement of edge {edge} ({from} to {to})")
+            }
+        }
+    }
+}
+
+/// Why a factorisation or solve in [`OptimizeError::Factorization`] failed. The sparse solver's
+/// own errors (faer's out-of-memory and index-overflow, which carry nothing more) map onto
+/// these one to one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum FactorizationFailure {
+    /// The matrix is not positive definite to working precision.
+    #[error("the matrix is not positive definite")]
+    NotPositiveDefinite,
+    /// The solution has a NaN or infinite entry.
+    #[error("the solution is not finite")]
+    NonFiniteSolution,
+    /// Memory for the factor or its scratch could not be allocated.
+    #[error("out of memory")]
+    OutOfMemory,
+    /// The factor has more entries than its index type can address.
+    #[error("an index overflows its type")]
+    IndexOverflow,
+    /// An error of the sparse solver this version does not know.
+    #[error("unrecognised sparse solver error")]
+    Unrecognised,
+}
+
+/// Errors of a [`Planner`](crate::Planner): bad arguments only. An unreachable goal is not an
+/// error but the answer `Ok(None)` of [`Planner::plan`](crate::Planner::plan).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 #[non_exhaustive]
 pub enum PlanError {
-    /// The goal cannot be reached from the start.
-    #[error("no path from the start to the goal")]
-    NoPath,
     /// Start or goal is off the grid.
     #[error("{which} ({x}, {y}) is outside the {width}x{height} grid")]
     OutOfBounds {

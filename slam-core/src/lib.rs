@@ -1,7 +1,8 @@
 //! # slam-core
 //!
 //! The shared foundation of spot-nav: rigid-body geometry (SE(3)/SE(2) with their exponential
-//! maps and Jacobians), [`PointCloud`] with voxel downsampling, the bit-packed occupancy
+//! maps and Jacobians, and the closed-form rigid fit of paired points, [`fit_rigid_transform`]),
+//! [`PointCloud`] with voxel downsampling, the bit-packed occupancy
 //! [`BitGrid`] shared by the map builder and the planners, the [`PoseGraph`] data type, file
 //! formats ([`io`]: PCD, PLY, KITTI scans and poses, TUM trajectories), and the three traits that
 //! the backends implement: [`Registrator`], [`Optimizer`] and [`Planner`].
@@ -43,7 +44,10 @@ pub mod traits;
 mod voxel;
 
 pub use cloud::{Aabb, PointCloud};
-pub use error::{CloudError, FormatError, GridError, OptimizeError, PlanError, RegistrationError};
+pub use error::{
+    CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
+    OptimizeError, PlanError, RegistrationError, RigidFitError,
+};
 pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};
 pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};

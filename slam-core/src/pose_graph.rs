@@ -7,7 +7,7 @@ use std::fmt::Debug;
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::error::OptimizeError;
+use crate::error::{GraphValue, OptimizeError};
 use crate::geometry::{Pose2, Pose3, se2_log, se3_log};
 use crate::robust_kernel::RobustKernel;
 
@@ -158,7 +158,9 @@ impl<P: GraphPose> PoseGraph<P> {
             return Err(OptimizeError::DuplicateNode { id });
         }
         if !pose.is_finite() {
-            return Err(OptimizeError::NonFinite(format!("pose of node {id}")));
+            return Err(OptimizeError::NonFinite {
+                what: GraphValue::NodePose { id },
+            });
         }
         self.nodes.push(Node {
             id,
@@ -172,8 +174,9 @@ impl<P: GraphPose> PoseGraph<P> {
     /// Add an edge between the nodes with ids `from` and `to`; returns its index.
     ///
     /// # Errors
-    /// [`OptimizeError::UnknownNode`], [`OptimizeError::SelfLoop`], [`OptimizeError::NonFinite`]
-    /// or [`OptimizeError::InformationNotPositiveDefinite`].
+    /// [`OptimizeError::UnknownNode`], [`OptimizeError::SelfLoop`], [`OptimizeError::NonFinite`],
+    /// [`OptimizeError::InformationNotPositiveDefinite`] or
+    /// [`OptimizeError::InvalidRobustKernel`].
     pub fn add_edge(
         &mut self,
         from: u64,
@@ -192,21 +195,26 @@ impl<P: GraphPose> PoseGraph<P> {
             return Err(OptimizeError::SelfLoop { id: from });
         }
         if !measurement.is_finite() {
-            return Err(OptimizeError::NonFinite(format!(
-                "measurement of edge {from}-{to}"
-            )));
+            return Err(OptimizeError::NonFinite {
+                what: GraphValue::Measurement {
+                    edge: self.edges.len(),
+                    from,
+                    to,
+                },
+            });
         }
         if !P::information_is_valid(&information) {
             return Err(OptimizeError::InformationNotPositiveDefinite {
                 edge: self.edges.len(),
             });
         }
-        if let Some(k) = kernel
-            && !k.is_valid()
+        if let Some(kernel) = kernel
+            && !kernel.is_valid()
         {
-            return Err(OptimizeError::NonFinite(format!(
-                "robust kernel of edge {from}-{to}"
-            )));
+            return Err(OptimizeError::InvalidRobustKernel {
+                edge: self.edges.len(),
+                kernel,
+            });
         }
         self.edges.push(Edge {
             from: a,
@@ -397,6 +405,33 @@ mod tests {
         ));
         bad[(0, 0)] = f64::NAN;
         assert!(g.add_edge(1, 2, Pose3::identity(), bad, None).is_err());
+        assert_eq!(
+            g.add_node(3, Pose3::translation(f64::NAN, 0.0, 0.0)),
+            Err(OptimizeError::NonFinite {
+                what: GraphValue::NodePose { id: 3 }
+            })
+        );
+        assert_eq!(
+            g.add_edge(
+                1,
+                2,
+                Pose3::translation(0.0, f64::INFINITY, 0.0),
+                info,
+                None
+            ),
+            Err(OptimizeError::NonFinite {
+                what: GraphValue::Measurement {
+                    edge: 0,
+                    from: 1,
+                    to: 2
+                }
+            })
+        );
+        let kernel = RobustKernel::Huber { delta: 0.0 };
+        assert_eq!(
+            g.add_edge(1, 2, Pose3::identity(), info, Some(kernel)),
+            Err(OptimizeError::InvalidRobustKernel { edge: 0, kernel })
+        );
         assert!(matches!(g.check_gauge(), Err(OptimizeError::NoFixedNode)));
         g.fix(1).unwrap();
         assert!(matches!(

@@ -241,7 +241,13 @@ fn pcd_errors_name_the_place() {
     let no_z = "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2\n";
     assert!(matches!(
         parse_pcd(no_z.as_bytes()),
-        Err(FormatError::Unsupported(_))
+        Err(FormatError::MissingField { field: "z" })
+    ));
+    let float_ring =
+        "FIELDS x y z ring\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3 4\n";
+    assert!(matches!(
+        parse_pcd(float_ring.as_bytes()),
+        Err(FormatError::NonIntegerRing { field }) if field == "ring"
     ));
     // A binary header that claims far more points than the data holds.
     let mut huge =
@@ -330,7 +336,7 @@ element face 1\nproperty list uchar int vertex_indices\nend_header\n60\n1 9 2 3 
     ));
     assert!(matches!(
         parse_ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n"),
-        Err(FormatError::Unsupported(_))
+        Err(FormatError::MissingField { field: "y" })
     ));
 }
 

@@ -88,6 +88,9 @@ pub enum AdapterError {
     /// A box to add to a building is not a finite, non-empty box.
     #[error("a box needs finite corners with min below max on every axis")]
     InvalidBox,
+    /// Two trajectories cannot be aligned (a non-finite position).
+    #[error("the trajectories cannot be aligned")]
+    Alignment(#[source] slam_core::RigidFitError),
     /// Two trajectories to compare have too few poses in common.
     #[error("{found} associated poses, at least {required} are needed")]
     TooFewPoses {

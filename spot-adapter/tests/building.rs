@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
 
 use nalgebra::{Point3, Vector2, Vector3};
+use slam_core::io::StampedPose;
 use spot_adapter::sim::{
     BoxKind, Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox,
 };
@@ -146,7 +147,7 @@ fn occupancy_grid_agrees_with_obstacle_test() {
 fn routes_stay_clear_of_obstacles() {
     let b = building(4);
     let lap = Route::corridor_loop(&b);
-    for (_, pose) in lap.walk(0.6, 5.0, 0.5).unwrap() {
+    for StampedPose { pose, .. } in lap.walk(0.6, 5.0, 0.5).unwrap() {
         let p = pose.translation.vector.xy();
         assert!(b.clearance(p) > 0.4, "loop passes {p:?}");
     }

@@ -5,9 +5,9 @@
 #![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
 
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3, Vector6};
+use slam_core::fit_rigid_transform;
 use slam_core::io::StampedPose;
 use slam_core::{Pose3, se3_exp};
-use spot_adapter::eval::align_rigid;
 use spot_adapter::eval::{
     DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate, end_point_drift,
     loop_end_point_error, path_length, segment_drift,
@@ -57,6 +57,7 @@ fn rigidly_moved_trajectory_has_zero_ate() {
 }
 
 #[test]
+/// The fit ATE aligns with (slam-core's) is a least-squares minimum on noisy trajectories.
 fn alignment_is_a_least_squares_minimum() {
     let mut rng = SimRng::new(2, 2);
     let a: Vec<Point3<f64>> = (0..50)
@@ -73,7 +74,7 @@ fn alignment_is_a_least_squares_minimum() {
         .iter()
         .map(|p| t * p + Vector3::new(rng.normal(0.1), rng.normal(0.1), rng.normal(0.1)))
         .collect();
-    let best = align_rigid(&a, &b).unwrap();
+    let best = fit_rigid_transform(&a, &b).unwrap();
     let cost = |x: &Pose3| {
         a.iter()
             .zip(&b)
@@ -98,7 +99,7 @@ fn alignment_is_a_least_squares_minimum() {
     }
     // And a reflection would fit mirrored data; the guard must still return a rotation.
     let mirrored: Vec<Point3<f64>> = a.iter().map(|p| Point3::new(p.x, p.y, -p.z)).collect();
-    let r = align_rigid(&a, &mirrored).unwrap();
+    let r = fit_rigid_transform(&a, &mirrored).unwrap();
     assert!((r.rotation.to_rotation_matrix().matrix().determinant() - 1.0).abs() < 1e-9);
 }
 

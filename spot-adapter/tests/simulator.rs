@@ -219,7 +219,7 @@ fn odometry_drifts_about_1_9_percent() {
     let truth: Vec<Pose3> = walk
         .iter()
         .chain(walk.iter().skip(1))
-        .map(|w| w.1)
+        .map(|w| w.pose)
         .collect();
     let mut drifts = Vec::new();
     let mut vertical = Vec::new();
@@ -253,7 +253,7 @@ fn gait_sway_moves_the_body_within_its_amplitudes() {
     let mut sim = SimulatedSpot::new(b.clone(), &lap, &config).unwrap();
     let (mut max_dz, mut max_tilt) = (0.0f64, 0.0f64);
     for (g, l) in sim.ground_truth().iter().zip(&level) {
-        let d = l.1.inverse() * g.pose;
+        let d = l.pose.inverse() * g.pose;
         max_dz = max_dz.max(d.translation.z.abs());
         max_tilt = max_tilt.max(d.rotation.angle());
         assert!(d.translation.vector.xy().norm() < 1e-12);

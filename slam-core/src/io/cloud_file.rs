@@ -10,7 +10,7 @@ use super::{read_kitti_bin, read_pcd, read_ply};
 /// Read a cloud by its extension: `.pcd`, `.ply` or KITTI's `.bin` (case-insensitive).
 ///
 /// # Errors
-/// [`FormatError::Unsupported`] for another extension; otherwise the reader's errors.
+/// [`FormatError::UnknownExtension`] for another extension; otherwise the reader's errors.
 pub fn read_cloud(path: impl AsRef<Path>) -> Result<PointCloud, FormatError> {
     let path = path.as_ref();
     let ext = path
@@ -22,10 +22,10 @@ pub fn read_cloud(path: impl AsRef<Path>) -> Result<PointCloud, FormatError> {
         "pcd" => read_pcd(path),
         "ply" => read_ply(path),
         "bin" => read_kitti_bin(path),
-        other => Err(FormatError::Unsupported(format!(
-            "{}: cloud extension {other:?} (expected pcd, ply or bin)",
-            path.display()
-        ))),
+        other => Err(FormatError::UnknownExtension {
+            path: path.to_path_buf(),
+            extension: other.to_owned(),
+        }),
     }
 }
 
@@ -37,7 +37,7 @@ mod tests {
     fn unknown_extension_is_an_error() {
         assert!(matches!(
             read_cloud("scan.xyz"),
-            Err(FormatError::Unsupported(_))
+            Err(FormatError::UnknownExtension { extension, .. }) if extension == "xyz"
         ));
     }
 }

@@ -33,9 +33,7 @@ pub fn parse_kitti_bin(bytes: &[u8]) -> Result<PointCloud, FormatError> {
         points.push(Point3::new(f(&r[0..]), f(&r[4..]), f(&r[8..])));
         intensity.push(f(&r[12..]));
     }
-    PointCloud::from_points(points)
-        .with_intensity(intensity)
-        .map_err(|e| FormatError::Unsupported(e.to_string()))
+    Ok(PointCloud::from_points(points).with_intensity(intensity)?)
 }
 
 /// Read a KITTI velodyne `.bin` scan.

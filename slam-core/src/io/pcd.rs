@@ -210,44 +210,59 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
     Err(line_err(line_no, "no DATA line: the header is incomplete"))
 }
 
-/// Where each channel lives in a record: (channel, byte offset in record, scalar, index of the
-/// value among all values of a record for ascii).
+/// Where one channel lives in the data.
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    channel: Channel,
+    /// Byte offset in a binary record.
+    offset: usize,
+    /// How the value is stored.
+    scalar: Scalar,
+    /// Index of the value among all values of an ascii line.
+    value_index: usize,
+    /// Index of the field in `FIELDS` (a compressed file stores each field in its own block).
+    field_index: usize,
+}
+
+/// Where each channel lives in a record, and the record's size.
 struct Layout {
     record_size: usize,
-    slots: Vec<(Channel, usize, Scalar, usize, usize)>,
+    /// One slot per channel found (the first field of each channel).
+    slots: Vec<Slot>,
 }
 
 fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
     let mut offset = 0usize;
     let mut value_index = 0usize;
-    let mut slots = Vec::new();
-    for (fi, f) in fields.iter().enumerate() {
+    let mut slots: Vec<Slot> = Vec::new();
+    for (field_index, f) in fields.iter().enumerate() {
         if let Some(ch) = Channel::from_name(&f.name)
-            && !slots
-                .iter()
-                .any(|s: &(Channel, usize, Scalar, usize, usize)| s.0 == ch)
+            && !slots.iter().any(|s| s.channel == ch)
         {
             if ch == Channel::Ring && !f.scalar.is_integer() {
-                return Err(FormatError::Unsupported(format!(
-                    "ring field {} is not an integer type",
-                    f.name
-                )));
+                return Err(FormatError::NonIntegerRing {
+                    field: f.name.clone(),
+                });
             }
-            slots.push((ch, offset, f.scalar, value_index, fi));
+            slots.push(Slot {
+                channel: ch,
+                offset,
+                scalar: f.scalar,
+                value_index,
+                field_index,
+            });
         }
         offset = f
             .scalar
             .size()
             .checked_mul(f.count)
             .and_then(|s| s.checked_add(offset))
-            .ok_or_else(|| FormatError::Unsupported("record size overflows".into()))?;
+            .ok_or(FormatError::RecordTooLarge)?;
         value_index += f.count;
     }
     for ch in [Channel::X, Channel::Y, Channel::Z] {
-        if !slots.iter().any(|s| s.0 == ch) {
-            return Err(FormatError::Unsupported(
-                format!("no {ch:?} field").to_lowercase(),
-            ));
+        if !slots.iter().any(|s| s.channel == ch) {
+            return Err(FormatError::MissingField { field: ch.name() });
         }
     }
     Ok(Layout {
@@ -257,7 +272,7 @@ fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
 }
 
 fn sink_for(layout: &Layout, n: usize) -> ChannelSink {
-    let has = |c| layout.slots.iter().any(|s| s.0 == c);
+    let has = |c| layout.slots.iter().any(|s| s.channel == c);
     ChannelSink::new(
         n,
         has(Channel::Ring),
@@ -270,13 +285,13 @@ fn sink_for(layout: &Layout, n: usize) -> ChannelSink {
 fn push_point(
     sink: &mut ChannelSink,
     layout: &Layout,
-    mut value: impl FnMut(&(Channel, usize, Scalar, usize, usize)) -> Result<f64, FormatError>,
+    mut value: impl FnMut(&Slot) -> Result<f64, FormatError>,
     at: impl Fn() -> FormatError,
 ) -> Result<(), FormatError> {
     let mut p = [0f32; 3];
     for s in &layout.slots {
         let v = value(s)?;
-        match s.0 {
+        match s.channel {
             Channel::X => p[0] = v as f32,
             Channel::Y => p[1] = v as f32,
             Channel::Z => p[2] = v as f32,
@@ -362,7 +377,8 @@ fn lzf_decompress(input: &[u8], out_len: usize, base: usize) -> Result<Vec<u8>, 
 ///
 /// # Errors
 /// [`FormatError::Line`] for header and ascii errors, [`FormatError::Byte`] for binary data that
-/// is truncated or malformed, [`FormatError::Unsupported`] for files without x, y, z.
+/// is truncated or malformed, [`FormatError::MissingField`] for files without x, y, z,
+/// [`FormatError::NonIntegerRing`] for a floating-point ring field.
 pub fn parse_pcd(bytes: &[u8]) -> Result<PointCloud, FormatError> {
     let header = parse_header(bytes)?;
     let layout = layout(&header.fields)?;
@@ -394,7 +410,12 @@ fn parse_binary(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointCl
                 "ring value is not a u16",
             )
         };
-        push_point(&mut sink, layout, |s| Ok(s.2.read(&rec[s.1..], true)), at)?;
+        push_point(
+            &mut sink,
+            layout,
+            |s| Ok(s.scalar.read(&rec[s.offset..], true)),
+            at,
+        )?;
     }
     sink.finish()
 }
@@ -437,9 +458,9 @@ fn parse_compressed(
             &mut sink,
             layout,
             |s| {
-                let f = &header.fields[s.4];
-                let off = field_start[s.4] + i * f.scalar.size() * f.count;
-                Ok(s.2.read(&raw[off..], true))
+                let f = &header.fields[s.field_index];
+                let off = field_start[s.field_index] + i * f.scalar.size() * f.count;
+                Ok(s.scalar.read(&raw[off..], true))
             },
             at,
         )?;
@@ -480,7 +501,7 @@ fn parse_ascii(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointClo
         push_point(
             &mut sink,
             layout,
-            |s| parse_f64(tokens[s.3], line_no, "value"),
+            |s| parse_f64(tokens[s.value_index], line_no, "value"),
             at,
         )?;
     }

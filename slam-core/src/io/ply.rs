@@ -158,37 +158,46 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
     })
 }
 
-/// Vertex property slots: (channel, property index).
-fn vertex_slots(el: &Element) -> Result<Vec<(Channel, usize)>, FormatError> {
-    let mut slots: Vec<(Channel, usize)> = Vec::new();
+/// Which vertex property feeds a channel.
+#[derive(Clone, Copy, Debug)]
+struct VertexSlot {
+    channel: Channel,
+    /// Index of the property in the vertex element.
+    property: usize,
+}
+
+/// One slot per channel found (the first property of each channel).
+fn vertex_slots(el: &Element) -> Result<Vec<VertexSlot>, FormatError> {
+    let mut slots: Vec<VertexSlot> = Vec::new();
     for (i, p) in el.properties.iter().enumerate() {
         if let Property::Scalar { name, scalar } = p
             && let Some(ch) = Channel::from_name(name)
-            && !slots.iter().any(|s| s.0 == ch)
+            && !slots.iter().any(|s| s.channel == ch)
         {
             if ch == Channel::Ring && !scalar.is_integer() {
-                return Err(FormatError::Unsupported(format!(
-                    "ring property {name} is not an integer type"
-                )));
+                return Err(FormatError::NonIntegerRing {
+                    field: name.clone(),
+                });
             }
-            slots.push((ch, i));
+            slots.push(VertexSlot {
+                channel: ch,
+                property: i,
+            });
         }
     }
     for ch in [Channel::X, Channel::Y, Channel::Z] {
-        if !slots.iter().any(|s| s.0 == ch) {
-            return Err(FormatError::Unsupported(
-                format!("vertex element has no {ch:?} property").to_lowercase(),
-            ));
+        if !slots.iter().any(|s| s.channel == ch) {
+            return Err(FormatError::MissingField { field: ch.name() });
         }
     }
     Ok(slots)
 }
 
-fn store(sink: &mut ChannelSink, slots: &[(Channel, usize)], values: &[f64]) -> Option<()> {
+fn store(sink: &mut ChannelSink, slots: &[VertexSlot], values: &[f64]) -> Option<()> {
     let mut p = [0f32; 3];
-    for &(ch, i) in slots {
-        let v = values[i];
-        match ch {
+    for s in slots {
+        let v = values[s.property];
+        match s.channel {
             Channel::X => p[0] = v as f32,
             Channel::Y => p[1] = v as f32,
             Channel::Z => p[2] = v as f32,
@@ -208,8 +217,9 @@ fn store(sink: &mut ChannelSink, slots: &[(Channel, usize)], values: &[f64]) -> 
 ///
 /// # Errors
 /// [`FormatError::Line`] for header and ascii errors, [`FormatError::Byte`] for truncated or
-/// malformed binary data, [`FormatError::Unsupported`] when there is no vertex element with x, y,
-/// z.
+/// malformed binary data, [`FormatError::NoVertexElement`] or [`FormatError::MissingField`] when
+/// there is no vertex element with x, y, z, [`FormatError::NonIntegerRing`] for a floating-point
+/// ring property.
 // One walk over the header's elements, in binary or text; splitting it would scatter the cursor.
 #[allow(clippy::too_many_lines)]
 pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
@@ -218,10 +228,10 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
         .elements
         .iter()
         .position(|e| e.name == "vertex")
-        .ok_or_else(|| FormatError::Unsupported("no vertex element".into()))?;
+        .ok_or(FormatError::NoVertexElement)?;
     let slots = vertex_slots(&header.elements[vi])?;
     let vcount = header.elements[vi].count;
-    let has = |c| slots.iter().any(|s| s.0 == c);
+    let has = |c| slots.iter().any(|s| s.channel == c);
     // Cap the preallocation by what the data could hold (a lying header must not allocate).
     let cap = vcount.min(bytes.len() - header.data_offset);
     let mut sink = ChannelSink::new(

@@ -87,6 +87,18 @@ pub(crate) enum Channel {
 }
 
 impl Channel {
+    /// The channel's field name in the files (the first of its aliases).
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Self::X => "x",
+            Self::Y => "y",
+            Self::Z => "z",
+            Self::Intensity => "intensity",
+            Self::Ring => "ring",
+            Self::Time => "t",
+        }
+    }
+
     /// The channel a field or property of this name holds, if any.
     pub(crate) fn from_name(name: &str) -> Option<Self> {
         Some(match name {
@@ -124,15 +136,14 @@ impl ChannelSink {
     /// The finished cloud.
     pub(crate) fn finish(self) -> Result<crate::PointCloud, FormatError> {
         let mut c = crate::PointCloud::from_points(self.xyz);
-        let wrap = |e: crate::CloudError| FormatError::Unsupported(e.to_string());
         if let Some(r) = self.ring {
-            c = c.with_ring(r).map_err(wrap)?;
+            c = c.with_ring(r)?;
         }
         if let Some(i) = self.intensity {
-            c = c.with_intensity(i).map_err(wrap)?;
+            c = c.with_intensity(i)?;
         }
         if let Some(t) = self.time {
-            c = c.with_time(t).map_err(wrap)?;
+            c = c.with_time(t)?;
         }
         Ok(c)
     }

@@ -11,6 +11,7 @@ use super::report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
 use crate::cloud::PointCloud;
 use crate::error::CloudError;
 use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_log};
+use crate::io::StampedPose;
 use crate::pose_graph::PoseGraph;
 use crate::traits::optimizer::Optimizer;
 use crate::traits::registrator::MapRegistrator;
@@ -40,6 +41,26 @@ struct Keyframe<S, C> {
     cloud: PointCloud,
 }
 
+/// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the
+/// keyframe's optimised pose.
+#[derive(Clone, Copy, Debug)]
+struct ScanPose {
+    stamp: f64,
+    /// Index of the keyframe.
+    keyframe: usize,
+    /// The scan's LiDAR pose in the keyframe's LiDAR frame.
+    keyframe_t_lidar: Pose3,
+}
+
+/// A loop to check: an old keyframe near a new one.
+#[derive(Clone, Copy, Debug)]
+struct LoopCandidate {
+    /// Index of the old keyframe.
+    old: usize,
+    /// Index of the new keyframe.
+    new: usize,
+}
+
 /// The target the odometry registers against: the last `local_map_keyframes` keyframes placed
 /// at their poses (keyed by their index).
 struct LocalMap<T> {
@@ -67,13 +88,13 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     keyframes: Vec<Keyframe<R::Source, C::Source>>,
     local_map: Option<LocalMap<R::Target>>,
     node_index: NodeIndex,
-    pending_loops: Vec<(usize, usize)>,
+    pending_loops: Vec<LoopCandidate>,
     last_loop_attempt: Option<usize>,
-    /// Every accepted scan: stamp, its keyframe, and the LiDAR pose relative to that keyframe.
-    scan_poses: Vec<(f64, usize, Pose3)>,
+    /// Every accepted scan.
+    scan_poses: Vec<ScanPose>,
     last_stamp: f64,
     /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
-    last_odometry: Option<(f64, Pose3)>,
+    last_odometry: Option<StampedPose>,
     report: SlamReport,
 }
 
@@ -138,27 +159,33 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// The latest LiDAR pose in the map frame (`map_T_lidar`), `None` before the first scan.
     #[must_use]
     pub fn current_lidar_pose(&self) -> Option<Pose3> {
-        let &(_, k, rel) = self.scan_poses.last()?;
-        Some(self.keyframe_pose(k) * rel)
+        let s = self.scan_poses.last()?;
+        Some(self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar)
     }
 
-    /// Optimised keyframe trajectory: `(stamp, map_T_lidar)` per keyframe.
+    /// Optimised keyframe trajectory: stamp and `map_T_lidar` per keyframe.
     #[must_use]
-    pub fn keyframe_trajectory(&self) -> Vec<(f64, Pose3)> {
+    pub fn keyframe_trajectory(&self) -> Vec<StampedPose> {
         self.keyframes
             .iter()
             .enumerate()
-            .map(|(i, k)| (k.stamp, self.keyframe_pose(i)))
+            .map(|(i, k)| StampedPose {
+                stamp: k.stamp,
+                pose: self.keyframe_pose(i),
+            })
             .collect()
     }
 
-    /// Trajectory of every accepted scan, `(stamp, map_T_lidar)`: each scan rides on its keyframe,
-    /// so loop closures correct it too.
+    /// Trajectory of every accepted scan, stamp and `map_T_lidar`: each scan rides on its
+    /// keyframe, so loop closures correct it too.
     #[must_use]
-    pub fn scan_trajectory(&self) -> Vec<(f64, Pose3)> {
+    pub fn scan_trajectory(&self) -> Vec<StampedPose> {
         self.scan_poses
             .iter()
-            .map(|&(s, k, rel)| (s, self.keyframe_pose(k) * rel))
+            .map(|s| StampedPose {
+                stamp: s.stamp,
+                pose: self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar,
+            })
             .collect()
     }
 
@@ -211,11 +238,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         });
         let velocity = self
             .last_odometry
-            .replace((scan.stamp, odom_t_lidar))
-            .and_then(|(stamp, pose)| {
-                let dt = scan.stamp - stamp;
+            .replace(StampedPose {
+                stamp: scan.stamp,
+                pose: odom_t_lidar,
+            })
+            .and_then(|last| {
+                let dt = scan.stamp - last.stamp;
                 (self.config.deskew && swept && dt > 0.0 && dt <= 1.0)
-                    .then(|| se3_log(&(pose.inverse() * odom_t_lidar)) / dt)
+                    .then(|| se3_log(&(last.pose.inverse() * odom_t_lidar)) / dt)
             });
         let Some(last) = self.keyframes.len().checked_sub(1) else {
             if self.config.deskew && velocity.is_none() && swept {
@@ -233,7 +263,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             || delta.rotation.angle() >= self.config.keyframe_rotation;
         if !moved {
             self.last_stamp = scan.stamp;
-            self.scan_poses.push((scan.stamp, last, delta));
+            self.scan_poses.push(ScanPose {
+                stamp: scan.stamp,
+                keyframe: last,
+                keyframe_t_lidar: delta,
+            });
             self.report
                 .scan_ms
                 .push(started.elapsed().as_secs_f64() * 1e3);
@@ -407,7 +441,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         self.report.keyframes += 1;
         self.slide_local_map(index);
         self.last_stamp = scan.stamp;
-        self.scan_poses.push((scan.stamp, index, Pose3::identity()));
+        self.scan_poses.push(ScanPose {
+            stamp: scan.stamp,
+            keyframe: index,
+            keyframe_t_lidar: Pose3::identity(),
+        });
 
         // Queue a loop candidate: the oldest keyframe near this one outside the local window.
         let window = self.config.local_map_keyframes;
@@ -420,7 +458,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 self.node_index
                     .oldest_within(&pose, self.config.loop_search_radius, index - window)
         {
-            self.pending_loops.push((candidate, index));
+            self.pending_loops.push(LoopCandidate {
+                old: candidate,
+                new: index,
+            });
             self.last_loop_attempt = Some(index);
         }
         self.node_index.insert(index, &pose);
@@ -441,9 +482,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             return LoopOutcome::Idle;
         }
         let started = Instant::now();
-        let (cand, new) = self.pending_loops.remove(0);
+        let candidate = self.pending_loops.remove(0);
         self.report.loops_attempted += 1;
-        let outcome = self.try_loop(cand, new);
+        let outcome = self.try_loop(candidate.old, candidate.new);
         self.report
             .loop_ms
             .push(started.elapsed().as_secs_f64() * 1e3);

@@ -53,6 +53,10 @@ impl GridPath {
 /// A shortest-path planner bound to one grid. Construction does the per-grid work (connected
 /// components, JPS+ jump tables); [`Planner::plan`] answers queries.
 ///
+/// The contract separates answers from mistakes: an unreachable goal is the answer `Ok(None)`,
+/// while an error always means a bad argument (an endpoint off the grid or on a blocked cell), so
+/// a caller can never take one for the other.
+///
 /// ```
 /// use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner, validate_endpoints};
 ///
@@ -60,31 +64,40 @@ impl GridPath {
 /// struct EastOnly<'g>(&'g BitGrid);
 ///
 /// impl Planner for EastOnly<'_> {
-///     fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError> {
+///     fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
 ///         validate_endpoints(self.0, start, goal)?;
 ///         if start.y != goal.y || goal.x < start.x {
-///             return Err(PlanError::NoPath);
+///             return Ok(None);
 ///         }
 ///         let cells: Vec<Cell> = (start.x..=goal.x).map(|x| Cell::new(x, start.y)).collect();
 ///         if cells.iter().any(|&c| self.0.is_blocked(c)) {
-///             return Err(PlanError::NoPath);
+///             return Ok(None);
 ///         }
-///         Ok(GridPath { length: f64::from(goal.x - start.x), expanded: cells.len(), cells })
+///         Ok(Some(GridPath { length: f64::from(goal.x - start.x), expanded: cells.len(), cells }))
 ///     }
 /// }
 ///
-/// let grid = BitGrid::new(10, 1)?;
-/// let path = EastOnly(&grid).plan(Cell::new(2, 0), Cell::new(7, 0)).unwrap();
+/// let grid = BitGrid::from_fn(10, 1, |x, _| x == 8)?;
+/// let mut east = EastOnly(&grid);
+/// let path = east.plan(Cell::new(2, 0), Cell::new(7, 0))?.expect("a free row");
 /// assert_eq!(path.length, 5.0);
-/// # Ok::<(), slam_core::GridError>(())
+/// // Unreachable (westward): an answer, not an error.
+/// assert_eq!(east.plan(Cell::new(7, 0), Cell::new(2, 0))?, None);
+/// // A blocked goal: an error.
+/// assert!(matches!(
+///     east.plan(Cell::new(2, 0), Cell::new(8, 0)),
+///     Err(PlanError::BlockedCell { which: "goal", x: 8, y: 0 })
+/// ));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub trait Planner {
-    /// A shortest path from `start` to `goal`.
+    /// A shortest path from `start` to `goal`, or `None` when the goal cannot be reached from the
+    /// start (a normal answer).
     ///
     /// # Errors
-    /// [`PlanError::NoPath`] when the goal is unreachable (a normal answer);
-    /// [`PlanError::OutOfBounds`] or [`PlanError::BlockedCell`] for a bad start or goal.
-    fn plan(&mut self, start: Cell, goal: Cell) -> Result<GridPath, PlanError>;
+    /// Only for bad arguments: [`PlanError::OutOfBounds`] or [`PlanError::BlockedCell`] for a
+    /// start or goal off the grid or on a blocked cell.
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError>;
 }
 
 /// The checks every planner makes on its endpoints: both on the grid and free.

@@ -1,13 +1,12 @@
 //! Absolute trajectory error after rigid alignment, as evo's `ape -a` computes it for the
 //! translation part: associate poses by stamp, align the estimate onto the reference with
-//! [`align_rigid`], and report statistics of the remaining position errors.
+//! [`slam_core::fit_rigid_transform`], and report statistics of the remaining position errors.
 
 use nalgebra::Point3;
-use slam_core::Pose3;
 use slam_core::io::StampedPose;
+use slam_core::{Pose3, RigidFitError, fit_rigid_transform};
 
 use crate::error::AdapterError;
-use crate::eval::alignment::align_rigid;
 
 /// Largest stamp difference (seconds) for two poses to be associated, 0.01 s (evo's default).
 pub const DEFAULT_MAX_STAMP_DIFFERENCE: f64 = 0.01;
@@ -63,7 +62,8 @@ pub fn associate(
 /// alignment (translation errors; stamps associated within `max_dt` seconds).
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] when fewer than 3 poses can be associated.
+/// [`AdapterError::TooFewPoses`] when fewer than 3 poses can be associated,
+/// [`AdapterError::Alignment`] when a pose is not finite.
 pub fn absolute_trajectory_error(
     estimate: &[StampedPose],
     reference: &[StampedPose],
@@ -78,7 +78,13 @@ pub fn absolute_trajectory_error(
         .iter()
         .map(|&(_, j)| Point3::from(reference[j].pose.translation.vector))
         .collect();
-    let alignment = align_rigid(&est, &refs)?;
+    let alignment = fit_rigid_transform(&est, &refs).map_err(|e| match e {
+        RigidFitError::TooFewPairs { pairs, required } => AdapterError::TooFewPoses {
+            found: pairs,
+            required,
+        },
+        other => AdapterError::Alignment(other),
+    })?;
     let mut errors: Vec<f64> = est
         .iter()
         .zip(&refs)

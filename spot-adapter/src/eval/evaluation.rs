@@ -16,15 +16,15 @@ use crate::eval::drift::{
 /// A trajectory of LiDAR poses (`map_T_lidar` per stamp) as body poses (`map_T_body`).
 #[must_use]
 pub fn body_trajectory(
-    lidar_trajectory: Vec<(f64, Pose3)>,
+    lidar_trajectory: Vec<StampedPose>,
     body_t_lidar: &Pose3,
 ) -> Vec<StampedPose> {
     let lidar_t_body = body_t_lidar.inverse();
     lidar_trajectory
         .into_iter()
-        .map(|(stamp, p)| StampedPose {
-            stamp,
-            pose: p * lidar_t_body,
+        .map(|s| StampedPose {
+            stamp: s.stamp,
+            pose: s.pose * lidar_t_body,
         })
         .collect()
 }
@@ -83,7 +83,7 @@ impl TrajectoryEvaluation {
     /// # Errors
     /// As [`TrajectoryEvaluation::compute`].
     pub fn of_lidar_trajectory(
-        lidar_trajectory: Vec<(f64, Pose3)>,
+        lidar_trajectory: Vec<StampedPose>,
         body_t_lidar: &Pose3,
         truth: &[StampedPose],
     ) -> Result<(Self, Vec<StampedPose>), AdapterError> {

@@ -5,12 +5,10 @@
 //!
 //! Uses `slam-core` only (poses, the stamped-pose type and the rigid fit).
 
-mod alignment;
 mod ate;
 mod drift;
 mod evaluation;
 
-pub use alignment::align_rigid; // TODO(merge): slam_core::geometry
 pub use ate::{AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate};
 pub use drift::{
     EndPointDrift, INDOOR_SEGMENT_LENGTHS, KITTI_SEGMENT_LENGTHS, SegmentDrift, end_point_drift,

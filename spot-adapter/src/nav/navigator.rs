@@ -5,7 +5,7 @@
 use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
 use nalgebra::Vector2;
 use pathfind::{JumpPointSearch, filter_path};
-use slam_core::{BitGrid, Cell, PlanError, Planner, PointCloud, Pose3, Registrator};
+use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
 
 use crate::error::AdapterError;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
@@ -240,10 +240,12 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         else {
             return Ok(None);
         };
-        let path = match self.planner.plan(start, goal_cell) {
-            Ok(path) => path,
-            Err(PlanError::NoPath) => return Ok(None),
-            Err(e) => return Err(AdapterError::Planner(e)),
+        let Some(path) = self
+            .planner
+            .plan(start, goal_cell)
+            .map_err(AdapterError::Planner)?
+        else {
+            return Ok(None);
         };
         let filtered = filter_path(self.grid, &path);
         let mut waypoints: Vec<Vector2<f64>> = filtered

@@ -2,6 +2,7 @@
 //! speed, with a heading that turns smoothly through corners.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector2, Vector3};
+use slam_core::io::StampedPose;
 use slam_core::{Pose2, Pose3};
 
 use crate::error::AdapterError;
@@ -136,7 +137,7 @@ impl Route {
         speed: f64,
         rate: f64,
         body_height: f64,
-    ) -> Result<Vec<(f64, Pose3)>, AdapterError> {
+    ) -> Result<Vec<StampedPose>, AdapterError> {
         if !(speed.is_finite() && speed > 0.0) {
             return Err(AdapterError::invalid(
                 "speed",
@@ -169,13 +170,13 @@ impl Route {
                     - std::f64::consts::PI;
             }
             last_yaw = Some(yaw);
-            out.push((
-                k as f64 / rate,
-                Pose3::from_parts(
+            out.push(StampedPose {
+                stamp: k as f64 / rate,
+                pose: Pose3::from_parts(
                     Translation3::new(t.x, t.y, body_height),
                     UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw),
                 ),
-            ));
+            });
         }
         Ok(out)
     }

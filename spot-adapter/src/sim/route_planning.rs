@@ -74,11 +74,10 @@ impl Route {
                 })
         };
         let (s, g): (Cell, Cell) = (to_cell("start", start)?, to_cell("goal", goal)?);
-        // Both ends are free cells on the grid, so the planner's only answer left is the path
-        // or none.
         let path = AStar::new(&grid)
             .plan(s, g)
-            .map_err(|_| AdapterError::NoRoute)?;
+            .map_err(AdapterError::Planner)?
+            .ok_or(AdapterError::NoRoute)?;
         let filtered = filter_path(&grid, &path);
         let mut kept = vec![start];
         kept.extend(filtered.waypoints.iter().map(|&c| grid.cell_center(c)));

@@ -93,7 +93,7 @@ pub struct SimulatedSpot {
     odometry: OdometryModel,
     noise: SimRng,
     body_t_lidar: Pose3,
-    truth: Vec<(f64, Pose3)>,
+    truth: Vec<StampedPose>,
     next: usize,
     motion_distortion: bool,
 }
@@ -128,8 +128,8 @@ impl SimulatedSpot {
             config.lidar.rotation_rate,
             config.spot.body_height,
         )?;
-        for (t, pose) in &mut truth {
-            *pose *= sway.offset(*t);
+        for p in &mut truth {
+            p.pose *= sway.offset(p.stamp);
         }
         Ok(Self {
             building,
@@ -175,10 +175,7 @@ impl SimulatedSpot {
     /// The whole ground-truth trajectory `world_T_body`, one pose per sample.
     #[must_use]
     pub fn ground_truth(&self) -> Vec<StampedPose> {
-        self.truth
-            .iter()
-            .map(|&(stamp, pose)| StampedPose { stamp, pose })
-            .collect()
+        self.truth.clone()
     }
 
     /// Number of samples the whole run yields.
@@ -210,12 +207,17 @@ impl Iterator for SimulatedSpot {
     type Item = Sample;
 
     fn next(&mut self) -> Option<Sample> {
-        let &(stamp, world_t_body) = self.truth.get(self.next)?;
+        let StampedPose {
+            stamp,
+            pose: world_t_body,
+        } = *self.truth.get(self.next)?;
         self.next += 1;
         let odom_t_body = self.odometry.step(&world_t_body);
         let start = world_t_body * self.body_t_lidar;
         let cloud = match self.truth.get(self.next) {
-            Some(&(_, next_body)) if self.motion_distortion => self.lidar.scan_moving(
+            Some(&StampedPose {
+                pose: next_body, ..
+            }) if self.motion_distortion => self.lidar.scan_moving(
                 &self.building,
                 &start,
                 &(next_body * self.body_t_lidar),
