@@ -30,7 +30,7 @@ use spot_adapter::nav::{NavigationStep, Navigator, NavigatorConfig, navigation_g
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
-use spot_adapter::robot::Robot;
+use spot_adapter::robot::{Robot, VelocityCommand};
 use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
 use spot_nav_examples::{Progress, Registration, Timings, map_and_evaluate, out, parse_goal};
 
@@ -111,6 +111,8 @@ enum Outcome {
     Arrived,
     GaveUp,
     NoPath,
+    Blocked,
+    Lost,
 }
 
 impl Outcome {
@@ -119,6 +121,8 @@ impl Outcome {
             Self::Arrived => "arrived",
             Self::GaveUp => "gave up (scan limit)",
             Self::NoPath => "no path on the map",
+            Self::Blocked => "blocked (no progress after backing off and retrying)",
+            Self::Lost => "lost (the robot could not be found on the map)",
         }
     }
 }
@@ -163,8 +167,13 @@ fn walk(
         if let Some(c) = nav.grid().cell_at(truth_map.translation.vector.xy()) {
             trail.push(c);
         }
-        match step {
-            NavigationStep::Walk(command) if cycles < MAX_CYCLES => {
+        let command = match step {
+            NavigationStep::Walk(command) => Some(command),
+            NavigationStep::Hold => Some(VelocityCommand::default()),
+            _ => None,
+        };
+        match (step, command) {
+            (_, Some(command)) if cycles < MAX_CYCLES => {
                 let before = spot.position();
                 sample = spot.step(command);
                 walked += (spot.position() - before).norm();
@@ -177,9 +186,11 @@ fn walk(
                     ),
                 );
             }
-            NavigationStep::Walk(_) => break Outcome::GaveUp,
-            NavigationStep::Arrived => break Outcome::Arrived,
-            NavigationStep::NoPath => break Outcome::NoPath,
+            (_, Some(_)) => break Outcome::GaveUp,
+            (NavigationStep::Arrived, _) => break Outcome::Arrived,
+            (NavigationStep::Blocked, _) => break Outcome::Blocked,
+            (NavigationStep::Lost, _) => break Outcome::Lost,
+            _ => break Outcome::NoPath,
         }
     };
     progress.finish();

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 use spot_adapter::AdapterError;
-use spot_adapter::nav::NavigatorConfig;
+use spot_adapter::nav::{LocaliserConfig, NavigatorConfig, StuckConfig};
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, OdometryDriftConfig, OdometryModel, Route,
     RouteConfig, SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
@@ -91,10 +91,29 @@ fn bad_settings_are_rejected() {
     };
     assert!(invalid(n.validate(), "goal_tolerance"));
     let n = NavigatorConfig {
-        max_correction: f64::NAN,
+        localiser: LocaliserConfig {
+            max_correction: f64::NAN,
+            ..LocaliserConfig::default()
+        },
         ..NavigatorConfig::default()
     };
     assert!(invalid(n.validate(), "max_correction"));
+    let n = NavigatorConfig {
+        localiser: LocaliserConfig {
+            search_step: 0.001,
+            ..LocaliserConfig::default()
+        },
+        ..NavigatorConfig::default()
+    };
+    assert!(invalid(n.validate(), "search_step"));
+    let n = NavigatorConfig {
+        stuck: StuckConfig {
+            window: 0,
+            ..StuckConfig::default()
+        },
+        ..NavigatorConfig::default()
+    };
+    assert!(invalid(n.validate(), "stuck.window"));
 }
 
 #[test]

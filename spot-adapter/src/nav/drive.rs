@@ -2,11 +2,10 @@
 //! the goal is reached, no path is left, or the cycles run out; the robot is stopped on every
 //! way out, errors included.
 
-use nalgebra::Vector2;
 use slam_core::{Pose3, Registrator};
 
 use crate::error::DriveError;
-use crate::nav::navigator::{NavigationStep, Navigator};
+use crate::nav::navigator::{Goal, NavigationStep, Navigator};
 use crate::robot::{MobilityCommand, Robot, Sample};
 
 /// How a drive ended.
@@ -17,6 +16,10 @@ pub enum DriveOutcome {
     Arrived,
     /// No collision-free path joins the robot and the goal on the map.
     NoPath,
+    /// The robot made no progress after several attempts to get free.
+    Blocked,
+    /// The robot could not be found on the map.
+    Lost,
     /// The cycle budget ran out first.
     GaveUp,
 }
@@ -41,7 +44,7 @@ pub struct DriveCycle<'a> {
     pub estimate: Pose3,
 }
 
-/// Drive `robot` with `navigator` toward `goal` (map frame, metres) for at most `max_cycles`
+/// Drive `robot` with `navigator` toward `goal` (map frame, metres, optionally with a heading) for at most `max_cycles`
 /// samples. `observe` sees every cycle: the sample, the navigator's decision and its estimate
 /// (for logging and evaluation). The robot is sent a stop however the drive ends.
 ///
@@ -52,10 +55,11 @@ pub struct DriveCycle<'a> {
 pub fn drive<R: Robot, G: Registrator>(
     robot: &mut R,
     navigator: &mut Navigator<'_, G>,
-    goal: Vector2<f64>,
+    goal: impl Into<Goal>,
     max_cycles: usize,
     mut observe: impl FnMut(&DriveCycle<'_>),
 ) -> Result<DriveReport, DriveError<R::Error>> {
+    let goal = goal.into();
     let result = (|| {
         for cycle in 1..=max_cycles {
             let sample = robot.next_sample().map_err(DriveError::Robot)?;
@@ -74,8 +78,14 @@ pub fn drive<R: Robot, G: Registrator>(
                         .map_err(DriveError::Robot)?;
                     continue;
                 }
+                NavigationStep::Hold => {
+                    robot.stop().map_err(DriveError::Robot)?;
+                    continue;
+                }
                 NavigationStep::Arrived => DriveOutcome::Arrived,
                 NavigationStep::NoPath => DriveOutcome::NoPath,
+                NavigationStep::Blocked => DriveOutcome::Blocked,
+                NavigationStep::Lost => DriveOutcome::Lost,
             };
             return Ok(DriveReport {
                 outcome,

@@ -6,7 +6,11 @@
 //! simulator: the same code drives a simulated Spot and a real one.
 
 mod drive;
+mod localiser;
 mod navigator;
+mod stuck;
 
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
-pub use navigator::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
+pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
+pub use navigator::{Goal, NavigationStep, Navigator, NavigatorConfig, navigation_grid};
+pub use stuck::StuckConfig;

@@ -8,6 +8,8 @@ use pathfind::{JumpPointSearch, filter_path};
 use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
 
 use crate::error::AdapterError;
+use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser, LocaliserConfig};
+use crate::nav::stuck::{StuckConfig, StuckMonitor, StuckState};
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 
 /// Settings of [`Navigator`]. Lengths in metres, angles in radians, speeds per second.
@@ -18,19 +20,28 @@ pub struct NavigatorConfig {
     /// Obstacles are inflated by this much: the robot's half width (0.25 m) and a margin for
     /// localisation and control error, 0.40 m.
     pub clearance: f64,
-    /// Arrived when the body is this close to the goal, 0.20 m.
+    /// Arrived when the estimated body is this close to the goal, 0.05 m (localisation is good
+    /// to a few centimetres, so the true body ends within 0.10 m).
     pub goal_tolerance: f64,
+    /// ... and, for a goal with a heading, faces it this closely, 0.1 rad.
+    pub heading_tolerance: f64,
+    /// Within this distance of the goal, with nothing in between, the robot walks straight at it
+    /// sideways and forwards without turning (Spot walks in any direction), 0.6 m.
+    pub approach_distance: f64,
+    /// Speed of that final approach per metre still to go, 1.5 /s, ...
+    pub approach_gain: f64,
+    /// ... and at most this, 0.3 m/s.
+    pub approach_speed: f64,
     /// Turn in place while the heading error to the next waypoint exceeds this, 0.5 (29°).
     pub turn_in_place_above: f64,
     /// Walking speed, 0.6 m/s (the simulated Spot's).
     pub speed: f64,
-    /// Turn rate per radian of heading error, 1.5 /s (capped at Spot's 1 rad/s).
+    /// Turn rate per radian of heading error, 1.5 /s (capped at the robot's limit).
     pub heading_gain: f64,
-    /// A registration that moves the odometry's prediction farther than this is rejected, 0.3 m
-    /// (odometry drifts millimetres between two scans: a larger correction is a wrong match).
-    pub max_correction: f64,
-    /// ... or turns it more than this, 0.1 rad (5.7°).
-    pub max_correction_angle: f64,
+    /// Localisation against the map: corrections, health, the wide search when lost.
+    pub localiser: LocaliserConfig,
+    /// What counts as stuck and how the robot gets free.
+    pub stuck: StuckConfig,
 }
 
 impl Default for NavigatorConfig {
@@ -38,36 +49,44 @@ impl Default for NavigatorConfig {
         Self {
             grid: OccupancyGridConfig::default(),
             clearance: 0.40,
-            goal_tolerance: 0.20,
+            goal_tolerance: 0.05,
+            heading_tolerance: 0.1,
+            approach_distance: 0.6,
+            approach_gain: 1.5,
+            approach_speed: 0.3,
             turn_in_place_above: 0.5,
             speed: 0.6,
             heading_gain: 1.5,
-            max_correction: 0.3,
-            max_correction_angle: 0.1,
+            localiser: LocaliserConfig::default(),
+            stuck: StuckConfig::default(),
         }
     }
 }
 
 impl NavigatorConfig {
-    /// Every length, angle, speed and gain finite and positive.
+    /// Every length, angle, speed and gain finite and positive; the localiser's and the stuck
+    /// monitor's settings valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the settings.
+    /// [`AdapterError::InvalidConfig`] naming the first bad setting.
     pub fn validate(&self) -> Result<(), AdapterError> {
         for (setting, value) in [
             ("clearance", self.clearance),
             ("goal_tolerance", self.goal_tolerance),
+            ("heading_tolerance", self.heading_tolerance),
+            ("approach_distance", self.approach_distance),
+            ("approach_gain", self.approach_gain),
+            ("approach_speed", self.approach_speed),
             ("turn_in_place_above", self.turn_in_place_above),
             ("speed", self.speed),
             ("heading_gain", self.heading_gain),
-            ("max_correction", self.max_correction),
-            ("max_correction_angle", self.max_correction_angle),
         ] {
             if !(value.is_finite() && value > 0.0) {
                 return Err(AdapterError::invalid(setting, value, "finite and positive"));
             }
         }
-        Ok(())
+        self.localiser.validate()?;
+        self.stuck.validate()
     }
 }
 
@@ -90,38 +109,63 @@ pub fn navigation_grid(
     Ok(inflate(occupancy.occupied(), config.clearance))
 }
 
+/// A goal: a plan-view position (map frame, metres) and, optionally, the heading to end with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Goal {
+    /// Where the body should end (metres, map frame).
+    pub position: Vector2<f64>,
+    /// The heading it should end with (radians, map frame), if any.
+    pub heading: Option<f64>,
+}
+
+impl From<Vector2<f64>> for Goal {
+    fn from(position: Vector2<f64>) -> Self {
+        Self {
+            position,
+            heading: None,
+        }
+    }
+}
+
 /// What the navigator decided this cycle.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum NavigationStep {
     /// Walk: hold this command until the next scan.
     Walk(VelocityCommand),
-    /// The body is within the goal tolerance: stop.
+    /// Stand still this cycle (searching for the robot's place on the map).
+    Hold,
+    /// The body is within the goal tolerance (and faces the goal's heading): stop.
     Arrived,
     /// No collision-free path joins the robot and the goal on the map (an answer, not a
     /// failure): stop.
     NoPath,
+    /// The robot made no progress though it tried to get free several times: stop.
+    Blocked,
+    /// Localisation failed and the wide searches did not find the robot on the map: stop.
+    Lost,
 }
 
 /// Walks the robot to goals in a mapped building (map frame = the map cloud's frame).
 ///
-/// Each [`Navigator::step`] predicts the body pose from the odometry since the previous scan,
-/// corrects it by registering the scan against the map (prepared once), replans with
-/// [`JumpPointSearch`] on the map's inflated occupancy grid and keeps the turning points that a
-/// straight collision-free segment cannot skip ([`filter_path`]); then it turns in place while
-/// the heading error to the next waypoint is large, and otherwise walks toward it steering
-/// proportionally. A goal that cannot be reached is answered with [`NavigationStep::NoPath`];
-/// nothing loops forever.
+/// Each [`Navigator::step`] predicts the body pose from the odometry since the previous scan and
+/// corrects it by registering the scan against the map (prepared once; the localiser tracks its
+/// health, takes a large correction only once consecutive scans confirm it, and searches wide
+/// when the robot seems lost), replans with [`JumpPointSearch`] on the map's inflated occupancy
+/// grid and keeps the turning points that a straight collision-free segment cannot skip
+/// ([`filter_path`]); then it turns in place while the heading error to the next waypoint is
+/// large, walks toward it steering proportionally otherwise, and near the goal walks straight
+/// at it (sideways too) ever slower. A robot that makes no progress backs off and tries again,
+/// and is reported [`NavigationStep::Blocked`] after a few attempts. A goal that cannot be
+/// reached is answered with [`NavigationStep::NoPath`]; nothing loops forever.
 pub struct Navigator<'g, R: Registrator> {
     config: NavigatorConfig,
     limits: MotionLimits,
-    registrator: R,
-    map: R::Target,
+    localiser: Localiser<R>,
     grid: &'g BitGrid,
     planner: JumpPointSearch<'g>,
-    map_t_body: Pose3,
-    last_odom_t_body: Option<Pose3>,
     waypoints: Vec<Vector2<f64>>,
-    localisation_failures: usize,
+    stuck: StuckMonitor,
 }
 
 impl<'g, R: Registrator> Navigator<'g, R> {
@@ -147,73 +191,109 @@ impl<'g, R: Registrator> Navigator<'g, R> {
             .prepare_target(map)
             .map_err(AdapterError::LocalisationMap)?;
         Ok(Self {
+            localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone()),
+            stuck: StuckMonitor::new(config.stuck.clone()),
             config,
             limits: robot.limits.clone(),
-            registrator,
-            map: target,
             grid,
             planner: JumpPointSearch::new(grid),
-            map_t_body,
-            last_odom_t_body: None,
             waypoints: Vec::new(),
-            localisation_failures: 0,
         })
     }
 
-    /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame, metres).
+    /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame: a position,
+    /// or a [`Goal`] with a final heading).
     ///
     /// # Errors
-    /// [`AdapterError::NonFiniteGoal`] for a goal that is not a finite point (checked before
-    /// anything else); [`AdapterError::Planner`] when the planner refuses its arguments, which
-    /// the navigator's own checks rule out (a defect, not an answer).
+    /// [`AdapterError::NonFiniteGoal`] for a goal that is not a finite point or heading
+    /// (checked before anything else); [`AdapterError::Planner`] when the planner refuses its
+    /// arguments, which the navigator's own checks rule out (a defect, not an answer).
     pub fn step(
         &mut self,
         sample: &Sample,
-        goal: Vector2<f64>,
+        goal: impl Into<Goal>,
     ) -> Result<NavigationStep, AdapterError> {
-        if !(goal.x.is_finite() && goal.y.is_finite()) {
+        let goal = goal.into();
+        let target = goal.position;
+        if !(target.x.is_finite()
+            && target.y.is_finite()
+            && goal.heading.is_none_or(f64::is_finite))
+        {
             return Err(AdapterError::NonFiniteGoal {
-                x: goal.x,
-                y: goal.y,
+                x: target.x,
+                y: target.y,
             });
         }
-        self.localise(sample);
-        let position = self.map_t_body.translation.vector.xy();
-        if (goal - position).norm() <= self.config.goal_tolerance {
+        match self.localiser.update(sample) {
+            LocalisationStatus::Searching => {
+                self.stuck.reset();
+                return Ok(NavigationStep::Hold);
+            }
+            LocalisationStatus::Lost => {
+                self.waypoints.clear();
+                return Ok(NavigationStep::Lost);
+            }
+            _ => {}
+        }
+        let pose = self.localiser.pose();
+        let position = pose.translation.vector.xy();
+        let yaw = pose.rotation.euler_angles().2;
+        let distance = (target - position).norm();
+        let heading_error = goal.heading.map_or(0.0, |h| wrap(h - yaw));
+        if distance <= self.config.goal_tolerance
+            && heading_error.abs() <= self.config.heading_tolerance
+        {
             self.waypoints.clear();
+            self.stuck.reset();
             return Ok(NavigationStep::Arrived);
         }
-        let Some(waypoints) = self.plan(position, goal)? else {
+        match self.stuck.check(position) {
+            StuckState::Free => {}
+            StuckState::BackingOff => {
+                let command = VelocityCommand::new(-self.config.stuck.backoff_speed, 0.0);
+                return Ok(NavigationStep::Walk(command));
+            }
+            StuckState::Blocked => {
+                self.waypoints.clear();
+                self.stuck.reset();
+                return Ok(NavigationStep::Blocked);
+            }
+        }
+        let Some(waypoints) = self.plan(position, target)? else {
             self.waypoints.clear();
             return Ok(NavigationStep::NoPath);
         };
         self.waypoints = waypoints;
-        Ok(NavigationStep::Walk(self.command(position)))
+        let command = if distance <= self.config.goal_tolerance {
+            // In place: only the heading is left.
+            let rate = (self.config.heading_gain * heading_error)
+                .clamp(-self.limits.max_yaw_rate, self.limits.max_yaw_rate);
+            VelocityCommand::new(0.0, rate)
+        } else if distance <= self.config.approach_distance && self.waypoints.len() == 1 {
+            self.approach(&pose, target)
+        } else {
+            self.command(position, yaw)
+        };
+        self.stuck.commanded(&command);
+        Ok(NavigationStep::Walk(command))
     }
 
-    /// Predict from the odometry, then correct by registration (the prediction stands when the
-    /// registration fails, does not converge, or would move it implausibly far).
-    fn localise(&mut self, sample: &Sample) {
-        if let Some(last) = self.last_odom_t_body.replace(sample.odom_t_body) {
-            self.map_t_body *= last.inverse() * sample.odom_t_body;
-        }
-        let guess = self.map_t_body * sample.body_t_lidar;
-        let aligned = self
-            .registrator
-            .prepare_source(&sample.cloud)
-            .and_then(|s| self.registrator.align(&s, &self.map, &guess));
-        let corrected = aligned
-            .ok()
-            .filter(|a| a.converged)
-            .map(|a| a.pose * sample.body_t_lidar.inverse())
-            .filter(|c| {
-                let jump = self.map_t_body.inverse() * c;
-                jump.translation.vector.norm() <= self.config.max_correction
-                    && jump.rotation.angle() <= self.config.max_correction_angle
-            });
-        match corrected {
-            Some(c) => self.map_t_body = c,
-            None => self.localisation_failures += 1,
+    /// The final approach: straight at the goal in the body frame (forward and sideways, no
+    /// turn), at a speed proportional to the distance left.
+    fn approach(&self, pose: &Pose3, target: Vector2<f64>) -> VelocityCommand {
+        let to = target - pose.translation.vector.xy();
+        let yaw = pose.rotation.euler_angles().2;
+        let (c, s) = (yaw.cos(), yaw.sin());
+        let body = Vector2::new(c * to.x + s * to.y, -s * to.x + c * to.y);
+        let distance = body.norm();
+        let speed = (self.config.approach_gain * distance)
+            .min(self.config.approach_speed)
+            .min(self.limits.max_lateral_speed);
+        let v = body / distance.max(1e-9) * speed;
+        VelocityCommand {
+            forward: v.x,
+            lateral: v.y,
+            yaw_rate: 0.0,
         }
     }
 
@@ -264,7 +344,7 @@ impl<'g, R: Registrator> Navigator<'g, R> {
     }
 
     /// The command toward the first waypoint that is not already underfoot.
-    fn command(&self, position: Vector2<f64>) -> VelocityCommand {
+    fn command(&self, position: Vector2<f64>, yaw: f64) -> VelocityCommand {
         let near = 0.5 * self.config.goal_tolerance;
         let target = self
             .waypoints
@@ -274,7 +354,6 @@ impl<'g, R: Registrator> Navigator<'g, R> {
             .copied()
             .unwrap_or(position);
         let to = target - position;
-        let yaw = self.map_t_body.rotation.euler_angles().2;
         let error = wrap(to.y.atan2(to.x) - yaw);
         let max_yaw_rate = self.limits.max_yaw_rate;
         let yaw_rate = (self.config.heading_gain * error).clamp(-max_yaw_rate, max_yaw_rate);
@@ -290,7 +369,13 @@ impl<'g, R: Registrator> Navigator<'g, R> {
     /// The current estimate of the body pose in the map frame.
     #[must_use]
     pub fn pose(&self) -> Pose3 {
-        self.map_t_body
+        self.localiser.pose()
+    }
+
+    /// The health of localisation (last registration, failures, relocalisations).
+    #[must_use]
+    pub fn localisation(&self) -> LocalisationHealth {
+        self.localiser.health()
     }
 
     /// The planned waypoints (metres) after the robot's position, ending at the goal.
@@ -305,11 +390,11 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         self.grid
     }
 
-    /// Cycles whose registration failed, did not converge or was rejected as too large a jump
-    /// (the odometry's prediction stood).
+    /// Cycles whose registration failed, did not converge, matched too little or was an
+    /// unconfirmed jump (the odometry's prediction stood).
     #[must_use]
     pub fn localisation_failures(&self) -> usize {
-        self.localisation_failures
+        self.localiser.health().failures
     }
 }
 

@@ -1,0 +1,344 @@
+//! Localisation against a map that knows when it is lost: each scan corrects the odometry's
+//! prediction by registration; the health of those corrections is tracked, a large correction is
+//! taken once consecutive scans confirm it, and after repeated failures a wide search over seeds
+//! around the estimate relocalises the robot, or reports it lost.
+
+use nalgebra::{Translation3, UnitQuaternion, Vector3};
+use slam_core::{Alignment, Pose3, Registrator};
+
+use crate::error::AdapterError;
+use crate::robot::Sample;
+
+/// Settings of the localiser. Lengths in metres, angles in radians.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocaliserConfig {
+    /// A correction that moves the odometry's prediction farther than this is not taken from one
+    /// scan, 0.3 m (odometry drifts millimetres between two scans: a larger correction is a
+    /// wrong match or a genuine recovery, which the next scans must confirm).
+    pub max_correction: f64,
+    /// ... or turns it more than this, 0.1 rad (5.7°).
+    pub max_correction_angle: f64,
+    /// A registration counts only when it converged with at least this share of the scan's
+    /// points matched, 0.5.
+    pub min_inlier_ratio: f64,
+    /// Consecutive scans whose large corrections agree (within 5 cm and 0.02 rad, once carried
+    /// by the odometry) before the correction is taken, 3.
+    pub confirm_after: usize,
+    /// Consecutive failed or unconfirmed scans after which the robot is lost and a wide search
+    /// runs, 5 (one second at 5 Hz).
+    pub lost_after: usize,
+    /// The wide search tries seeds this far around the estimate in x and y, 1.0 m, ...
+    pub search_radius: f64,
+    /// ... spaced this far apart, 0.5 m, ...
+    pub search_step: f64,
+    /// ... at headings this far either side of the estimate's, 0.52 rad (30°), ...
+    pub search_angle: f64,
+    /// ... spaced this far apart, 0.175 rad (10°).
+    pub search_angle_step: f64,
+    /// The best seed's registration must match at least this share of the scan, 0.6.
+    pub relocalise_min_inlier_ratio: f64,
+    /// Wide searches (one per scan) before the robot is reported lost, 3.
+    pub max_searches: usize,
+}
+
+impl Default for LocaliserConfig {
+    fn default() -> Self {
+        Self {
+            max_correction: 0.3,
+            max_correction_angle: 0.1,
+            min_inlier_ratio: 0.5,
+            confirm_after: 3,
+            lost_after: 5,
+            search_radius: 1.0,
+            search_step: 0.5,
+            search_angle: 30f64.to_radians(),
+            search_angle_step: 10f64.to_radians(),
+            relocalise_min_inlier_ratio: 0.6,
+            max_searches: 3,
+        }
+    }
+}
+
+impl LocaliserConfig {
+    /// Every setting finite and positive, the ratios at most 1, the counts at least 1.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), AdapterError> {
+        for (setting, value) in [
+            ("max_correction", self.max_correction),
+            ("max_correction_angle", self.max_correction_angle),
+            ("search_radius", self.search_radius),
+            ("search_step", self.search_step),
+            ("search_angle", self.search_angle),
+            ("search_angle_step", self.search_angle_step),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(AdapterError::invalid(setting, value, "finite and positive"));
+            }
+        }
+        for (setting, value) in [
+            ("min_inlier_ratio", self.min_inlier_ratio),
+            (
+                "relocalise_min_inlier_ratio",
+                self.relocalise_min_inlier_ratio,
+            ),
+        ] {
+            if !(value > 0.0 && value <= 1.0) {
+                return Err(AdapterError::invalid(setting, value, "within (0, 1]"));
+            }
+        }
+        for (setting, value) in [
+            ("confirm_after", self.confirm_after),
+            ("lost_after", self.lost_after),
+            ("max_searches", self.max_searches),
+        ] {
+            if value == 0 {
+                return Err(AdapterError::invalid(setting, 0.0, "at least 1"));
+            }
+        }
+        // The search's seed count grows with the square of radius / step: keep it bounded.
+        let per_axis = (2.0 * self.search_radius / self.search_step).floor() + 1.0;
+        let headings = (2.0 * self.search_angle / self.search_angle_step).floor() + 1.0;
+        if per_axis * per_axis * headings > 2000.0 {
+            return Err(AdapterError::invalid(
+                "search_step",
+                self.search_step,
+                "large enough for at most 2000 seeds",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// How localisation went this cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum LocalisationStatus {
+    /// The scan corrected the estimate.
+    Corrected,
+    /// The scan did not correct it (failed, poor, or an unconfirmed jump): the odometry's
+    /// prediction stands.
+    Predicted,
+    /// A wide search found the robot again.
+    Relocalised,
+    /// A wide search failed; the robot should stand still while the next scans are searched.
+    Searching,
+    /// Every allowed wide search failed: the robot does not know where it is.
+    Lost,
+}
+
+/// The health of localisation, for monitoring and the navigator's decisions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LocalisationHealth {
+    /// Whether the last registration converged.
+    pub converged: bool,
+    /// Share of the last scan's points the registration matched.
+    pub inlier_ratio: f64,
+    /// Smallest over largest eigenvalue of the last registration's information: near zero in a
+    /// degenerate view.
+    pub min_eigenvalue_ratio: f64,
+    /// Consecutive scans that did not correct the estimate.
+    pub consecutive_failures: usize,
+    /// Scans that did not correct the estimate, in all.
+    pub failures: usize,
+    /// Large corrections taken after confirmation, in all.
+    pub confirmed_jumps: usize,
+    /// Wide searches that found the robot, in all.
+    pub relocalisations: usize,
+    /// Wide searches run since the robot was last localised.
+    pub searches: usize,
+}
+
+/// A large correction waiting for confirmation: the corrected pose and the odometry then.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    map_t_body: Pose3,
+    odom_t_body: Pose3,
+    count: usize,
+}
+
+impl Candidate {
+    /// Whether `corrected` (at odometry `odom_t_body`) agrees with this candidate carried along
+    /// by the odometry since.
+    fn agrees(&self, corrected: &Pose3, odom_t_body: &Pose3) -> bool {
+        let carried = self.map_t_body * (self.odom_t_body.inverse() * odom_t_body);
+        let d = carried.inverse() * corrected;
+        d.translation.vector.norm() <= 0.05 && d.rotation.angle() <= 0.02
+    }
+}
+
+/// The localiser: the estimate `map_T_body`, the map prepared once, the health.
+pub(crate) struct Localiser<R: Registrator> {
+    config: LocaliserConfig,
+    registrator: R,
+    map: R::Target,
+    map_t_body: Pose3,
+    last_odom_t_body: Option<Pose3>,
+    candidate: Option<Candidate>,
+    health: LocalisationHealth,
+}
+
+impl<R: Registrator> Localiser<R> {
+    pub(crate) fn new(
+        registrator: R,
+        map: R::Target,
+        map_t_body: Pose3,
+        config: LocaliserConfig,
+    ) -> Self {
+        Self {
+            config,
+            registrator,
+            map,
+            map_t_body,
+            last_odom_t_body: None,
+            candidate: None,
+            health: LocalisationHealth::default(),
+        }
+    }
+
+    pub(crate) fn pose(&self) -> Pose3 {
+        self.map_t_body
+    }
+
+    pub(crate) fn health(&self) -> LocalisationHealth {
+        self.health
+    }
+
+    /// Whether `a` counts as a good registration.
+    fn good(&self, a: &Alignment) -> bool {
+        a.converged && a.inlier_ratio >= self.config.min_inlier_ratio
+    }
+
+    /// Predict from the odometry, correct by registering `sample`'s scan, track the health,
+    /// and search wide when the robot seems lost.
+    pub(crate) fn update(&mut self, sample: &Sample) -> LocalisationStatus {
+        if let Some(last) = self.last_odom_t_body.replace(sample.odom_t_body) {
+            self.map_t_body *= last.inverse() * sample.odom_t_body;
+        }
+        let Ok(source) = self.registrator.prepare_source(&sample.cloud) else {
+            return self.failed();
+        };
+        let guess = self.map_t_body * sample.body_t_lidar;
+        let aligned = self.registrator.align(&source, &self.map, &guess);
+        if let Ok(a) = &aligned {
+            self.health.converged = a.converged;
+            self.health.inlier_ratio = a.inlier_ratio;
+            self.health.min_eigenvalue_ratio = a.min_eigenvalue_ratio;
+        } else {
+            self.health.converged = false;
+        }
+        let Some(corrected) = aligned
+            .ok()
+            .filter(|a| self.good(a))
+            .map(|a| a.pose * sample.body_t_lidar.inverse())
+        else {
+            return self.failed_with(sample, &source);
+        };
+        let jump = self.map_t_body.inverse() * corrected;
+        let small = jump.translation.vector.norm() <= self.config.max_correction
+            && jump.rotation.angle() <= self.config.max_correction_angle;
+        if small {
+            return self.accept(corrected, LocalisationStatus::Corrected);
+        }
+        // A large correction: taken once consecutive scans agree on it.
+        let count = match self.candidate {
+            Some(c) if c.agrees(&corrected, &sample.odom_t_body) => c.count + 1,
+            _ => 1,
+        };
+        self.candidate = Some(Candidate {
+            map_t_body: corrected,
+            odom_t_body: sample.odom_t_body,
+            count,
+        });
+        if count >= self.config.confirm_after {
+            self.health.confirmed_jumps += 1;
+            return self.accept(corrected, LocalisationStatus::Corrected);
+        }
+        self.failed_with(sample, &source)
+    }
+
+    fn accept(&mut self, pose: Pose3, status: LocalisationStatus) -> LocalisationStatus {
+        self.map_t_body = pose;
+        self.candidate = None;
+        self.health.consecutive_failures = 0;
+        self.health.searches = 0;
+        status
+    }
+
+    /// A scan that did not correct the estimate and whose source could not be prepared.
+    fn failed(&mut self) -> LocalisationStatus {
+        self.health.failures += 1;
+        self.health.consecutive_failures += 1;
+        if self.health.consecutive_failures >= self.config.lost_after {
+            self.health.searches += 1;
+            if self.health.searches >= self.config.max_searches {
+                return LocalisationStatus::Lost;
+            }
+            return LocalisationStatus::Searching;
+        }
+        LocalisationStatus::Predicted
+    }
+
+    /// A scan that did not correct the estimate: after `lost_after` in a row, search wide.
+    fn failed_with(&mut self, sample: &Sample, source: &R::Source) -> LocalisationStatus {
+        self.health.failures += 1;
+        self.health.consecutive_failures += 1;
+        if self.health.consecutive_failures < self.config.lost_after {
+            return LocalisationStatus::Predicted;
+        }
+        if let Some(found) = self.search(sample, source) {
+            self.health.relocalisations += 1;
+            return self.accept(found, LocalisationStatus::Relocalised);
+        }
+        self.health.searches += 1;
+        if self.health.searches >= self.config.max_searches {
+            LocalisationStatus::Lost
+        } else {
+            LocalisationStatus::Searching
+        }
+    }
+
+    /// The best-matching body pose among seeds around the estimate, when it is good enough.
+    fn search(&self, sample: &Sample, source: &R::Source) -> Option<Pose3> {
+        let c = &self.config;
+        let steps = |half: f64, step: f64| {
+            let n = (half / step).floor() as i64;
+            (-n..=n).map(move |k| k as f64 * step)
+        };
+        let mut best: Option<(f64, f64, Pose3)> = None;
+        for dx in steps(c.search_radius, c.search_step) {
+            for dy in steps(c.search_radius, c.search_step) {
+                for da in steps(c.search_angle, c.search_angle_step) {
+                    let t = self.map_t_body.translation.vector + Vector3::new(dx, dy, 0.0);
+                    let seed = Pose3::from_parts(
+                        Translation3::from(t),
+                        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), da)
+                            * self.map_t_body.rotation,
+                    );
+                    let Ok(a) =
+                        self.registrator
+                            .align(source, &self.map, &(seed * sample.body_t_lidar))
+                    else {
+                        continue;
+                    };
+                    if !a.converged || a.inlier_ratio < c.relocalise_min_inlier_ratio {
+                        continue;
+                    }
+                    let better = best.as_ref().is_none_or(|&(ratio, rmse, _)| {
+                        a.inlier_ratio > ratio + 1e-9
+                            || ((a.inlier_ratio - ratio).abs() <= 1e-9 && a.rmse < rmse)
+                    });
+                    if better {
+                        best = Some((
+                            a.inlier_ratio,
+                            a.rmse,
+                            a.pose * sample.body_t_lidar.inverse(),
+                        ));
+                    }
+                }
+            }
+        }
+        best.map(|(_, _, pose)| pose)
+    }
+}

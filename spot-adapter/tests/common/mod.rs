@@ -1,0 +1,136 @@
+//! What the navigation tests share: a building's map from true-pose scans, random reachable
+//! goals, and a navigator on a commanded Spot driven through the `Robot` interface.
+#![allow(dead_code, clippy::unwrap_used)]
+
+use nalgebra::Vector2;
+use slam_core::PointCloud;
+use spot_adapter::nav::{
+    DriveOutcome, NavigationStep, Navigator, NavigatorConfig, drive, navigation_grid,
+};
+use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::robot::Robot;
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot,
+    SimulationConfig,
+};
+
+/// The building of `seed` and a map of it: every 4th scan of one lap of its corridor loop (with
+/// the noise of seed 0), at its true pose, thinned to 5 cm.
+pub fn building_and_map(seed: u64) -> (Building, PointCloud) {
+    let building = Building::generate(seed, &BuildingConfig::default()).unwrap();
+    let lap = Route::corridor_loop(&building);
+    let sim = SimulatedSpot::new(building, &lap, &SimulationConfig::default()).unwrap();
+    let building = sim.building().clone();
+    let body_t_lidar = sim.body_t_lidar();
+    let mut points = Vec::new();
+    for sample in sim.step_by(4) {
+        let world_t_lidar = sample.ground_truth.unwrap() * body_t_lidar;
+        points.extend_from_slice(sample.cloud.transformed(&world_t_lidar).points());
+    }
+    let map = PointCloud::from_points(points)
+        .voxel_downsample(0.05)
+        .unwrap();
+    (building, map)
+}
+
+/// `count` goals drawn in rooms and corridors of `building`: at least 0.6 m from every
+/// obstacle, on floor the map saw (a floor point of `map` within 0.25 m), each reachable with
+/// Spot's clearance from the one before (the first from `start`).
+pub fn random_goals(
+    building: &Building,
+    map: &PointCloud,
+    start: Vector2<f64>,
+    count: usize,
+    seed: u64,
+) -> Vec<Vector2<f64>> {
+    let floor: Vec<Vector2<f64>> = map
+        .points()
+        .iter()
+        .filter(|p| p.z < 0.1)
+        .map(|p| Vector2::new(f64::from(p.x), f64::from(p.y)))
+        .collect();
+    let cell = 0.25;
+    let key = |p: Vector2<f64>| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let seen: std::collections::HashSet<(i64, i64)> = floor.iter().map(|&p| key(p)).collect();
+    let mut rng = SimRng::new(seed, 0x90a1);
+    let mut goals = Vec::with_capacity(count);
+    let mut from = start;
+    let size = building.size();
+    while goals.len() < count {
+        let p = Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
+        let observed = seen.contains(&key(p));
+        if observed
+            && building.clearance(p) >= 0.6
+            && (p - from).norm() > 2.0
+            && Route::between(building, from, p, &RouteConfig::default()).is_ok()
+        {
+            goals.push(p);
+            from = p;
+        }
+    }
+    goals
+}
+
+/// One leg of a multi-goal run, measured on the ground truth.
+#[derive(Clone, Debug)]
+pub struct Leg {
+    pub goal: Vector2<f64>,
+    pub outcome: DriveOutcome,
+    /// True distance from the goal at the end (metres).
+    pub error: f64,
+    pub collisions: usize,
+    pub cycles: usize,
+    pub walked: f64,
+    /// Largest localisation error on the leg (metres).
+    pub worst_localisation: f64,
+}
+
+/// Drives a commanded Spot from `start` (facing `yaw`) through `goals` in turn on `map`, each
+/// leg starting where the last ended, at most `cycles` scans a leg.
+pub fn run_legs(
+    building: &Building,
+    map: &PointCloud,
+    start: Vector2<f64>,
+    yaw: f64,
+    goals: &[Vector2<f64>],
+    cycles: usize,
+    config: &NavigatorConfig,
+) -> Vec<Leg> {
+    let sim = SimulationConfig::default();
+    let mut spot = CommandedSpot::new(building.clone(), start, yaw, &sim).unwrap();
+    let lidar_height = sim.spot.body_height + sim.spot.body_t_lidar.translation.z;
+    let grid = navigation_grid(map, lidar_height, config).unwrap();
+    let mut nav = Navigator::new(
+        point_to_plane_tracker(),
+        map,
+        &grid,
+        spot.body_pose(),
+        spot.description(),
+        config.clone(),
+    )
+    .unwrap();
+    let mut legs = Vec::new();
+    for &goal in goals {
+        let collisions_before = spot.collisions();
+        let (mut worst, mut walked) = (0.0f64, 0.0);
+        let mut last: Option<Vector2<f64>> = None;
+        let report = drive(&mut spot, &mut nav, goal, cycles, |cycle| {
+            let truth = cycle.sample.ground_truth.unwrap().translation.vector.xy();
+            worst = worst.max((cycle.estimate.translation.vector.xy() - truth).norm());
+            walked += last.map_or(0.0, |p| (truth - p).norm());
+            last = Some(truth);
+            let _ = matches!(cycle.step, NavigationStep::Walk(_));
+        })
+        .unwrap();
+        legs.push(Leg {
+            goal,
+            outcome: report.outcome,
+            error: (spot.position() - goal).norm(),
+            collisions: spot.collisions() - collisions_before,
+            cycles: report.cycles,
+            walked,
+            worst_localisation: worst,
+        });
+    }
+    legs
+}
