@@ -261,6 +261,11 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         }
         let Some(waypoints) = self.plan(position, target)? else {
             self.waypoints.clear();
+            // "No path" from an estimate the last scan did not confirm may be the estimate's
+            // fault: stand and localise first.
+            if self.localiser.health().consecutive_failures > 0 {
+                return Ok(NavigationStep::Hold);
+            }
             return Ok(NavigationStep::NoPath);
         };
         self.waypoints = waypoints;

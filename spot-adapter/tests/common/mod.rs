@@ -3,7 +3,7 @@
 #![allow(dead_code, clippy::unwrap_used)]
 
 use nalgebra::Vector2;
-use slam_core::PointCloud;
+use slam_core::{PointCloud, Pose3};
 use spot_adapter::nav::{
     DriveOutcome, NavigationStep, Navigator, NavigatorConfig, drive, navigation_grid,
 };
@@ -81,8 +81,10 @@ pub struct Leg {
     pub collisions: usize,
     pub cycles: usize,
     pub walked: f64,
-    /// Largest localisation error on the leg (metres).
+    /// Largest localisation error on the leg (metres) above 5 cm, or 0.
     pub worst_localisation: f64,
+    /// The cycle from which the localisation error stayed under 5 cm, if it did.
+    pub localised_after: Option<usize>,
 }
 
 /// Drives a commanded Spot from `start` (facing `yaw`) through `goals` in turn on `map`, each
@@ -95,6 +97,7 @@ pub fn run_legs(
     goals: &[Vector2<f64>],
     cycles: usize,
     config: &NavigatorConfig,
+    kidnap: &Pose3,
 ) -> Vec<Leg> {
     let sim = SimulationConfig::default();
     let mut spot = CommandedSpot::new(building.clone(), start, yaw, &sim).unwrap();
@@ -104,7 +107,8 @@ pub fn run_legs(
         point_to_plane_tracker(),
         map,
         &grid,
-        spot.body_pose(),
+        // The estimate starts `kidnap` away from the truth.
+        spot.body_pose() * kidnap,
         spot.description(),
         config.clone(),
     )
@@ -114,12 +118,20 @@ pub fn run_legs(
         let collisions_before = spot.collisions();
         let (mut worst, mut walked) = (0.0f64, 0.0);
         let mut last: Option<Vector2<f64>> = None;
+        let (mut cycle_count, mut localised_from) = (0usize, None);
         let report = drive(&mut spot, &mut nav, goal, cycles, |cycle| {
+            cycle_count += 1;
             let truth = cycle.sample.ground_truth.unwrap().translation.vector.xy();
-            worst = worst.max((cycle.estimate.translation.vector.xy() - truth).norm());
+            let error = (cycle.estimate.translation.vector.xy() - truth).norm();
+            // Localised from the first cycle after which the error stays under 5 cm.
+            if error < 0.05 {
+                localised_from.get_or_insert(cycle_count);
+            } else {
+                localised_from = None;
+                worst = worst.max(error);
+            }
             walked += last.map_or(0.0, |p| (truth - p).norm());
             last = Some(truth);
-            let _ = matches!(cycle.step, NavigationStep::Walk(_));
         })
         .unwrap();
         legs.push(Leg {
@@ -130,6 +142,7 @@ pub fn run_legs(
             cycles: report.cycles,
             walked,
             worst_localisation: worst,
+            localised_after: localised_from,
         });
     }
     legs
