@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{building_and_map, random_goals, run_legs};
+use common::{Start, building_and_map, random_goals, run_legs};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 use spot_adapter::nav::{DriveOutcome, NavigatorConfig};
@@ -18,12 +18,10 @@ fn twenty_goals(seed: u64) -> (usize, usize) {
     let legs = run_legs(
         &building,
         &map,
-        start,
-        0.0,
+        &Start::at(start),
         &goals,
         1500,
         &NavigatorConfig::default(),
-        &Pose3::identity(),
     );
     let mut reached = 0;
     let mut collisions = 0;
@@ -81,15 +79,17 @@ fn kidnapped(seed: u64) {
         Translation3::new(0.3, 0.4, 0.0),
         UnitQuaternion::from_euler_angles(0.0, 0.0, 10f64.to_radians()),
     );
+    let start = Start {
+        kidnap,
+        ..Start::at(start)
+    };
     let legs = run_legs(
         &building,
         &map,
-        start,
-        0.0,
+        &start,
         &goals,
         1500,
         &NavigatorConfig::default(),
-        &kidnap,
     );
     let leg = &legs[0];
     eprintln!("seed {seed} kidnapped: {leg:?}");

@@ -4,9 +4,7 @@
 
 use nalgebra::Vector2;
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::nav::{
-    DriveOutcome, NavigationStep, Navigator, NavigatorConfig, drive, navigation_grid,
-};
+use spot_adapter::nav::{DriveOutcome, Navigator, NavigatorConfig, drive, navigation_grid};
 use spot_adapter::pipelines::point_to_plane_tracker;
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
@@ -87,20 +85,38 @@ pub struct Leg {
     pub localised_after: Option<usize>,
 }
 
-/// Drives a commanded Spot from `start` (facing `yaw`) through `goals` in turn on `map`, each
-/// leg starting where the last ended, at most `cycles` scans a leg.
+/// Where a run starts: the true position and heading, and how far the navigator's first
+/// estimate is off (`true_pose * kidnap`).
+pub struct Start {
+    pub position: Vector2<f64>,
+    pub yaw: f64,
+    pub kidnap: Pose3,
+}
+
+impl Start {
+    /// At `position` facing east, the estimate exact.
+    pub fn at(position: Vector2<f64>) -> Self {
+        Self {
+            position,
+            yaw: 0.0,
+            kidnap: Pose3::identity(),
+        }
+    }
+}
+
+/// Drives a commanded Spot from `start` through `goals` in turn on `map`, each leg starting
+/// where the last ended, at most `cycles` scans a leg.
 pub fn run_legs(
     building: &Building,
     map: &PointCloud,
-    start: Vector2<f64>,
-    yaw: f64,
+    start: &Start,
     goals: &[Vector2<f64>],
     cycles: usize,
     config: &NavigatorConfig,
-    kidnap: &Pose3,
 ) -> Vec<Leg> {
+    let kidnap = &start.kidnap;
     let sim = SimulationConfig::default();
-    let mut spot = CommandedSpot::new(building.clone(), start, yaw, &sim).unwrap();
+    let mut spot = CommandedSpot::new(building.clone(), start.position, start.yaw, &sim).unwrap();
     let lidar_height = sim.spot.body_height + sim.spot.body_t_lidar.translation.z;
     let grid = navigation_grid(map, lidar_height, config).unwrap();
     let mut nav = Navigator::new(
