@@ -1,46 +1,53 @@
-//! The main job, on a simulated Spot: map an unknown building, then walk from A to B in it with no
-//! recorded route.
+//! The main job, on a simulated Spot: map an unknown building, then walk to goals in it with no
+//! recorded route, around obstacles dropped after mapping.
 //!
 //! 1. Mapping: Spot walks one lap of the generated building's corridor loop while the Graph-SLAM
 //!    engine maps it (point-to-plane ICP or LOAM odometry, loop closure, Levenberg-Marquardt).
 //! 2. Navigation: from where the lap ended, the `Navigator` walks the robot (a `CommandedSpot`
-//!    that moves only as commanded, with drifting odometry) to a goal on the map: each scan it
-//!    localises against the map, replans with Jump Point Search on the map's inflated occupancy
-//!    grid and follows the filtered waypoints.
+//!    that moves only as commanded, with drifting odometry) to each goal in turn: each scan it
+//!    localises against the map, replans on the map's inflated occupancy grid and follows the
+//!    filtered waypoints. Boxes are dropped on the routes of some legs after mapping.
 //!
-//! Prints the mapping accuracy and the navigation result against the simulator's ground truth.
-//! With no goal it walks into the room whose door is farthest from the start.
-//!
-//! `cargo run --release --example mission -- [--seed N] [--registration p2plane|loam]
-//! [--goal X,Y] [--out DIR]` (the goal in metres in the map frame, which is where the lap
-//! started, x ahead; `--out` writes the map (PLY) and the grid with the walked path (PNG)).
-//! Exits with status 1 when the robot does not arrive (no path, or the scan limit) or collides.
+//! Prints the mapping accuracy and each leg's result against the simulator's ground truth and
+//! writes them to `--out` (default `mission-out/`): `map.ply`, `grid.png`, `map.yaml` +
+//! `map.pgm` (ROS `map_server`), `estimate.tum` and `ground_truth.tum` (body poses in the map
+//! frame), `summary.json`. Exits with status 1 when a goal was not reached.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::Parser;
-use nalgebra::{Point3, Vector2};
-use registration::PointToPlaneIcp;
-use slam_core::io::{PlyEncoding, write_ply};
-use slam_core::{BitGrid, Cell, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
-use spot_adapter::nav::{NavigationStep, Navigator, NavigatorConfig, navigation_grid};
+use clap::{Parser, ValueEnum};
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
+use serde::Serialize;
+use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
+use spot_adapter::nav::{
+    Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind, navigation_grid,
+};
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
-use spot_adapter::robot::{Robot, VelocityCommand};
-use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
-use spot_nav_examples::{Progress, Registration, Timings, map_and_evaluate, out, parse_goal};
+use spot_adapter::robot::{MobilityCommand, Robot};
+use spot_adapter::sim::{
+    BoxKind, Building, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot, SimulationConfig,
+    SolidBox,
+};
+use spot_nav_examples::picture::{self, Overlay};
+use spot_nav_examples::{
+    Progress, Registration, Timings, map_and_evaluate, out, parse_goal, parse_numbers, value_name,
+};
 
-/// The main job on a simulated Spot: map an unknown building, then walk to a goal in it.
+/// The main job on a simulated Spot: map an unknown building, then walk to goals in it.
 ///
 /// Maps the generated building with Graph-SLAM in one lap of its corridor loop, then walks from
-/// where the lap ended to a goal on that map with no recorded route (localising against the map
-/// each scan, replanning with Jump Point Search on its inflated occupancy grid). Prints the mapping accuracy and the navigation result against the simulator's ground truth.
-/// Without `--goal` the robot walks into the room whose door is farthest from the start. Fails
-/// when the robot does not arrive (no path on the map, or the scan limit) or collides.
+/// where the lap ended to each goal in turn on that map with no recorded route (localising
+/// against the map each scan, replanning on its inflated occupancy grid), around boxes dropped
+/// on the routes after mapping. Prints the mapping accuracy and every leg's result against the
+/// simulator's ground truth, and writes the map, the grid picture, the ROS map, the
+/// trajectories and `summary.json` to `--out`. Fails when a goal is not reached within 0.10 m
+/// (by the ground truth) or the robot collides.
 #[derive(Debug, Parser)]
 #[command(name = "mission")]
 struct Args {
@@ -52,26 +59,76 @@ struct Args {
         default_value_t = 3
     )]
     seed: u64,
+    /// Random reachable goals to visit (from a fixed generator seeded by `--seed`), when no
+    /// `--goal` is given.
+    #[arg(
+        long,
+        value_name = "K",
+        allow_negative_numbers = true,
+        default_value_t = 5
+    )]
+    goals: usize,
+    /// A goal in metres in the map frame (where the lap started, x ahead); repeat for several,
+    /// visited in order. Replaces the random goals.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = parse_goal)]
+    goal: Vec<Vector2<f64>>,
+    /// Boxes dropped on the routes of as many legs after mapping (never on the first).
+    #[arg(
+        long,
+        value_name = "M",
+        allow_negative_numbers = true,
+        default_value_t = 1
+    )]
+    obstacles: usize,
+    /// Start navigating with the estimate this far off the truth: metres, degrees.
+    #[arg(long, value_name = "METRES,DEGREES", allow_hyphen_values = true, value_parser = parse_numbers::<2>)]
+    kidnap: Option<[f64; 2]>,
     /// Odometry and loop refinement backend of the mapping lap.
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
     registration: Registration,
-    /// The goal in metres in the map frame (where the lap started, x ahead) [default: the
-    /// entry of the room farthest from the start].
-    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = parse_goal)]
-    goal: Option<Vector2<f64>>,
-    /// Write the map (`map.ply`) and the grid with the walked cells (`grid.png`) to this folder.
-    #[arg(long, value_name = "DIR")]
-    out: Option<PathBuf>,
+    /// The navigator's planner.
+    #[arg(long, value_enum, default_value_t = PlannerChoice::Jps)]
+    planner: PlannerChoice,
+    /// Where the outputs go.
+    #[arg(long, value_name = "DIR", default_value = "mission-out")]
+    out: PathBuf,
 }
 
-/// Scans the navigation may take before it gives up (5 minutes at 5 Hz).
+/// `--planner`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum PlannerChoice {
+    /// Jump Point Search.
+    Jps,
+    /// A* with the octile heuristic.
+    Astar,
+}
+
+/// Scans a leg may take before the robot gives up (5 minutes at 5 Hz).
 const MAX_CYCLES: usize = 1500;
+
+/// A goal counts as reached within this distance of the true body (metres).
+const REACHED_WITHIN: f64 = 0.10;
 
 /// The map and where the robot ended, from one mapped lap.
 struct Mapped {
     map: PointCloud,
     /// The engine's estimate of the body at the last scan (map frame).
     map_t_body: Pose3,
+    summary: MappingSummary,
+}
+
+/// The mapping lap's figures (`summary.json`'s `mapping`).
+#[derive(Clone, Debug, Serialize)]
+struct MappingSummary {
+    scans: usize,
+    keyframes: usize,
+    loops_closed: usize,
+    lap_length_m: f64,
+    ate_m: f64,
+    loop_end_point_error_m: f64,
+    segment_drift_percent: Option<f64>,
+    mean_ms_per_scan: f64,
+    seconds: f64,
 }
 
 /// Walks one lap of `sim` through `slam`, prints the mapping figures, returns the map.
@@ -102,137 +159,247 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     Ok(Mapped {
         map: slam.map(0.05)?,
         map_t_body: map_t_lidar * body_t_lidar.inverse(),
+        summary: MappingSummary {
+            scans: report.scans,
+            keyframes: report.keyframes,
+            loops_closed: report.loops_closed,
+            lap_length_m: e.end_point.path_length,
+            ate_m: e.ate.rmse,
+            loop_end_point_error_m: e.loop_end_point_error,
+            segment_drift_percent: e.segments.as_ref().map(|s| 100.0 * s.translation),
+            mean_ms_per_scan: report.mean_scan_ms(),
+            seconds: mapping.seconds,
+        },
     })
 }
 
-/// How the navigation ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Outcome {
-    Arrived,
-    GaveUp,
-    NoPath,
-    Blocked,
-    Lost,
+/// One leg's figures (`summary.json`'s `goals`).
+#[derive(Clone, Debug, Serialize)]
+struct LegSummary {
+    /// The goal in the map frame (metres).
+    goal: [f64; 2],
+    /// `arrived`, `no_path`, `blocked`, `lost` or `gave_up`.
+    outcome: &'static str,
+    /// Arrived and within 0.10 m of the goal by the ground truth.
+    reached: bool,
+    final_error_m: f64,
+    collisions: usize,
+    cycles: usize,
+    walked_m: f64,
+    /// Length of the shortest collision-free route on the building's true floor plan.
+    shortest_m: Option<f64>,
+    localisation_error_max_m: f64,
+    cycle_ms_mean: f64,
+    cycle_ms_p99: f64,
+    cycle_ms_max: f64,
 }
 
-impl Outcome {
-    fn describe(self) -> &'static str {
-        match self {
-            Self::Arrived => "arrived",
-            Self::GaveUp => "gave up (scan limit)",
-            Self::NoPath => "no path on the map",
-            Self::Blocked => "blocked (no progress after backing off and retrying)",
-            Self::Lost => "lost (the robot could not be found on the map)",
-        }
+/// `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+struct Summary {
+    seed: u64,
+    registration: String,
+    planner: String,
+    kidnap: Option<[f64; 2]>,
+    mapping: MappingSummary,
+    /// Plan-view footprints of the dropped boxes in the map frame: min and max corners.
+    obstacles: Vec<[[f64; 2]; 2]>,
+    goals: Vec<LegSummary>,
+    reached: usize,
+    collisions: usize,
+}
+
+/// The world and map frames of the run: the map frame is the odometry frame of the lap, which
+/// starts at the first body pose.
+struct Frames {
+    world_t_map: Pose3,
+}
+
+impl Frames {
+    fn to_world(&self, p: Vector2<f64>) -> Vector2<f64> {
+        (self.world_t_map * Point3::new(p.x, p.y, 0.0)).coords.xy()
+    }
+
+    fn to_map(&self, p: Vector2<f64>) -> Vector2<f64> {
+        (self.world_t_map.inverse() * Point3::new(p.x, p.y, 0.0))
+            .coords
+            .xy()
     }
 }
 
-/// What the navigation did.
-struct Walk {
-    outcome: Outcome,
-    cycles: usize,
-    /// Metres walked (ground truth).
-    walked: f64,
-    /// Largest localisation error (metres, ground truth).
-    worst: f64,
-    /// Grid cells the robot stood in (ground truth).
-    trail: Vec<Cell>,
-    cycle_ms: Vec<f64>,
+/// `count` goals in the building (world frame): at least 0.6 m from every obstacle, in space
+/// the lap saw (a floor point of the map within 0.25 m), at least 5 m from the one before and
+/// reachable from it with Spot's clearance.
+fn random_goals(
+    building: &Building,
+    map: &PointCloud,
+    frames: &Frames,
+    start: Vector2<f64>,
+    count: usize,
+    seed: u64,
+) -> Result<Vec<Vector2<f64>>> {
+    let cell = 0.25;
+    let key = |p: Vector2<f64>| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let floor_z = -frames.world_t_map.translation.z;
+    let seen: std::collections::HashSet<(i64, i64)> = map
+        .points()
+        .iter()
+        .filter(|p| f64::from(p.z) < floor_z + 0.1)
+        .map(|p| key(frames.to_world(Vector2::new(f64::from(p.x), f64::from(p.y)))))
+        .collect();
+    let mut rng = SimRng::new(seed, 0x6041);
+    let mut goals: Vec<Vector2<f64>> = Vec::with_capacity(count);
+    let size = building.size();
+    for _ in 0..200_000 {
+        if goals.len() == count {
+            return Ok(goals);
+        }
+        let from = goals.last().copied().unwrap_or(start);
+        let p = Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
+        if seen.contains(&key(p))
+            && building.clearance(p) >= 0.6
+            && (p - from).norm() >= 5.0
+            && Route::between(building, from, p, &RouteConfig::default()).is_ok()
+        {
+            goals.push(p);
+        }
+    }
+    bail!("found only {} of {count} reachable goals", goals.len())
 }
 
-/// Runs `nav` on `spot` to `goal_map` (map frame; `goal_world` the same in the world, for the
-/// progress line) until it arrives, finds no path or reaches the scan limit.
-fn walk(
-    nav: &mut Navigator<'_, PointToPlaneIcp>,
+/// A 0.6 x 0.6 x 0.6 m box on the route from `from` to `goal` (world frame): halfway along it,
+/// shifted sideways as little as needed for the goal to stay reachable; `None` when no such
+/// place is 2 m from both ends.
+fn drop_box(building: &Building, from: Vector2<f64>, goal: Vector2<f64>) -> Option<SolidBox> {
+    let config = RouteConfig::default();
+    let route = Route::between(building, from, goal, &config).ok()?;
+    let at = route.point_at(0.5 * route.length());
+    if (at - from).norm() < 2.0 || (at - goal).norm() < 2.0 {
+        return None;
+    }
+    let ahead = route.point_at(0.5 * route.length() + 0.2) - at;
+    let side = Vector2::new(-ahead.y, ahead.x).normalize();
+    for shift in [0.0, 0.2, -0.2, 0.4, -0.4, 0.6, -0.6] {
+        let c = at + side * shift;
+        let solid = SolidBox {
+            min: Point3::new(c.x - 0.3, c.y - 0.3, 0.0),
+            max: Point3::new(c.x + 0.3, c.y + 0.3, 0.6),
+            kind: BoxKind::Obstacle,
+        };
+        let mut trial = building.clone();
+        if trial.add_box(solid).is_ok()
+            && trial.clearance(from) >= 0.5
+            && Route::between(&trial, from, goal, &config).is_ok()
+        {
+            return Some(solid);
+        }
+    }
+    None
+}
+
+/// What one leg did, measured on the ground truth.
+struct Leg {
+    outcome: &'static str,
+    cycles: usize,
+    walked: f64,
+    worst: f64,
+    cycle_ms: Vec<f64>,
+    planned: Vec<Vector2<f64>>,
+}
+
+/// Runs `nav` on `spot` to `goal` (map frame) until it arrives, stops or reaches the scan
+/// limit, through the `Robot` interface; appends the estimate and the truth (map frame).
+fn leg<R: Registrator>(
+    nav: &mut Navigator<'_, R>,
     spot: &mut CommandedSpot,
-    goal_map: Vector2<f64>,
-    goal_world: Vector2<f64>,
-    world_t_map: &Pose3,
-) -> Result<Walk> {
-    let mut sample = spot.sense();
-    let (mut walked, mut worst, mut cycles) = (0.0f64, 0.0f64, 0usize);
-    let mut trail: Vec<Cell> = Vec::new();
+    goal: Vector2<f64>,
+    frames: &Frames,
+    trajectories: &mut (Vec<StampedPose>, Vec<StampedPose>),
+    label: &str,
+) -> Result<Leg> {
+    let (mut walked, mut worst) = (0.0f64, 0.0f64);
+    let mut last: Option<Vector2<f64>> = None;
     let mut cycle_ms = Vec::new();
-    let mut progress = Progress::new("navigating", "scans", None);
-    let outcome = loop {
+    let mut planned = Vec::new();
+    let mut progress = Progress::new(label, "scans", None);
+    let goal_world = frames.to_world(goal);
+    let mut outcome = "gave_up";
+    for cycle in 0..MAX_CYCLES {
+        let sample = spot.next_sample()?;
         let t = Instant::now();
-        let step = nav.step(&sample, goal_map)?;
+        let step = nav.step(&sample, Goal::from(goal))?;
         cycle_ms.push(t.elapsed().as_secs_f64() * 1e3);
-        let truth_map = world_t_map.inverse() * sample.ground_truth.context("simulated")?;
+        let truth = frames.world_t_map.inverse() * sample.ground_truth.context("simulated")?;
+        let estimate = nav.pose();
         worst = worst.max(
-            (nav.pose().translation.vector - truth_map.translation.vector)
+            (estimate.translation.vector - truth.translation.vector)
                 .xy()
                 .norm(),
         );
-        if let Some(c) = nav.grid().cell_at(truth_map.translation.vector.xy()) {
-            trail.push(c);
+        walked += last.map_or(0.0, |p| (truth.translation.vector.xy() - p).norm());
+        last = Some(truth.translation.vector.xy());
+        trajectories.0.push(StampedPose {
+            stamp: sample.stamp,
+            pose: estimate,
+        });
+        trajectories.1.push(StampedPose {
+            stamp: sample.stamp,
+            pose: truth,
+        });
+        if planned.is_empty() && !nav.waypoints().is_empty() {
+            planned.push(estimate.translation.vector.xy());
+            planned.extend_from_slice(nav.waypoints());
         }
-        let command = match step {
-            NavigationStep::Walk(command) => Some(command),
-            NavigationStep::Hold => Some(VelocityCommand::default()),
-            _ => None,
-        };
-        match (step, command) {
-            (_, Some(command)) if cycles < MAX_CYCLES => {
-                let before = spot.position();
-                sample = spot.step(command);
-                walked += (spot.position() - before).norm();
-                cycles += 1;
-                progress.update(
-                    cycles as u64,
-                    format!(
-                        "{walked:.1} m walked, {:.1} m to go",
-                        (goal_world - spot.position()).norm()
-                    ),
-                );
+        match step {
+            NavigationStep::Walk(command) => spot.send(&MobilityCommand::Velocity(command))?,
+            NavigationStep::Hold => spot.stop()?,
+            other => {
+                outcome = match other {
+                    NavigationStep::Arrived => "arrived",
+                    NavigationStep::NoPath => "no_path",
+                    NavigationStep::Blocked => "blocked",
+                    _ => "lost",
+                };
+                spot.stop()?;
+                break;
             }
-            (_, Some(_)) => break Outcome::GaveUp,
-            (NavigationStep::Arrived, _) => break Outcome::Arrived,
-            (NavigationStep::Blocked, _) => break Outcome::Blocked,
-            (NavigationStep::Lost, _) => break Outcome::Lost,
-            _ => break Outcome::NoPath,
         }
-    };
+        progress.update(
+            cycle as u64 + 1,
+            format!(
+                "{walked:.1} m walked, {:.1} m to go",
+                (goal_world - spot.position()).norm()
+            ),
+        );
+    }
     progress.finish();
-    Ok(Walk {
+    Ok(Leg {
         outcome,
-        cycles,
+        cycles: cycle_ms.len(),
         walked,
         worst,
-        trail,
         cycle_ms,
+        planned,
     })
-}
-
-/// The map (PLY) and its grid with the inflated obstacles and the walked cells (PNG) in `dir`.
-fn write_outputs(
-    dir: &Path,
-    map: &PointCloud,
-    lidar_height: f64,
-    inflated: &BitGrid,
-    trail: &[Cell],
-) -> Result<()> {
-    std::fs::create_dir_all(dir)?;
-    write_ply(dir.join("map.ply"), map, PlyEncoding::BinaryLittleEndian)?;
-    let occupancy = gridmap::OccupancyGridBuilder::new(NavigatorConfig::default().grid)?
-        .build(map, lidar_height)?;
-    gridmap::write_png(dir.join("grid.png"), &occupancy, Some(inflated), trail, &[])?;
-    out!("wrote       {0}/map.ply, {0}/grid.png", dir.display())?;
-    Ok(())
 }
 
 fn main() -> ExitCode {
     spot_nav_examples::run(|| mission(&Args::parse()))
 }
 
+#[allow(clippy::too_many_lines)] // The mission reads top to bottom: map, goals, legs, outputs.
 fn mission(args: &Args) -> Result<()> {
     let seed = args.seed;
+    if args.goal.is_empty() && args.goals == 0 {
+        bail!("--goals 0 and no --goal: nothing to visit");
+    }
     let config = SimulationConfig::with_seed(seed);
     let sim = SimulatedSpot::corridor_loop(&config)?;
-    let building = sim.building().clone();
+    let mut building = sim.building().clone();
     let truth = sim.ground_truth();
-    // The map frame is the odometry frame, which starts at the first body pose.
-    let world_t_map = truth.first().context("empty lap")?.pose;
+    let frames = Frames {
+        world_t_map: truth.first().context("empty lap")?.pose,
+    };
     let lap_end = truth.last().context("empty lap")?.pose;
     out!(
         "building    seed {seed}: {:.1} x {:.1} m, {} rooms",
@@ -245,33 +412,53 @@ fn mission(args: &Args) -> Result<()> {
         Registration::Loam => map_building(loam_slam(slam_config()), sim)?,
     };
 
-    // Navigation, from where the lap ended.
+    // Goals (world frame) from where the lap ended.
     let start = lap_end.translation.vector.xy();
-    let goal_world = match args.goal {
-        Some(g) => (world_t_map * Point3::new(g.x, g.y, 0.0)).coords.xy(),
-        None => building
-            .rooms()
-            .iter()
-            .max_by(|a, b| (a.door - start).norm().total_cmp(&(b.door - start).norm()))
-            .context("the building has no room")?
-            .entry_point(),
+    let goals_world: Vec<Vector2<f64>> = if args.goal.is_empty() {
+        random_goals(&building, &mapped.map, &frames, start, args.goals, seed)?
+    } else {
+        args.goal.iter().map(|&g| frames.to_world(g)).collect()
     };
-    let goal_map = (world_t_map.inverse() * Point3::new(goal_world.x, goal_world.y, 0.0))
-        .coords
-        .xy();
-    let mut spot = CommandedSpot::new(building, start, lap_end.rotation.euler_angles().2, &config)?;
+    let goals: Vec<Vector2<f64>> = goals_world.iter().map(|&g| frames.to_map(g)).collect();
+    // Legs that get a box on their route: spread over the legs after the first.
+    let boxed: Vec<usize> = (0..args.obstacles.min(goals.len().saturating_sub(1)))
+        .map(|k| 1 + k * (goals.len() - 1) / args.obstacles.max(1))
+        .collect();
+
+    let mut spot = CommandedSpot::new(
+        building.clone(),
+        start,
+        lap_end.rotation.euler_angles().2,
+        &config,
+    )?;
     // The map frame's origin is the body at the lap's start: the LiDAR sits its mounting height
     // above it.
     let lidar_height = config.spot.body_t_lidar.translation.z;
+    let nav_config = NavigatorConfig {
+        planner: match args.planner {
+            PlannerChoice::Jps => PlannerKind::JumpPointSearch,
+            PlannerChoice::Astar => PlannerKind::AStar,
+        },
+        ..NavigatorConfig::default()
+    };
     let started = Instant::now();
-    let grid = navigation_grid(&mapped.map, lidar_height, &NavigatorConfig::default())?;
+    let grid = navigation_grid(&mapped.map, lidar_height, &nav_config)?;
+    let kidnap = args
+        .kidnap
+        .map_or_else(Pose3::identity, |[metres, degrees]| {
+            let d = 30f64.to_radians();
+            Pose3::from_parts(
+                Translation3::new(metres * d.cos(), metres * d.sin(), 0.0),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, degrees.to_radians()),
+            )
+        });
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         &mapped.map,
         &grid,
-        mapped.map_t_body,
+        mapped.map_t_body * kidnap,
         spot.description(),
-        NavigatorConfig::default(),
+        nav_config,
     )?;
     out!(
         "grid        {} x {} cells of {:.2} m, obstacles inflated by {:.2} m ({:.1} s)",
@@ -281,45 +468,149 @@ fn mission(args: &Args) -> Result<()> {
         NavigatorConfig::default().clearance,
         started.elapsed().as_secs_f64()
     )?;
-    out!(
-        "goal        ({:.2}, {:.2}) m in the map frame, {:.1} m from the start as the crow flies",
-        goal_map.x,
-        goal_map.y,
-        (goal_world - start).norm()
-    )?;
-    let walk = walk(&mut nav, &mut spot, goal_map, goal_world, &world_t_map)?;
-    let cycles = Timings::new(walk.cycle_ms.iter().copied()).context("no navigation cycle")?;
-    let to_goal = (goal_world - spot.position()).norm();
-    out!(
-        "navigation  {} after {} scans ({:.1} s walking), {:.1} m walked; ends {to_goal:.3} m from the goal (ground truth)",
-        walk.outcome.describe(),
-        walk.cycles,
-        walk.cycles as f64 / config.lidar.rotation_rate,
-        walk.walked,
-    )?;
-    out!(
-        "            collisions {}, localisation error up to {:.3} m, {} registrations fell back to odometry; {:.1} ms mean, {:.1} ms max per cycle",
-        spot.collisions(),
-        walk.worst,
-        nav.localisation_failures(),
-        cycles.mean(),
-        cycles.max()
-    )?;
-    if let Some(dir) = &args.out {
-        write_outputs(dir, &mapped.map, lidar_height, nav.grid(), &walk.trail)?;
+
+    let mut trajectories = (Vec::new(), Vec::new());
+    let mut overlay = Overlay {
+        start: Some(frames.to_map(start)),
+        goals: goals.clone(),
+        ..Overlay::default()
+    };
+    let mut legs = Vec::new();
+    let mut obstacles = Vec::new();
+    for (k, (&goal, &goal_world)) in goals.iter().zip(&goals_world).enumerate() {
+        let from = spot.position();
+        if boxed.contains(&k)
+            && let Some(solid) = drop_box(spot.building(), from, goal_world)
+        {
+            spot.building_mut().add_box(solid)?;
+            building.add_box(solid)?;
+            let (lo, hi) = (
+                frames.to_map(solid.min.coords.xy()),
+                frames.to_map(solid.max.coords.xy()),
+            );
+            let footprint = (lo.inf(&hi), lo.sup(&hi));
+            overlay.obstacles.push(footprint);
+            obstacles.push([footprint.0.into(), footprint.1.into()]);
+            out!(
+                "obstacle    0.6 m box dropped on leg {}'s route at ({:.1}, {:.1}) m (map frame)",
+                k + 1,
+                0.5 * (footprint.0.x + footprint.1.x),
+                0.5 * (footprint.0.y + footprint.1.y)
+            )?;
+        }
+        let shortest = Route::between(&building, from, goal_world, &RouteConfig::default())
+            .ok()
+            .map(|r| r.length());
+        let collisions_before = spot.collisions();
+        let label = format!("goal {}/{}", k + 1, goals.len());
+        let walk = leg(
+            &mut nav,
+            &mut spot,
+            goal,
+            &frames,
+            &mut trajectories,
+            &label,
+        )?;
+        let error = (spot.position() - goal_world).norm();
+        let collisions = spot.collisions() - collisions_before;
+        let times = Timings::new(walk.cycle_ms.iter().copied());
+        let summary = LegSummary {
+            goal: [goal.x, goal.y],
+            outcome: walk.outcome,
+            reached: walk.outcome == "arrived" && error <= REACHED_WITHIN,
+            final_error_m: error,
+            collisions,
+            cycles: walk.cycles,
+            walked_m: walk.walked,
+            shortest_m: shortest,
+            localisation_error_max_m: walk.worst,
+            cycle_ms_mean: times.as_ref().map_or(0.0, Timings::mean),
+            cycle_ms_p99: times.as_ref().map_or(0.0, |t| t.quantile(0.99)),
+            cycle_ms_max: times.as_ref().map_or(0.0, Timings::max),
+        };
+        out!(
+            "goal {:>2}     ({:6.2}, {:6.2}): {} after {} scans, {:.1} m walked (shortest {}), {:.3} m from the goal, {} collisions, localisation error up to {:.3} m, {:.1} ms mean per cycle",
+            k + 1,
+            goal.x,
+            goal.y,
+            summary.outcome,
+            summary.cycles,
+            summary.walked_m,
+            shortest.map_or_else(|| "-".to_owned(), |s| format!("{s:.1} m")),
+            error,
+            collisions,
+            summary.localisation_error_max_m,
+            summary.cycle_ms_mean
+        )?;
+        overlay.planned.push(walk.planned);
+        legs.push(summary);
     }
-    if walk.outcome != Outcome::Arrived {
+    overlay.walked = trajectories
+        .1
+        .iter()
+        .map(|p| p.pose.translation.vector.xy())
+        .collect();
+
+    let reached = legs.iter().filter(|l| l.reached).count();
+    let collisions = legs.iter().map(|l| l.collisions).sum();
+    let summary = Summary {
+        seed,
+        registration: value_name(&args.registration),
+        planner: value_name(&args.planner),
+        kidnap: args.kidnap,
+        mapping: mapped.summary.clone(),
+        obstacles,
+        goals: legs,
+        reached,
+        collisions,
+    };
+    write_outputs(
+        &args.out,
+        &mapped.map,
+        lidar_height,
+        nav.grid(),
+        &overlay,
+        &trajectories,
+        &summary,
+    )?;
+    out!(
+        "result      {reached} of {} goals reached within {REACHED_WITHIN} m, {collisions} collisions",
+        summary.goals.len()
+    )?;
+    if reached < summary.goals.len() || collisions > 0 {
         bail!(
-            "the robot did not reach the goal: {} after {} scans, {to_goal:.2} m from it",
-            walk.outcome.describe(),
-            walk.cycles
+            "{} of {} goals not reached, {collisions} collisions",
+            summary.goals.len() - reached,
+            summary.goals.len()
         );
     }
-    if spot.collisions() > 0 {
-        bail!(
-            "the robot arrived but collided {} times on the way",
-            spot.collisions()
-        );
-    }
+    Ok(())
+}
+
+/// Every output file in `dir`.
+fn write_outputs(
+    dir: &Path,
+    map: &PointCloud,
+    lidar_height: f64,
+    inflated: &slam_core::BitGrid,
+    overlay: &Overlay,
+    trajectories: &(Vec<StampedPose>, Vec<StampedPose>),
+    summary: &Summary,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_ply(dir.join("map.ply"), map, PlyEncoding::BinaryLittleEndian)?;
+    let occupancy = gridmap::OccupancyGridBuilder::new(NavigatorConfig::default().grid)?
+        .build(map, lidar_height)?;
+    picture::write_png(&dir.join("grid.png"), &occupancy, inflated, overlay)?;
+    gridmap::write_ros_map(&occupancy, dir.join("map.yaml"))?;
+    write_tum(dir.join("estimate.tum"), &trajectories.0)?;
+    write_tum(dir.join("ground_truth.tum"), &trajectories.1)?;
+    let json = serde_json::to_string_pretty(summary)?;
+    std::fs::write(dir.join("summary.json"), json + "\n")
+        .with_context(|| format!("writing {}/summary.json", dir.display()))?;
+    out!(
+        "wrote       {0}/map.ply, grid.png, map.yaml + map.pgm, estimate.tum, ground_truth.tum, summary.json",
+        dir.display()
+    )?;
     Ok(())
 }

@@ -22,13 +22,17 @@ pub enum Registration {
 /// `N` comma-separated numbers, e.g. `parse_numbers::<2>("1.5,-2")`.
 ///
 /// # Errors
-/// A message naming the count when there are not `N` fields or one is not a number.
+/// A message naming the count when there are not `N` fields, or the field that is not a finite
+/// number.
 pub fn parse_numbers<const N: usize>(text: &str) -> Result<[f64; N], String> {
     let values: Vec<f64> = text
         .split(',')
         .map(|field| field.trim().parse::<f64>())
         .collect::<Result<_, _>>()
         .map_err(|e| format!("{e} (expected {N} comma-separated numbers)"))?;
+    if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
+        return Err(format!("{bad} is not a finite number"));
+    }
     <[f64; N]>::try_from(values.as_slice()).map_err(|_| {
         format!(
             "expected {N} comma-separated numbers, found {}",

@@ -24,6 +24,7 @@ pub mod args;
 pub mod data;
 pub mod mapping;
 pub mod output;
+pub mod picture;
 pub mod progress;
 pub mod stats;
 

@@ -40,11 +40,17 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
         "mission",
         &[
             "--seed",
-            "--registration",
+            "--goals",
             "--goal",
+            "--obstacles",
+            "--kidnap",
+            "--registration",
+            "--planner",
             "--out",
             "p2plane",
             "loam",
+            "jps",
+            "astar",
         ],
     ),
     ("movingai", &["MAP", "SCEN", "--planner", "jps-plus", "all"]),
@@ -183,6 +189,10 @@ fn mission_rejects_a_malformed_seed_and_goal() {
     rejected("mission", &["--seed", "x"], "--seed");
     rejected("mission", &["--goal", "3"], "--goal");
     rejected("mission", &["--registration", "icp"], "--registration");
+    // A goal that is not a finite point is refused before anything is simulated.
+    rejected("mission", &["--goal", "nan,nan"], "--goal");
+    rejected("mission", &["--kidnap", "0.5"], "--kidnap");
+    rejected("mission", &["--goals", "-1"], "--goals");
 }
 
 #[test]

@@ -12,5 +12,7 @@ mod stuck;
 
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
-pub use navigator::{Goal, NavigationStep, Navigator, NavigatorConfig, navigation_grid};
+pub use navigator::{
+    Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind, navigation_grid,
+};
 pub use stuck::StuckConfig;

@@ -4,7 +4,7 @@
 
 use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
 use nalgebra::Vector2;
-use pathfind::{JumpPointSearch, filter_path};
+use pathfind::{AStar, JumpPointSearch, filter_path};
 use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
 
 use crate::error::AdapterError;
@@ -38,6 +38,8 @@ pub struct NavigatorConfig {
     pub speed: f64,
     /// Turn rate per radian of heading error, 1.5 /s (capped at the robot's limit).
     pub heading_gain: f64,
+    /// The planner on the navigation grid (Jump Point Search).
+    pub planner: PlannerKind,
     /// Localisation against the map: corrections, health, the wide search when lost.
     pub localiser: LocaliserConfig,
     /// What counts as stuck and how the robot gets free.
@@ -57,6 +59,7 @@ impl Default for NavigatorConfig {
             turn_in_place_above: 0.5,
             speed: 0.6,
             heading_gain: 1.5,
+            planner: PlannerKind::default(),
             localiser: LocaliserConfig::default(),
             stuck: StuckConfig::default(),
         }
@@ -107,6 +110,18 @@ pub fn navigation_grid(
         .and_then(|b| b.build(map, lidar_height))
         .map_err(AdapterError::NavigationGrid)?;
     Ok(inflate(occupancy.occupied(), config.clearance))
+}
+
+/// The shortest-path planner a [`Navigator`] uses; both are optimal on the grid, Jump Point
+/// Search is the faster (pathfind/README.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum PlannerKind {
+    /// [`JumpPointSearch`] with word scans.
+    #[default]
+    JumpPointSearch,
+    /// [`AStar`] with the octile heuristic.
+    AStar,
 }
 
 /// A goal: a plan-view position (map frame, metres) and, optionally, the heading to end with.
@@ -163,7 +178,7 @@ pub struct Navigator<'g, R: Registrator> {
     limits: MotionLimits,
     localiser: Localiser<R>,
     grid: &'g BitGrid,
-    planner: JumpPointSearch<'g>,
+    planner: Box<dyn Planner + 'g>,
     waypoints: Vec<Vector2<f64>>,
     stuck: StuckMonitor,
 }
@@ -193,10 +208,13 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone()),
             stuck: StuckMonitor::new(config.stuck.clone()),
+            planner: match config.planner {
+                PlannerKind::JumpPointSearch => Box::new(JumpPointSearch::new(grid)),
+                PlannerKind::AStar => Box::new(AStar::new(grid)),
+            },
             config,
             limits: robot.limits.clone(),
             grid,
-            planner: JumpPointSearch::new(grid),
             waypoints: Vec::new(),
         })
     }
