@@ -136,3 +136,40 @@ fn a_box_dropped_ahead_blocks_the_walk_but_not_the_turn() {
         "turned {turned} rad in 1 s at 0.5 rad/s"
     );
 }
+
+#[test]
+fn a_walker_crosses_the_corridor_to_and_fro_and_counts_when_it_walks_into_the_robot() {
+    let (mut spot, start, ahead) = spot();
+    let left = Vector2::new(-ahead.y, ahead.x);
+    // A person 2 m ahead, walking 1.2 m sideways and back at 1 m/s.
+    let from = start + 2.0 * ahead - 0.6 * left;
+    let to = start + 2.0 * ahead + 0.6 * left;
+    let half = Vector2::new(0.25, 0.25);
+    spot.add_walker(from, to, 1.0, half, 1.7).unwrap();
+    let mut seen = Vec::new();
+    for _ in 0..13 {
+        spot.next_sample().unwrap();
+        let b = spot.building().boxes().last().copied().unwrap();
+        seen.push(Vector2::new(
+            0.5 * (b.min.x + b.max.x),
+            0.5 * (b.min.y + b.max.y),
+        ));
+    }
+    // The first sample is taken standing; then 0.2 m per turn: at the far end after 6 turns,
+    // back at the start after 12.
+    assert!((seen[0] - from).norm() < 1e-9, "{}", seen[0]);
+    assert!((seen[6] - to).norm() < 1e-9, "{}", seen[6]);
+    assert!((seen[12] - from).norm() < 1e-9, "{}", seen[12]);
+    assert_eq!(spot.collisions(), 0, "it never came near the robot");
+    // One that walks across the robot's own position collides with it.
+    let (mut crossed, start, _) = crate::spot();
+    crossed
+        .add_walker(start - 0.8 * left, start + 0.8 * left, 1.0, half, 1.7)
+        .unwrap();
+    for _ in 0..10 {
+        crossed.next_sample().unwrap();
+    }
+    assert!(crossed.collisions() > 0);
+    assert!(crossed.add_walker(start, start, 1.0, half, 1.7).is_err());
+    assert!(crossed.add_walker(from, to, f64::NAN, half, 1.7).is_err());
+}

@@ -1,7 +1,7 @@
 //! A simulated Spot driven by motion commands: the closed-loop counterpart of
 //! [`SimulatedSpot`](crate::sim::SimulatedSpot), which walks a route fixed in advance.
 
-use nalgebra::{Translation3, UnitQuaternion, Vector2};
+use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::{Pose2, Pose3};
 
 use crate::error::AdapterError;
@@ -14,6 +14,36 @@ use crate::sim::lidar::Vlp16;
 use crate::sim::odometry::OdometryModel;
 use crate::sim::rng::SimRng;
 use crate::sim::simulated_spot::SimulationConfig;
+use crate::sim::solid_box::{BoxId, BoxKind, SolidBox};
+
+/// A box that walks to and fro along a segment (a person crossing a corridor), moved each
+/// LiDAR turn.
+#[derive(Clone, Debug)]
+struct Walker {
+    id: BoxId,
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+    speed: f64,
+    half_size: Vector2<f64>,
+    height: f64,
+    /// Arc length travelled, modulo a round trip.
+    travelled: f64,
+}
+
+impl Walker {
+    /// The box where the walker is after `travelled` metres.
+    fn solid(&self) -> SolidBox {
+        let length = (self.to - self.from).norm();
+        let s = self.travelled.rem_euclid(2.0 * length);
+        let along = if s <= length { s } else { 2.0 * length - s };
+        let c = self.from + (self.to - self.from) * (along / length);
+        SolidBox {
+            min: Point3::new(c.x - self.half_size.x, c.y - self.half_size.y, 0.0),
+            max: Point3::new(c.x + self.half_size.x, c.y + self.half_size.y, self.height),
+            kind: BoxKind::Obstacle,
+        }
+    }
+}
 
 /// The command a [`CommandedSpot`] is carrying out.
 #[derive(Clone, Debug)]
@@ -62,6 +92,7 @@ pub struct CommandedSpot {
     collisions: usize,
     active: Active,
     sensed: bool,
+    walkers: Vec<Walker>,
 }
 
 impl CommandedSpot {
@@ -103,6 +134,7 @@ impl CommandedSpot {
             collisions: 0,
             active: Active::Velocity(VelocityCommand::default()),
             sensed: false,
+            walkers: Vec::new(),
             lidar,
         })
     }
@@ -163,14 +195,71 @@ impl CommandedSpot {
         let next = self.world_t_body.translation.vector
             + chord(v) * Vector2::new(c, s)
             + chord(u) * Vector2::new(-s, c);
-        if self.building.clearance(next) >= self.description.geometry.half_width {
+        let half_width = self.description.geometry.half_width;
+        if self.building.clearance(next) >= half_width {
             self.world_t_body = Pose2::new(next, yaw + dyaw);
         } else {
             self.world_t_body = Pose2::new(self.world_t_body.translation.vector, yaw + dyaw);
             self.collisions += 1;
         }
+        if !self.walkers.is_empty() {
+            for walker in &mut self.walkers {
+                walker.travelled += walker.speed * dt;
+                // The walker exists (added with its id): moving it cannot fail.
+                let _ = self.building.move_box(walker.id, walker.solid());
+            }
+            // A walker that walks into the robot is a collision too.
+            if self.building.clearance(self.position()) < half_width {
+                self.collisions += 1;
+            }
+        }
         self.stamp += dt;
         self.sense()
+    }
+
+    /// A person-sized box (`half_size` half extents in x and y, `height` tall) that walks to and
+    /// fro between `from` and `to` at `speed` m/s, starting at `from`, moved each LiDAR turn;
+    /// the LiDAR sees it and the collision check counts it (also when it walks into the robot).
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for a speed that is not finite and positive or ends less
+    /// than 1 cm apart; [`AdapterError::InvalidBox`] for a malformed size.
+    pub fn add_walker(
+        &mut self,
+        from: Vector2<f64>,
+        to: Vector2<f64>,
+        speed: f64,
+        half_size: Vector2<f64>,
+        height: f64,
+    ) -> Result<BoxId, AdapterError> {
+        if !(speed.is_finite() && speed > 0.0) {
+            return Err(AdapterError::invalid(
+                "speed",
+                speed,
+                "finite and positive (m/s)",
+            ));
+        }
+        let length = (to - from).norm();
+        if !(length.is_finite() && length >= 0.01) {
+            return Err(AdapterError::invalid(
+                "walker path length",
+                length,
+                "finite and at least 0.01 m",
+            ));
+        }
+        let mut walker = Walker {
+            id: BoxId(0),
+            from,
+            to,
+            speed,
+            half_size,
+            height,
+            travelled: 0.0,
+        };
+        walker.id = self.building.add_box(walker.solid())?;
+        let id = walker.id;
+        self.walkers.push(walker);
+        Ok(id)
     }
 
     /// The body velocity that brings the reported odometry onto `trajectory`'s pose one turn
