@@ -189,6 +189,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .collect()
     }
 
+    /// Every keyframe's scan (voxel-filtered, in the LiDAR frame) with its optimised
+    /// `map_T_lidar`: the rays an occupancy grid's free space comes from.
+    pub fn keyframe_scans(&self) -> impl Iterator<Item = (Pose3, &PointCloud)> + '_ {
+        self.keyframes
+            .iter()
+            .enumerate()
+            .map(|(i, k)| (self.keyframe_pose(i), &k.cloud))
+    }
+
     /// The map: every keyframe cloud at its optimised pose, voxel-filtered at `voxel_size`.
     ///
     /// # Errors
