@@ -44,6 +44,7 @@ mod floor;
 mod fusion;
 mod occupancy;
 mod picture;
+mod planning;
 mod rays;
 mod ros_map;
 
@@ -56,4 +57,7 @@ pub use floor::{FloorConfig, FloorMap, floor_hints_below};
 pub use fusion::{FusionReport, LocalCell, LocalGrid, fuse_local_grid};
 pub use occupancy::{CellState, OccupancyGrid, UnknownCells};
 pub use picture::{colours, render, write_png};
+pub use planning::{
+    CellRect, ClearanceCostConfig, PlanningGrid, PlanningGridConfig, clearance_step_costs,
+};
 pub use ros_map::{read_ros_map, write_ros_map};
