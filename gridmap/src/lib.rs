@@ -42,6 +42,7 @@ mod distance;
 mod error;
 mod floor;
 mod fusion;
+mod live;
 mod occupancy;
 mod picture;
 mod planning;
@@ -55,6 +56,7 @@ pub use distance::{DistanceField, inflate, squared_distance_cells};
 pub use error::GridMapError;
 pub use floor::{FloorConfig, FloorMap, floor_hints_below};
 pub use fusion::{FusionReport, LocalCell, LocalGrid, fuse_local_grid};
+pub use live::{LiveLayer, LiveLayerConfig, LiveUpdate};
 pub use occupancy::{CellState, OccupancyGrid, UnknownCells};
 pub use picture::{colours, render, write_png};
 pub use planning::{
