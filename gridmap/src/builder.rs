@@ -56,7 +56,7 @@ impl OccupancyGridBuilder {
         &self.config
     }
 
-    fn check_cloud(cloud: &PointCloud) -> Result<(), GridMapError> {
+    pub(crate) fn check_cloud(cloud: &PointCloud) -> Result<(), GridMapError> {
         if cloud.is_empty() {
             return Err(GridMapError::EmptyCloud);
         }
@@ -85,7 +85,7 @@ impl OccupancyGridBuilder {
     }
 
     /// A grid over `extent` (min and max world x, y) with the configured margin.
-    fn empty_grid(
+    pub(crate) fn empty_grid(
         &self,
         min: Vector2<f64>,
         max: Vector2<f64>,
@@ -109,7 +109,7 @@ impl OccupancyGridBuilder {
     }
 
     /// Mark occupied every cell holding at least `min_points` of `points` (world x, y).
-    fn mark_occupied(
+    pub(crate) fn mark_occupied(
         &self,
         grid: &mut OccupancyGrid,
         points: &[Vector2<f64>],
@@ -222,7 +222,9 @@ impl OccupancyGridBuilder {
 }
 
 /// Smallest and largest x, y of `points`.
-fn extent(points: impl Iterator<Item = Vector2<f64>>) -> Option<(Vector2<f64>, Vector2<f64>)> {
+pub(crate) fn extent(
+    points: impl Iterator<Item = Vector2<f64>>,
+) -> Option<(Vector2<f64>, Vector2<f64>)> {
     points.fold(None, |acc, p| match acc {
         None => Some((p, p)),
         Some((lo, hi)) => Some((lo.inf(&p), hi.sup(&p))),

@@ -25,6 +25,25 @@ pub enum GridMapError {
         /// Upper bound of the slice.
         max_z: f64,
     },
+    /// No point lies in the obstacle band above the floor.
+    #[error("no point lies between {above_floor} m and {up_to} m above the floor")]
+    EmptyBand {
+        /// Lower bound of the band above the floor.
+        above_floor: f64,
+        /// Upper bound of the band above the floor.
+        up_to: f64,
+    },
+    /// A floor estimate needs at least one hint of where the floor is.
+    #[error("no floor hint given (points on the floor under the robot's poses)")]
+    NoFloorHint,
+    /// Updates of a live layer must come in time order.
+    #[error("stamp {stamp} s is before the previous update's {previous} s")]
+    StampOutOfOrder {
+        /// The previous update's stamp.
+        previous: f64,
+        /// The stamp given.
+        stamp: f64,
+    },
     /// A setting or argument is out of its valid range.
     #[error("{setting} = {value}: must be {expected}")]
     InvalidConfig {

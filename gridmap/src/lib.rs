@@ -35,20 +35,31 @@
 //! When not to use it: for 3D navigation (stairs, ramps, overhangs) a 2D slice is not enough; use
 //! an elevation map or a voxel map instead.
 
+mod band;
 mod builder;
 mod config;
 mod distance;
 mod error;
+mod floor;
 mod fusion;
+mod live;
 mod occupancy;
 mod picture;
+mod planning;
+mod rays;
 mod ros_map;
 
+pub use band::ObstacleBandConfig;
 pub use builder::OccupancyGridBuilder;
 pub use config::OccupancyGridConfig;
 pub use distance::{DistanceField, inflate, squared_distance_cells};
 pub use error::GridMapError;
+pub use floor::{FloorConfig, FloorMap, floor_hints_below};
 pub use fusion::{FusionReport, LocalCell, LocalGrid, fuse_local_grid};
+pub use live::{LiveLayer, LiveLayerConfig, LiveUpdate};
 pub use occupancy::{CellState, OccupancyGrid, UnknownCells};
 pub use picture::{colours, render, write_png};
+pub use planning::{
+    CellRect, ClearanceCostConfig, PlanningGrid, PlanningGridConfig, clearance_step_costs,
+};
 pub use ros_map::{read_ros_map, write_ros_map};

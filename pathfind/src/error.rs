@@ -16,6 +16,26 @@ pub enum PathfindError {
         /// The limit.
         max_side: u32,
     },
+    /// A per-cell cost array does not have one value per cell.
+    #[error("{got} cell costs for a {width}x{height} grid (one per cell expected)")]
+    CellCostCount {
+        /// Values given.
+        got: usize,
+        /// Grid width.
+        width: u32,
+        /// Grid height.
+        height: u32,
+    },
+    /// A free cell's cost multiplier is not finite or is below 1.
+    #[error("cell ({x}, {y}) has cost multiplier {value}: must be finite and at least 1")]
+    InvalidCellCost {
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// The multiplier given.
+        value: f64,
+    },
     /// A Moving AI file could not be parsed.
     #[error("line {line}: {message}")]
     Parse {

@@ -44,6 +44,7 @@
 mod astar;
 mod best_first;
 mod block_scan;
+mod cell_cost_astar;
 mod closed_set;
 mod components;
 mod cost;
@@ -61,6 +62,7 @@ mod path_filter;
 mod search_space;
 
 pub use astar::AStar;
+pub use cell_cost_astar::{CellCostAStar, CostedPath};
 pub use components::Components;
 pub use dijkstra::Dijkstra;
 pub use error::PathfindError;

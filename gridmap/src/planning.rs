@@ -1,0 +1,377 @@
+//! The grid a planner searches: hard inflation by the robot's half width plus a margin, and a
+//! clearance cost per cell from the distance field (the thesis' future work, f = g + h + o), kept
+//! up to date over a changed region at a cost bounded by the region's size.
+
+use slam_core::{BitGrid, Cell};
+
+use crate::distance::{DistanceField, squared_distance_cells};
+use crate::error::{GridMapError, check};
+use crate::occupancy::{CellState, OccupancyGrid, UnknownCells};
+
+/// The clearance cost: entering a cell `d` metres from the nearest obstacle costs the step's
+/// length times `1 + weight * penalty(d)`, with
+/// `penalty(d) = clamp((zero_beyond - d) / (zero_beyond - full_within), 0, 1)^2`:
+/// 1 at `full_within` and closer, falling to 0 at `zero_beyond` and beyond. Multipliers are at
+/// least 1, so a planner's octile heuristic stays admissible (pathfind's `CellCostAStar`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClearanceCostConfig {
+    /// Weight of the penalty (dimensionless), 2.0: a cell at `full_within` costs 3 times its
+    /// length; 0 turns the cost off (every multiplier 1: shortest paths).
+    pub weight: f64,
+    /// Distance (metres) at and below which the penalty is full, 0.30 m (the hard inflation: the
+    /// closest a free cell can be).
+    pub full_within: f64,
+    /// Distance (metres) at and beyond which the penalty is 0, 1.0 m: in corridors up to about
+    /// 2 m wide, paths keep to the middle.
+    pub zero_beyond: f64,
+}
+
+impl Default for ClearanceCostConfig {
+    fn default() -> Self {
+        Self {
+            weight: 2.0,
+            full_within: 0.30,
+            zero_beyond: 1.0,
+        }
+    }
+}
+
+impl ClearanceCostConfig {
+    /// Check the settings.
+    ///
+    /// # Errors
+    /// [`GridMapError::InvalidConfig`] unless `0 <= weight <= 1000`,
+    /// `0 <= full_within < zero_beyond <= 1000` (metres), all finite.
+    pub fn validate(&self) -> Result<(), GridMapError> {
+        check(
+            self.weight.is_finite() && (0.0..=1000.0).contains(&self.weight),
+            "ClearanceCostConfig::weight",
+            self.weight,
+            "finite, from 0 to 1000",
+        )?;
+        check(
+            self.full_within.is_finite() && self.full_within >= 0.0,
+            "ClearanceCostConfig::full_within",
+            self.full_within,
+            "finite and not negative",
+        )?;
+        check(
+            self.zero_beyond.is_finite()
+                && self.zero_beyond > self.full_within
+                && self.zero_beyond <= 1000.0,
+            "ClearanceCostConfig::zero_beyond",
+            self.zero_beyond,
+            "finite, above ClearanceCostConfig::full_within and at most 1000 m",
+        )?;
+        Ok(())
+    }
+
+    /// The cost multiplier of a cell `d` metres from the nearest obstacle (at least 1).
+    #[inline]
+    #[must_use]
+    pub fn multiplier(&self, d: f64) -> f32 {
+        let p = ((self.zero_beyond - d) / (self.zero_beyond - self.full_within)).clamp(0.0, 1.0);
+        (1.0 + self.weight * p * p) as f32
+    }
+}
+
+/// The cost multipliers of every cell (row-major) from a distance field, for pathfind's
+/// `CellCostAStar::new(&grid, &costs)`: [`ClearanceCostConfig::multiplier`] of each distance.
+///
+/// # Errors
+/// [`GridMapError::InvalidConfig`] for invalid settings.
+pub fn clearance_step_costs(
+    field: &DistanceField,
+    config: &ClearanceCostConfig,
+) -> Result<Vec<f32>, GridMapError> {
+    config.validate()?;
+    Ok(field
+        .as_slice()
+        .iter()
+        .map(|&d| config.multiplier(f64::from(d)))
+        .collect())
+}
+
+/// Settings of [`PlanningGrid`]. Lengths in metres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanningGridConfig {
+    /// How unknown cells count: [`UnknownCells::Blocked`] (default: the robot stays in observed
+    /// space; unknown cells are obstacles for the inflation and the clearance too) or
+    /// [`UnknownCells::Free`].
+    pub unknown: UnknownCells,
+    /// Hard inflation, 0.30 m: Spot's half width (0.25 m) plus 0.05 m. Cells whose centre lies
+    /// within it of an obstacle cell's centre are blocked.
+    pub inflation: f64,
+    /// The clearance cost on the cells left free.
+    pub cost: ClearanceCostConfig,
+}
+
+impl Default for PlanningGridConfig {
+    fn default() -> Self {
+        Self {
+            unknown: UnknownCells::Blocked,
+            inflation: 0.30,
+            cost: ClearanceCostConfig::default(),
+        }
+    }
+}
+
+impl PlanningGridConfig {
+    /// Check the settings.
+    ///
+    /// # Errors
+    /// [`GridMapError::InvalidConfig`] for an inflation that is not finite, not negative and at
+    /// most 1000 m, or an invalid cost.
+    pub fn validate(&self) -> Result<(), GridMapError> {
+        check(
+            self.inflation.is_finite() && (0.0..=1000.0).contains(&self.inflation),
+            "PlanningGridConfig::inflation",
+            self.inflation,
+            "finite, from 0 to 1000 m",
+        )?;
+        self.cost.validate()
+    }
+
+    /// The farthest distance (metres) that matters: beyond it a cell is neither blocked nor
+    /// penalised.
+    fn reach(&self) -> f64 {
+        if self.cost.weight > 0.0 {
+            self.inflation.max(self.cost.zero_beyond)
+        } else {
+            self.inflation
+        }
+    }
+}
+
+/// A rectangle of cells, `x0..x1` by `y0..y1` (ends excluded).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CellRect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl CellRect {
+    /// The rectangle holding one cell.
+    #[must_use]
+    pub fn cell(c: Cell) -> Self {
+        Self {
+            x0: c.x,
+            y0: c.y,
+            x1: c.x + 1,
+            y1: c.y + 1,
+        }
+    }
+
+    /// Whether it holds no cell.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// Number of cells.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        if self.is_empty() {
+            0
+        } else {
+            (self.x1 - self.x0) as usize * (self.y1 - self.y0) as usize
+        }
+    }
+
+    /// The smallest rectangle holding both.
+    #[must_use]
+    pub fn union(&self, other: &Self) -> Self {
+        if self.is_empty() {
+            return *other;
+        }
+        if other.is_empty() {
+            return *self;
+        }
+        Self {
+            x0: self.x0.min(other.x0),
+            y0: self.y0.min(other.y0),
+            x1: self.x1.max(other.x1),
+            y1: self.y1.max(other.y1),
+        }
+    }
+
+    /// Grown by `cells` on every side, cut to a `width` x `height` grid.
+    #[must_use]
+    pub fn grown(&self, cells: u32, width: u32, height: u32) -> Self {
+        Self {
+            x0: self.x0.saturating_sub(cells).min(width),
+            y0: self.y0.saturating_sub(cells).min(height),
+            x1: self.x1.saturating_add(cells).min(width),
+            y1: self.y1.saturating_add(cells).min(height),
+        }
+    }
+}
+
+/// The planning layer over an occupancy grid: the blocked cells (obstacles, and unknown cells
+/// unless configured free, hard-inflated by [`PlanningGridConfig::inflation`]), each cell's
+/// clearance (metres to the nearest obstacle, capped at the reach: the larger of the inflation
+/// and the cost's `zero_beyond`) and its step-cost multiplier.
+///
+/// Build it once per map ([`PlanningGrid::new`], linear in cells), then after each change of the
+/// occupancy (a live layer's update) [`PlanningGrid::refresh`] the changed rectangle: the work
+/// covers the rectangle grown by twice the reach, not the map. Plan with pathfind's
+/// `CellCostAStar::new(planning.blocked(), planning.step_costs())`, or with any shortest-path
+/// planner on [`PlanningGrid::blocked`] when the cost is off.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanningGrid {
+    config: PlanningGridConfig,
+    blocked: BitGrid,
+    clearance: Vec<f32>,
+    costs: Vec<f32>,
+}
+
+impl PlanningGrid {
+    /// The planning layer of `occupancy`.
+    ///
+    /// # Errors
+    /// [`GridMapError::InvalidConfig`] for invalid settings.
+    pub fn new(
+        occupancy: &OccupancyGrid,
+        config: PlanningGridConfig,
+    ) -> Result<Self, GridMapError> {
+        config.validate()?;
+        let (w, h) = (occupancy.width(), occupancy.height());
+        let mut grid = Self {
+            blocked: occupancy.occupied().clone(),
+            clearance: vec![0.0; w as usize * h as usize],
+            costs: vec![1.0; w as usize * h as usize],
+            config,
+        };
+        grid.recompute(
+            occupancy,
+            CellRect {
+                x0: 0,
+                y0: 0,
+                x1: w,
+                y1: h,
+            },
+        )?;
+        Ok(grid)
+    }
+
+    /// Bring the layer up to date after the occupancy changed inside `changed` (cells outside it
+    /// must be as they were). Recomputes the distance transform over `changed` grown by twice
+    /// the reach and writes the cells within one reach of it, the only ones whose capped
+    /// clearance can change. Returns the rectangle written (empty when `changed` is).
+    ///
+    /// # Errors
+    /// [`GridMapError::GeometryMismatch`] when `occupancy` is not the grid the layer was built
+    /// for (size or placement).
+    pub fn refresh(
+        &mut self,
+        occupancy: &OccupancyGrid,
+        changed: CellRect,
+    ) -> Result<CellRect, GridMapError> {
+        if changed.is_empty() {
+            return Ok(changed);
+        }
+        let (w, h) = (occupancy.width(), occupancy.height());
+        let written = changed.grown(self.reach_cells(), w, h);
+        self.recompute(occupancy, written)?;
+        Ok(written)
+    }
+
+    /// Cells of the reach, rounded up, plus one for the rounding of the centres.
+    fn reach_cells(&self) -> u32 {
+        let cells = (self.config.reach() / self.blocked.geometry().resolution).ceil() + 1.0;
+        cells.min(f64::from(u32::MAX / 4)) as u32
+    }
+
+    /// Recompute the cells of `written` from the obstacles within one reach of it.
+    fn recompute(
+        &mut self,
+        occupancy: &OccupancyGrid,
+        written: CellRect,
+    ) -> Result<(), GridMapError> {
+        let (w, h) = (occupancy.width(), occupancy.height());
+        if (w, h) != (self.blocked.width(), self.blocked.height())
+            || occupancy.geometry() != self.blocked.geometry()
+        {
+            return Err(GridMapError::GeometryMismatch);
+        }
+        if written.is_empty() {
+            return Ok(());
+        }
+        let source = written.grown(self.reach_cells(), w, h);
+        let unknown_blocked = self.config.unknown == UnknownCells::Blocked;
+        let obstacle = |x: u32, y: u32| match occupancy.state(Cell::new(x, y)) {
+            CellState::Occupied => true,
+            CellState::Unknown => unknown_blocked,
+            CellState::Free => false,
+        };
+        let sub = BitGrid::from_fn(source.x1 - source.x0, source.y1 - source.y0, |x, y| {
+            obstacle(source.x0 + x, source.y0 + y)
+        })?;
+        let d2 = squared_distance_cells(&sub);
+        let res = occupancy.geometry().resolution;
+        let reach = self.config.reach();
+        let r_cells = self.config.inflation / res;
+        let limit = r_cells * r_cells + 1e-9;
+        let sub_w = sub.width() as usize;
+        for y in written.y0..written.y1 {
+            for x in written.x0..written.x1 {
+                let k = (y - source.y0) as usize * sub_w + (x - source.x0) as usize;
+                let i = y as usize * w as usize + x as usize;
+                let d2 = d2[k];
+                let metres = (d2.sqrt() * res).min(reach);
+                self.clearance[i] = metres as f32;
+                self.costs[i] = self.config.cost.multiplier(metres);
+                // The same test as `inflate`, so that the blocked cells are `inflate`'s.
+                self.blocked.set(Cell::new(x, y), d2 <= limit)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn config(&self) -> &PlanningGridConfig {
+        &self.config
+    }
+
+    /// Blocked cells: obstacles (and unknown cells, unless configured free) inflated by the
+    /// inflation radius, with the occupancy grid's size and placement.
+    #[must_use]
+    pub fn blocked(&self) -> &BitGrid {
+        &self.blocked
+    }
+
+    /// The step-cost multiplier of every cell (row-major, at least 1; all 1 with the cost off).
+    #[must_use]
+    pub fn step_costs(&self) -> &[f32] {
+        &self.costs
+    }
+
+    /// Metres from every cell centre to the nearest obstacle cell centre (row-major), capped at
+    /// the reach (the larger of the inflation and the cost's `zero_beyond`; the inflation alone
+    /// with the cost off).
+    #[must_use]
+    pub fn clearance(&self) -> &[f32] {
+        &self.clearance
+    }
+
+    /// Whether the cost is on (a positive weight): plan with a cost-aware planner; otherwise
+    /// every multiplier is 1 and the fastest shortest-path planner gives the same paths.
+    #[must_use]
+    pub fn cost_enabled(&self) -> bool {
+        self.config.cost.weight > 0.0
+    }
+
+    /// Whether any of `cells` is blocked (or off the grid): the test for replanning when a live
+    /// layer's update blocked part of the current path.
+    #[must_use]
+    pub fn blocks_any(&self, cells: &[Cell]) -> bool {
+        cells.iter().any(|&c| self.blocked.is_blocked(c))
+    }
+}

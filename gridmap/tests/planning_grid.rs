@@ -1,0 +1,222 @@
+//! The planning layer against brute force: its blocked cells are `inflate`'s, its clearance the
+//! distance field's (capped), a refresh over a changed rectangle equals a rebuild, and a 0.9 m
+//! door stays open under the hard inflation that a 0.40 m inflation closes.
+#![allow(clippy::unwrap_used, clippy::panic)]
+
+mod common;
+
+use gridmap::{
+    CellRect, CellState, ClearanceCostConfig, DistanceField, FloorConfig, FloorMap, GridMapError,
+    ObstacleBandConfig, OccupancyGrid, OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid,
+    PlanningGridConfig, UnknownCells, clearance_step_costs, inflate,
+};
+use nalgebra::{Point3, Vector2};
+use proptest::prelude::*;
+use slam_core::{Cell, GridGeometry};
+
+fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
+    let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.1).unwrap();
+    let mut grid = OccupancyGrid::new(w, h, geometry, CellState::Free).unwrap();
+    let mut s = seed | 1;
+    for y in 0..h {
+        for x in 0..w {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let r = (s % 1000) as u32;
+            let state = if r < density * 10 {
+                CellState::Occupied
+            } else if r < (density + unknown) * 10 {
+                CellState::Unknown
+            } else {
+                CellState::Free
+            };
+            grid.set(Cell::new(x, y), state).unwrap();
+        }
+    }
+    grid
+}
+
+fn config(unknown: bool, inflation: f64, weight: f64) -> PlanningGridConfig {
+    PlanningGridConfig {
+        unknown: if unknown {
+            UnknownCells::Blocked
+        } else {
+            UnknownCells::Free
+        },
+        inflation,
+        cost: ClearanceCostConfig {
+            weight,
+            ..ClearanceCostConfig::default()
+        },
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn layer_matches_inflate_and_the_distance_field(
+        w in 1u32..90, h in 1u32..90, density in 0u32..20, unknown in 0u32..10, seed in any::<u64>(),
+        blocked in any::<bool>(), inflation in 0.0f64..0.6, weight in prop_oneof![Just(0.0), 0.0f64..5.0],
+    ) {
+        let occupancy = random_occupancy(w, h, density, unknown, seed);
+        let cfg = config(blocked, inflation, weight);
+        let layer = PlanningGrid::new(&occupancy, cfg.clone()).unwrap();
+        let obstacles = occupancy.to_planning_grid(cfg.unknown);
+        prop_assert_eq!(layer.blocked(), &inflate(&obstacles, inflation));
+        let field = DistanceField::new(&obstacles);
+        let reach = if weight > 0.0 { inflation.max(1.0) } else { inflation };
+        let costs = clearance_step_costs(&field, &cfg.cost).unwrap();
+        for (i, (&d, &c)) in layer.clearance().iter().zip(layer.step_costs()).enumerate() {
+            let want = field.as_slice()[i].min(reach as f32);
+            prop_assert!((d - want).abs() < 1e-5, "cell {}: {} vs {}", i, d, want);
+            prop_assert!(c >= 1.0);
+            if field.as_slice()[i] <= reach as f32 {
+                prop_assert!((c - costs[i]).abs() < 1e-5);
+            }
+            if weight == 0.0 {
+                prop_assert!((c - 1.0).abs() < f32::EPSILON);
+            }
+        }
+        prop_assert_eq!(layer.cost_enabled(), weight > 0.0);
+    }
+
+    #[test]
+    fn refresh_of_a_changed_rectangle_equals_a_rebuild(
+        w in 1u32..120, h in 1u32..120, density in 0u32..15, seed in any::<u64>(),
+        rect in (0u32..120, 0u32..120, 1u32..40, 1u32..40), flips in 1usize..60,
+        weight in prop_oneof![Just(0.0), 0.5f64..4.0],
+    ) {
+        let mut occupancy = random_occupancy(w, h, density, 5, seed);
+        let cfg = config(seed % 2 == 0, 0.3, weight);
+        let mut layer = PlanningGrid::new(&occupancy, cfg.clone()).unwrap();
+        let (x0, y0) = (rect.0 % w, rect.1 % h);
+        let changed = CellRect { x0, y0, x1: (x0 + rect.2).min(w), y1: (y0 + rect.3).min(h) };
+        let mut s = seed.rotate_left(17) | 1;
+        for _ in 0..flips {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let x = changed.x0 + (s % u64::from(changed.x1 - changed.x0)) as u32;
+            let y = changed.y0 + ((s >> 20) % u64::from(changed.y1 - changed.y0)) as u32;
+            let state = [CellState::Free, CellState::Occupied, CellState::Unknown][(s >> 40) as usize % 3];
+            occupancy.set(Cell::new(x, y), state).unwrap();
+        }
+        let written = layer.refresh(&occupancy, changed).unwrap();
+        prop_assert!(written.len() >= changed.len());
+        let rebuilt = PlanningGrid::new(&occupancy, cfg).unwrap();
+        prop_assert_eq!(layer.blocked(), rebuilt.blocked());
+        for (a, b) in layer.clearance().iter().zip(rebuilt.clearance()) {
+            prop_assert!((a - b).abs() < 1e-6);
+        }
+        prop_assert_eq!(layer.step_costs(), rebuilt.step_costs());
+    }
+}
+
+/// The room's door is 0.9 m wide; on the map its frame cells' centres are 0.9 m apart (8 free
+/// cells). The hard inflation of 0.30 m leaves two cells open, 0.40 m closes it.
+#[test]
+fn a_door_of_0_9_m_stays_open_under_the_hard_inflation() {
+    let world = common::room(-0.8);
+    let cloud = world.surface_cloud(-0.15, -0.15, 12.15, 6.15, 0.04);
+    let floor = FloorMap::estimate(
+        &cloud,
+        &[Point3::new(1.0, 3.0, -0.8)],
+        &FloorConfig::default(),
+    )
+    .unwrap();
+    let occupancy = OccupancyGridBuilder::new(OccupancyGridConfig::default())
+        .unwrap()
+        .build_floor_band(&cloud, &floor, &ObstacleBandConfig::default())
+        .unwrap();
+    // Rows open across the whole cross wall (its faces at x = 8.0 and 8.15 m).
+    let columns: Vec<u32> = [7.95, 8.05, 8.15, 8.25]
+        .iter()
+        .map(|&x| {
+            occupancy
+                .occupied()
+                .cell_at(Vector2::new(x, 3.0))
+                .unwrap()
+                .x
+        })
+        .collect();
+    let open_rows = |grid: &slam_core::BitGrid| -> Vec<f64> {
+        (0..grid.height())
+            .filter(|&y| columns.iter().all(|&x| !grid.is_blocked(Cell::new(x, y))))
+            .map(|y| grid.cell_center(Cell::new(columns[0], y)).y)
+            .filter(|y| (1.0..5.0).contains(y))
+            .collect()
+    };
+    let door: Vec<f64> = open_rows(occupancy.occupied());
+    assert_eq!(door.len(), 8, "the map shows the door 0.8 m wide: {door:?}");
+    let layer = PlanningGrid::new(&occupancy, PlanningGridConfig::default()).unwrap();
+    let open = open_rows(layer.blocked());
+    assert_eq!(open.len(), 2, "{open:?}");
+    assert!(open.iter().all(|y| (y - 3.0).abs() < 0.1));
+    assert!(open_rows(&inflate(occupancy.occupied(), 0.40)).is_empty());
+    // In the door, 0.4-0.5 m from the frame: multipliers 1 + 2 ((1 - d) / 0.7)^2.
+    for y in open {
+        let cell = layer.blocked().cell_at(Vector2::new(8.07, y)).unwrap();
+        let i = (cell.y * layer.blocked().width() + cell.x) as usize;
+        let d = f64::from(layer.clearance()[i]);
+        assert!((0.39..0.51).contains(&d), "{d}");
+        let want = 1.0 + 2.0 * ((1.0 - d) / 0.7).powi(2);
+        assert!((f64::from(layer.step_costs()[i]) - want).abs() < 1e-5);
+    }
+    // In the room's middle, 3 m from the walls: no penalty.
+    let mid = layer.blocked().cell_at(Vector2::new(4.0, 2.0)).unwrap();
+    let i = (mid.y * layer.blocked().width() + mid.x) as usize;
+    assert!((layer.step_costs()[i] - 1.0).abs() < f32::EPSILON);
+}
+
+#[test]
+fn bad_settings_are_errors() {
+    let occupancy = random_occupancy(10, 10, 10, 0, 7);
+    let cases: Vec<(PlanningGridConfig, &str)> = vec![
+        (config(true, f64::NAN, 1.0), "PlanningGridConfig::inflation"),
+        (config(true, -0.1, 1.0), "PlanningGridConfig::inflation"),
+        (config(true, 1e9, 1.0), "PlanningGridConfig::inflation"),
+        (config(true, 0.3, f64::NAN), "ClearanceCostConfig::weight"),
+        (config(true, 0.3, -1.0), "ClearanceCostConfig::weight"),
+        (
+            PlanningGridConfig {
+                cost: ClearanceCostConfig {
+                    full_within: f64::NAN,
+                    ..ClearanceCostConfig::default()
+                },
+                ..PlanningGridConfig::default()
+            },
+            "ClearanceCostConfig::full_within",
+        ),
+        (
+            PlanningGridConfig {
+                cost: ClearanceCostConfig {
+                    zero_beyond: 0.2,
+                    ..ClearanceCostConfig::default()
+                },
+                ..PlanningGridConfig::default()
+            },
+            "ClearanceCostConfig::zero_beyond",
+        ),
+    ];
+    for (cfg, name) in cases {
+        match PlanningGrid::new(&occupancy, cfg) {
+            Err(GridMapError::InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    let mut layer = PlanningGrid::new(&occupancy, PlanningGridConfig::default()).unwrap();
+    let other = random_occupancy(11, 10, 10, 0, 7);
+    let all = CellRect {
+        x0: 0,
+        y0: 0,
+        x1: 10,
+        y1: 10,
+    };
+    assert!(matches!(
+        layer.refresh(&other, all),
+        Err(GridMapError::GeometryMismatch)
+    ));
+    assert!(layer.refresh(&occupancy, all).is_ok());
+}
