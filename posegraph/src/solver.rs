@@ -3,9 +3,11 @@
 
 use nalgebra::SVector;
 use slam_core::{
-    FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph, StopReason,
+    Edge, FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph,
+    StopReason,
 };
 
+use crate::error::{InvalidConfig, check};
 use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
 
@@ -34,9 +36,77 @@ impl Default for SolverConfig {
     }
 }
 
-/// `sum rho(e^T Omega e)` with `poses` in place of the graph's.
-fn cost_with<P: Linearize<D>, const D: usize>(
+impl SolverConfig {
+    /// Checks every setting: at least one iteration, tolerances finite and not negative.
+    ///
+    /// # Errors
+    /// [`InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), InvalidConfig> {
+        check(
+            self.max_iterations >= 1,
+            "SolverConfig::max_iterations",
+            self.max_iterations as f64,
+            "at least 1",
+        )?;
+        for (setting, v) in [
+            (
+                "SolverConfig::relative_cost_tolerance",
+                self.relative_cost_tolerance,
+            ),
+            ("SolverConfig::step_tolerance", self.step_tolerance),
+        ] {
+            check(
+                v.is_finite() && v >= 0.0,
+                setting,
+                v,
+                "finite and not negative",
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// `sum rho(e^T Omega e)` with `poses` in place of the graph's; with `weights` (one per edge),
+/// `sum w e^T Omega e` instead (the kernels ignored).
+pub(crate) fn cost_with<P: Linearize<D>, const D: usize>(
     graph: &PoseGraph<P>,
+    poses: &[P],
+    model: ErrorModel,
+    weights: Option<&[f64]>,
+) -> f64 {
+    let edges = graph.edges().iter().enumerate();
+    match weights {
+        None => edges
+            .map(|(_, e)| {
+                let s = chi2(e, poses, model);
+                e.kernel.map_or(s, |k| k.rho(s))
+            })
+            .sum(),
+        Some(w) => edges
+            .filter(|&(k, _)| w[k] != 0.0)
+            .map(|(k, e)| w[k] * chi2(e, poses, model))
+            .sum(),
+    }
+}
+
+/// `e^T Omega e` of edge `e` with `poses` in place of the graph's.
+pub(crate) fn chi2<P: Linearize<D>, const D: usize>(
+    e: &Edge<P>,
+    poses: &[P],
+    model: ErrorModel,
+) -> f64 {
+    let err = P::error(model, &e.measurement, &poses[e.from], &poses[e.to]);
+    (err.transpose() * P::info(&e.information) * err)[0]
+}
+
+/// The IRLS surrogate of a graph with robust kernels, `sum w_k s_k(poses)` with each kernel's
+/// weight `w_k = rho'(s_k)` taken at the linearisation point (`at`, the current poses) and held:
+/// the weighted least-squares problem a step minimises. Its relative decrease is the stop test
+/// of a kernelled graph: a bounded kernel (Geman-McClure) saturates far from the optimum, where
+/// the robust cost barely changes while the poses still move by metres.
+fn surrogate<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    at: &[P],
     poses: &[P],
     model: ErrorModel,
 ) -> f64 {
@@ -44,9 +114,8 @@ fn cost_with<P: Linearize<D>, const D: usize>(
         .edges()
         .iter()
         .map(|e| {
-            let err = P::error(model, &e.measurement, &poses[e.from], &poses[e.to]);
-            let s = (err.transpose() * P::info(&e.information) * err)[0];
-            e.kernel.map_or(s, |k| k.rho(s))
+            let s = chi2(e, poses, model);
+            e.kernel.map_or(s, |k| k.weight(chi2(e, at, model)) * s)
         })
         .sum()
 }
@@ -67,6 +136,7 @@ pub(crate) mod sealed {
     use slam_core::{OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph};
 
     use super::{Cache, SolverConfig, optimize};
+    use crate::gnc::{GncConfig, GncReport, graduate};
 
     /// The normal equations an optimiser keeps between calls, one slot per pose type.
     #[derive(Default)]
@@ -77,6 +147,11 @@ pub(crate) mod sealed {
 
     /// The loop of [`optimize`] with the cache slot of the pose type.
     pub trait Sealed: slam_core::GraphPose {
+        /// The position (metres; z = 0 in SE(2)).
+        fn position(&self) -> nalgebra::Vector3<f64>;
+        /// The identity pose.
+        fn identity_pose() -> Self;
+
         /// Run the loop (see [`optimize`]) with this pose type's slot of `caches`.
         fn optimize_cached(
             graph: &mut PoseGraph<Self>,
@@ -85,9 +160,22 @@ pub(crate) mod sealed {
             levenberg: bool,
             initial_lambda: f64,
         ) -> Result<OptimizationReport, OptimizeError>;
+
+        /// Graduated non-convexity (see [`graduate`]) with this pose type's slot of `caches`.
+        fn graduate(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &GncConfig,
+        ) -> Result<GncReport, OptimizeError>;
     }
 
     impl Sealed for Pose3 {
+        fn position(&self) -> nalgebra::Vector3<f64> {
+            self.translation.vector
+        }
+        fn identity_pose() -> Self {
+            Pose3::identity()
+        }
         fn optimize_cached(
             graph: &mut PoseGraph<Self>,
             caches: &mut Caches,
@@ -95,11 +183,26 @@ pub(crate) mod sealed {
             levenberg: bool,
             initial_lambda: f64,
         ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(graph, &mut caches.se3, config, levenberg, initial_lambda)
+            optimize(graph, &mut caches.se3, config, levenberg, initial_lambda, None)
+        }
+
+        fn graduate(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &GncConfig,
+        ) -> Result<GncReport, OptimizeError> {
+            graduate(graph, &mut caches.se3, config)
         }
     }
 
     impl Sealed for Pose2 {
+        fn position(&self) -> nalgebra::Vector3<f64> {
+            let t = self.translation.vector;
+            nalgebra::Vector3::new(t.x, t.y, 0.0)
+        }
+        fn identity_pose() -> Self {
+            Pose2::identity()
+        }
         fn optimize_cached(
             graph: &mut PoseGraph<Self>,
             caches: &mut Caches,
@@ -107,7 +210,15 @@ pub(crate) mod sealed {
             levenberg: bool,
             initial_lambda: f64,
         ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(graph, &mut caches.se2, config, levenberg, initial_lambda)
+            optimize(graph, &mut caches.se2, config, levenberg, initial_lambda, None)
+        }
+
+        fn graduate(
+            graph: &mut PoseGraph<Self>,
+            caches: &mut Caches,
+            config: &GncConfig,
+        ) -> Result<GncReport, OptimizeError> {
+            graduate(graph, &mut caches.se2, config)
         }
     }
 }
@@ -115,18 +226,22 @@ pub(crate) mod sealed {
 // One loop with the damping state machine in plain sight; splitting it would hide the control flow.
 #[allow(clippy::too_many_lines)]
 /// Run the loop. `levenberg` chooses LM (adaptive damping, rejected steps) or GN (no damping
-/// unless the factorisation needs it, every step accepted).
+/// unless the factorisation needs it, every step accepted). `weights` (one per edge) replace the
+/// edges' kernels: the cost is then `sum w e^T Omega e` (graduated non-convexity's inner
+/// problem).
 pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     graph: &mut PoseGraph<P>,
     cache: &mut Cache<D>,
     config: &SolverConfig,
     levenberg: bool,
     initial_lambda: f64,
+    weights: Option<&[f64]>,
 ) -> Result<OptimizationReport, OptimizeError> {
     graph.check_gauge()?;
     let model = config.error_model;
     let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
-    let initial_cost = cost_with(graph, &poses, model);
+    let initial_cost = cost_with(graph, &poses, model, weights);
+    let kernelled = weights.is_none() && graph.edges().iter().any(|e| e.kernel.is_some()) && std::env::var_os("OLDSTOP").is_none();
     let ne = match cache.take() {
         Some(ne) if ne.fits(graph) => cache.insert(ne),
         _ => cache.insert(NormalEquations::new(graph)?),
@@ -151,7 +266,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let mut damped = ne.values.clone();
     'outer: while iterations < config.max_iterations {
         if relinearize {
-            ne.assemble(graph, model);
+            ne.assemble(graph, model, weights);
             for (k, d) in diagonal.iter_mut().enumerate() {
                 *d = ne.values[ne.diagonal_position(k)].max(1e-9);
             }
@@ -194,7 +309,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
                 cause: FactorizationFailure::NonFiniteSolution,
             });
         }
-        let new_cost = cost_with(graph, &trial, model);
+        let new_cost = cost_with(graph, &trial, model, weights);
         // NaN costs count as worse.
         let improved = new_cost < cost;
         if levenberg && !improved {
@@ -207,7 +322,12 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             }
             continue;
         }
-        let decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+        let decrease = if kernelled {
+            let before = surrogate(graph, &poses, &poses, model);
+            (before - surrogate(graph, &poses, &trial, model)) / before.max(f64::MIN_POSITIVE)
+        } else {
+            (cost - new_cost) / cost.max(f64::MIN_POSITIVE)
+        };
         for (i, p) in trial.iter().enumerate() {
             graph.set_pose(i, *p);
         }
