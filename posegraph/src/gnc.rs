@@ -14,6 +14,7 @@ use slam_core::{OptimizationReport, OptimizeError, Optimizer, PoseGraph, StopRea
 use crate::error::{InvalidConfig, check};
 use crate::gnc_loss::{GncLoss, chi2_quantile};
 use crate::linearize::Linearize;
+use crate::loop_support::supported;
 use crate::solver::sealed::Caches;
 use crate::solver::{Cache, SolverConfig, SolverPose, chi2, optimize};
 
@@ -67,6 +68,16 @@ pub struct GncConfig {
     /// Cap on outer iterations (weight updates); at least 1. Reaching it is reported
     /// ([`GncReport::converged`] false), not an error.
     pub max_outer_iterations: usize,
+    /// Candidate loops with a consistent partner joining the same two stretches of odometry,
+    /// each end within this many odometry steps (the pairwise consistency test of PCM on short
+    /// chains, which needs no pose estimate), start as inliers: they are held at weight 1 while
+    /// the others graduate, and re-tested with them at the end. 0 turns the test off; default 5.
+    pub support_window: usize,
+    /// After the weights have converged, the rejected candidates with the smallest errors are
+    /// re-admitted one at a time, up to this many, each kept only when it lowers the TLS cost
+    /// (a rejected loop is judged at a solution without it); the first failure ends the trials.
+    /// Truncated least squares only; 0 turns it off; default 4.
+    pub readmission_trials: usize,
     /// Levenberg-Marquardt iterations per outer iteration (the weights change little from one
     /// to the next, so a full solve each time is wasted); at least 1.
     pub inner_iterations: usize,
@@ -87,6 +98,8 @@ impl Default for GncConfig {
             inlier_probability: 0.99,
             known_inliers: KnownInliers::ConsecutiveIds,
             mu_step: 1.4,
+            support_window: 5,
+            readmission_trials: 4,
             max_outer_iterations: 1000,
             inner_iterations: 2,
             weight_tolerance: 1e-4,
@@ -157,6 +170,9 @@ pub struct GncReport {
     pub known_inliers: usize,
     /// Candidates weighted out (weight below 0.5).
     pub rejected: usize,
+    /// Candidates that had a consistent partner ([`GncConfig::support_window`]) and so started
+    /// as inliers.
+    pub supported: usize,
 }
 
 impl GncReport {
@@ -249,6 +265,55 @@ fn residuals<P: Linearize<D>, const D: usize>(
     );
 }
 
+/// The final solves: Levenberg-Marquardt with the weights, then each candidate re-weighted at
+/// the solution (TLS: 1 exactly when its error is below `c2`; GM: its weight at `mu = 1`), until
+/// no weight changes (at most 10 rounds).
+struct Settle<'a> {
+    config: &'a GncConfig,
+    known: &'a [bool],
+    c2: f64,
+    /// LM iterations so far.
+    iterations: usize,
+}
+
+impl Settle<'_> {
+    /// Solve and re-weight until steady; returns the last solve's stop reason.
+    fn run<P: Linearize<D>, const D: usize>(
+        &mut self,
+        graph: &mut PoseGraph<P>,
+        cache: &mut Cache<D>,
+        weights: &mut [f64],
+        s: &mut Vec<f64>,
+    ) -> Result<StopReason, OptimizeError> {
+        let mut stop = StopReason::NothingToDo;
+        for _ in 0..10 {
+            let r = optimize(graph, cache, &self.config.solver, true, 1e-8, Some(weights))?;
+            self.iterations += r.iterations;
+            stop = r.stop_reason;
+            residuals(graph, &self.config.solver, s);
+            let mut changed = false;
+            for k in (0..weights.len()).filter(|&k| !self.known[k]) {
+                let w = match self.config.loss {
+                    GncLoss::TruncatedLeastSquares => {
+                        if s[k] <= self.c2 {
+                            1.0
+                        } else {
+                            0.0
+                        }
+                    }
+                    GncLoss::GemanMcClure => self.config.loss.weight(s[k], self.c2, 1.0),
+                };
+                changed |= (w - weights[k]).abs() > self.config.weight_tolerance;
+                weights[k] = w;
+            }
+            if !changed {
+                break;
+            }
+        }
+        Ok(stop)
+    }
+}
+
 /// The robust cost: `s` over known inliers, the loss over candidates.
 fn robust_cost(s: &[f64], known: &[bool], loss: GncLoss, c2: f64) -> f64 {
     s.iter()
@@ -260,7 +325,7 @@ fn robust_cost(s: &[f64], known: &[bool], loss: GncLoss, c2: f64) -> f64 {
 /// The whole run for one pose type (see [`GraduatedNonConvexity`]).
 // The outer loop, its convergence tests and the final re-test in one place.
 #[allow(clippy::too_many_lines)]
-pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
+pub(crate) fn graduate<P: Linearize<D> + SolverPose, const D: usize>(
     graph: &mut PoseGraph<P>,
     cache: &mut Cache<D>,
     config: &GncConfig,
@@ -272,13 +337,16 @@ pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
         .collect();
     let c2 = chi2_quantile(D, config.inlier_probability);
     let loss = config.loss;
+    // Supported candidates are held at weight 1 while the rest graduate.
+    let candidate: Vec<bool> = known.iter().map(|k| !k).collect();
+    let support = supported(graph, &candidate, config.support_window as u64, c2);
+    let held: Vec<bool> = known.iter().zip(&support).map(|(k, s)| *k || *s).collect();
     let mut s = Vec::with_capacity(m);
     residuals(graph, &config.solver, &mut s);
     let initial_cost = robust_cost(&s, &known, loss, c2);
     let mut weights = vec![1.0; m];
-    let lambda = 1e-8;
+    let lambda = 1e-8; // LevenbergMarquardt's default
     let mut iterations = 0;
-    let mut stop = StopReason::NothingToDo;
     // mu starts where the surrogate is convex over the residuals at the initial guess: with
     // odometry as the guess and the known inliers, the candidates start nearly weighted out
     // and come in as the surrogate graduates, those that agree with the rest first. (Starting
@@ -286,7 +354,7 @@ pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
     // until they look like inliers: on ring.g2o it is 50-100 m off.)
     let s_max = s
         .iter()
-        .zip(&known)
+        .zip(&held)
         .filter(|&(_, &k)| !k)
         .map(|(&s, _)| s)
         .fold(0.0, f64::max);
@@ -302,7 +370,7 @@ pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
             outer += 1;
             let mut change: f64 = 0.0;
             let mut binary = true;
-            for k in (0..m).filter(|&k| !known[k]) {
+            for k in (0..m).filter(|&k| !held[k]) {
                 let w = loss.weight(s[k], c2, mu);
                 change = change.max((w - weights[k]).abs());
                 binary &= w <= config.weight_tolerance || w >= 1.0 - config.weight_tolerance;
@@ -334,30 +402,48 @@ pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
             *w = if *w >= 0.5 { 1.0 } else { 0.0 };
         }
     }
-    for _ in 0..10 {
-        let r = optimize(graph, cache, &config.solver, true, lambda, Some(&weights))?;
-        iterations += r.iterations;
-        stop = r.stop_reason;
-        residuals(graph, &config.solver, &mut s);
-        let mut changed = false;
-        for k in (0..m).filter(|&k| !known[k]) {
-            let w = match loss {
-                GncLoss::TruncatedLeastSquares => {
-                    if s[k] <= c2 {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                }
-                GncLoss::GemanMcClure => loss.weight(s[k], c2, 1.0),
+    let mut settled = Settle {
+        config,
+        known: &known,
+        c2,
+        iterations: 0,
+    };
+    let mut stop = settled.run(graph, cache, &mut weights, &mut s)?;
+    // Re-admission: a rejected candidate was judged at a solution without it, where a part of
+    // the graph that only it holds (a stretch of odometry after the last other loop) can sit
+    // well off. Try the rejected candidates with the smallest errors one at a time, keeping a
+    // trial only when it lowers the TLS cost.
+    if loss == GncLoss::TruncatedLeastSquares {
+        let mut tried = vec![false; m];
+        for _ in 0..config.readmission_trials {
+            let Some(k) = (0..m)
+                .filter(|&k| !known[k] && weights[k] == 0.0 && !tried[k])
+                .min_by(|&a, &b| s[a].total_cmp(&s[b]))
+            else {
+                break;
             };
-            changed |= (w - weights[k]).abs() > config.weight_tolerance;
-            weights[k] = w;
-        }
-        if !changed {
-            break;
+            tried[k] = true;
+            let before = robust_cost(&s, &known, loss, c2);
+            let (saved_poses, saved_weights, saved_s): (Vec<P>, Vec<f64>, Vec<f64>) = (
+                graph.nodes().iter().map(|n| n.pose).collect(),
+                weights.clone(),
+                s.clone(),
+            );
+            weights[k] = 1.0;
+            let trial_stop = settled.run(graph, cache, &mut weights, &mut s)?;
+            if robust_cost(&s, &known, loss, c2) < before * (1.0 - 1e-9) {
+                stop = trial_stop;
+            } else {
+                for (i, p) in saved_poses.into_iter().enumerate() {
+                    graph.set_pose(i, p);
+                }
+                weights = saved_weights;
+                s = saved_s;
+                break;
+            }
         }
     }
+    iterations += settled.iterations;
     if !converged {
         stop = StopReason::MaxIterations;
     }
@@ -373,6 +459,7 @@ pub(crate) fn graduate<P: Linearize<D>, const D: usize>(
         converged,
         inlier_threshold: c2,
         known_inliers: known.iter().filter(|&&k| k).count(),
+        supported: support.iter().filter(|&&s| s).count(),
         weights,
         rejected,
     })

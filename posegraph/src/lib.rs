@@ -42,6 +42,7 @@ mod gnc;
 mod gnc_loss;
 mod levenberg_marquardt;
 mod linearize;
+mod loop_support;
 mod normal_equations;
 mod solver;
 mod sparse_cholesky;

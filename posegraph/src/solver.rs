@@ -151,6 +151,10 @@ pub(crate) mod sealed {
         fn position(&self) -> nalgebra::Vector3<f64>;
         /// The identity pose.
         fn identity_pose() -> Self;
+        /// `self * other`.
+        fn compose(&self, other: &Self) -> Self;
+        /// `self^-1`.
+        fn inverse_pose(&self) -> Self;
 
         /// Run the loop (see [`optimize`]) with this pose type's slot of `caches`.
         fn optimize_cached(
@@ -175,6 +179,12 @@ pub(crate) mod sealed {
         }
         fn identity_pose() -> Self {
             Pose3::identity()
+        }
+        fn compose(&self, other: &Self) -> Self {
+            self * other
+        }
+        fn inverse_pose(&self) -> Self {
+            self.inverse()
         }
         fn optimize_cached(
             graph: &mut PoseGraph<Self>,
@@ -202,6 +212,12 @@ pub(crate) mod sealed {
         }
         fn identity_pose() -> Self {
             Pose2::identity()
+        }
+        fn compose(&self, other: &Self) -> Self {
+            self * other
+        }
+        fn inverse_pose(&self) -> Self {
+            self.inverse()
         }
         fn optimize_cached(
             graph: &mut PoseGraph<Self>,
