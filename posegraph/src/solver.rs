@@ -4,7 +4,7 @@
 use nalgebra::SVector;
 use slam_core::{
     Edge, FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph,
-    StopReason,
+    RobustKernel, StopReason,
 };
 
 use crate::error::{InvalidConfig, check};
@@ -68,18 +68,20 @@ impl SolverConfig {
 
 /// `sum rho(e^T Omega e)` with `poses` in place of the graph's; with `weights` (one per edge),
 /// `sum w e^T Omega e` instead (the kernels ignored).
-pub(crate) fn cost_with<P: Linearize<D>, const D: usize>(
+/// Geman-McClure kernels are taken at `gm_scale` times their `c^2` (see [`graduated`]).
+fn cost_with<P: Linearize<D>, const D: usize>(
     graph: &PoseGraph<P>,
     poses: &[P],
     model: ErrorModel,
     weights: Option<&[f64]>,
+    gm_scale: f64,
 ) -> f64 {
     let edges = graph.edges().iter().enumerate();
     match weights {
         None => edges
             .map(|(_, e)| {
                 let s = chi2(e, poses, model);
-                e.kernel.map_or(s, |k| k.rho(s))
+                e.kernel.map_or(s, |k| graduated(k, gm_scale).rho(s))
             })
             .sum(),
         Some(w) => edges
@@ -118,6 +120,56 @@ fn surrogate<P: Linearize<D>, const D: usize>(
             e.kernel.map_or(s, |k| k.weight(chi2(e, at, model)) * s)
         })
         .sum()
+}
+
+/// `kernel` with a Geman-McClure scale widened to `c^2 * gm_scale`; other kernels unchanged.
+///
+/// Geman-McClure is bounded: an edge whose error is far beyond `c` costs almost exactly `c^2`
+/// and pulls with a weight of about `c^4 / s^2`. From ring.g2o's own guess (13 m of drift, every
+/// loop at `s` of about 17,000 with `c = 1`) the loops' weights are 1e-9 of odometry's, the cost
+/// is flat and the odometry-only map a stationary point: no descent method leaves it. So the
+/// optimisers graduate it as graduated non-convexity does (Yang et al., RA-L 2020): the scale
+/// starts at `2 s_max / c^2` (nearly least squares over every residual) and is divided by 1.4
+/// after each accepted step down to 1, where the optimisation then converges as usual.
+fn graduated(kernel: RobustKernel, gm_scale: f64) -> RobustKernel {
+    match kernel {
+        RobustKernel::GemanMcClure { c } if gm_scale > 1.0 => RobustKernel::GemanMcClure {
+            c: c * gm_scale.sqrt(),
+        },
+        k => k,
+    }
+}
+
+/// The first Geman-McClure scale (see [`graduated`]): `max(1, 2 s / c^2)` over the edges with a
+/// Geman-McClure kernel at `poses`.
+fn initial_gm_scale<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    poses: &[P],
+    model: ErrorModel,
+) -> f64 {
+    graph
+        .edges()
+        .iter()
+        .filter_map(|e| match e.kernel {
+            Some(RobustKernel::GemanMcClure { c }) => Some(2.0 * chi2(e, poses, model) / (c * c)),
+            _ => None,
+        })
+        .fold(1.0, f64::max)
+}
+
+/// The IRLS weight of every edge with the Geman-McClure kernels at `gm_scale`.
+fn level_weights<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    poses: &[P],
+    model: ErrorModel,
+    gm_scale: f64,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    out.extend(graph.edges().iter().map(|e| {
+        e.kernel
+            .map_or(1.0, |k| graduated(k, gm_scale).weight(chi2(e, poses, model)))
+    }));
 }
 
 /// Cached structure of an optimiser.
@@ -256,8 +308,14 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     graph.check_gauge()?;
     let model = config.error_model;
     let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
-    let initial_cost = cost_with(graph, &poses, model, weights);
-    let kernelled = weights.is_none() && graph.edges().iter().any(|e| e.kernel.is_some()) && std::env::var_os("OLDSTOP").is_none();
+    let initial_cost = cost_with(graph, &poses, model, weights, 1.0);
+    let kernelled = weights.is_none() && graph.edges().iter().any(|e| e.kernel.is_some());
+    let mut gm_scale = if weights.is_none() {
+        initial_gm_scale(graph, &poses, model)
+    } else {
+        1.0
+    };
+    let mut level = Vec::new();
     let ne = match cache.take() {
         Some(ne) if ne.fits(graph) => cache.insert(ne),
         _ => cache.insert(NormalEquations::new(graph)?),
@@ -271,7 +329,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
         });
     }
     let n = ne.dimension();
-    let mut cost = initial_cost;
+    let mut cost = cost_with(graph, &poses, model, weights, gm_scale);
     let mut lambda = if levenberg { initial_lambda } else { 0.0 };
     let mut nu = 2.0;
     let mut rhs = faer::Mat::<f64>::zeros(n, 1);
@@ -282,7 +340,12 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
     let mut damped = ne.values.clone();
     'outer: while iterations < config.max_iterations {
         if relinearize {
-            ne.assemble(graph, model, weights);
+            if gm_scale > 1.0 {
+                level_weights(graph, &poses, model, gm_scale, &mut level);
+                ne.assemble(graph, model, Some(&level));
+            } else {
+                ne.assemble(graph, model, weights);
+            }
             for (k, d) in diagonal.iter_mut().enumerate() {
                 *d = ne.values[ne.diagonal_position(k)].max(1e-9);
             }
@@ -325,7 +388,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
                 cause: FactorizationFailure::NonFiniteSolution,
             });
         }
-        let new_cost = cost_with(graph, &trial, model, weights);
+        let new_cost = cost_with(graph, &trial, model, weights, gm_scale);
         // NaN costs count as worse.
         let improved = new_cost < cost;
         if levenberg && !improved {
@@ -333,6 +396,13 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             lambda *= nu;
             nu *= 2.0;
             if lambda > 1e16 {
+                if gm_scale > 1.0 {
+                    // No better point at this scale: go on with the next one.
+                    gm_scale = (gm_scale / 1.4).max(1.0);
+                    cost = cost_with(graph, &poses, model, weights, gm_scale);
+                    (lambda, nu, relinearize) = (initial_lambda, 2.0, true);
+                    continue;
+                }
                 stop = StopReason::DampingExhausted;
                 break 'outer;
             }
@@ -355,6 +425,12 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             nu = 2.0;
         } else if lambda > 0.0 {
             lambda = 0.0;
+        }
+        if gm_scale > 1.0 {
+            // Graduating a Geman-McClure kernel: one step per scale, no stop test before 1.
+            gm_scale = (gm_scale / 1.4).max(1.0);
+            cost = cost_with(graph, &poses, model, weights, gm_scale);
+            continue;
         }
         if step_max < config.step_tolerance {
             stop = StopReason::StepConverged;
