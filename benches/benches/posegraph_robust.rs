@@ -107,7 +107,18 @@ fn run<P: SolverPose>(
             if let Some(dir) = write {
                 let stem = file.trim_end_matches(".g2o");
                 let path = dir.join(format!("{stem}_w{count}_s{seed}.g2o"));
-                if let Err(e) = write_g2o(&path, &wrap(corrupted.clone())) {
+                // Without the FIX line, as the original files: GTSAM's reader stops at it.
+                let mut unfixed = corrupted.clone();
+                for id in unfixed
+                    .nodes()
+                    .iter()
+                    .filter(|n| n.fixed)
+                    .map(|n| n.id)
+                    .collect::<Vec<_>>()
+                {
+                    let _ = unfixed.unfix(id);
+                }
+                if let Err(e) = write_g2o(&path, &wrap(unfixed)) {
                     eprintln!("{e}");
                 }
             }
@@ -135,7 +146,11 @@ fn run<P: SolverPose>(
                 s.true_loops,
                 r.outer_iterations,
                 r.optimization.iterations,
-                if r.converged { "converged" } else { "NOT converged" },
+                if r.converged {
+                    "converged"
+                } else {
+                    "NOT converged"
+                },
             );
         }
     }

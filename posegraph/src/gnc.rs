@@ -41,9 +41,7 @@ impl KnownInliers {
     fn contains<P: slam_core::GraphPose>(&self, graph: &PoseGraph<P>, k: usize) -> bool {
         let e = &graph.edges()[k];
         match self {
-            Self::ConsecutiveIds => {
-                graph.nodes()[e.from].id.abs_diff(graph.nodes()[e.to].id) == 1
-            }
+            Self::ConsecutiveIds => graph.nodes()[e.from].id.abs_diff(graph.nodes()[e.to].id) == 1,
             Self::WithoutKernel => e.kernel.is_none(),
             Self::Flags(flags) => flags.get(k).copied().unwrap_or(false),
             Self::None => false,
@@ -128,10 +126,7 @@ impl GncConfig {
             "finite and greater than 1",
         )?;
         for (setting, v) in [
-            (
-                "GncConfig::max_outer_iterations",
-                self.max_outer_iterations,
-            ),
+            ("GncConfig::max_outer_iterations", self.max_outer_iterations),
             ("GncConfig::inner_iterations", self.inner_iterations),
         ] {
             check(v >= 1, setting, v as f64, "at least 1")?;
@@ -381,9 +376,7 @@ pub(crate) fn graduate<P: Linearize<D> + SolverPose, const D: usize>(
                 // surrogate's (then very wide) band, as all loops are at a drifted guess; from
                 // mu = 1 on the band is within a factor 2 of the threshold.
                 GncLoss::TruncatedLeastSquares => binary && mu >= 1.0,
-                GncLoss::GemanMcClure => {
-                    loss.mu_at_end(mu) && change <= config.weight_tolerance
-                }
+                GncLoss::GemanMcClure => loss.mu_at_end(mu) && change <= config.weight_tolerance,
             };
             if done {
                 converged = true;

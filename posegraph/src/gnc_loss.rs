@@ -146,7 +146,10 @@ mod tests {
             (1, 0.5, 0.454_936_423_119_572_7),
         ] {
             let got = chi2_quantile(dof, p);
-            assert!((got - want).abs() < 1e-9 * want, "{dof} {p}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-9 * want,
+                "{dof} {p}: {got} vs {want}"
+            );
         }
     }
 

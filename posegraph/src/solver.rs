@@ -167,8 +167,9 @@ fn level_weights<P: Linearize<D>, const D: usize>(
 ) {
     out.clear();
     out.extend(graph.edges().iter().map(|e| {
-        e.kernel
-            .map_or(1.0, |k| graduated(k, gm_scale).weight(chi2(e, poses, model)))
+        e.kernel.map_or(1.0, |k| {
+            graduated(k, gm_scale).weight(chi2(e, poses, model))
+        })
     }));
 }
 
@@ -245,7 +246,14 @@ pub(crate) mod sealed {
             levenberg: bool,
             initial_lambda: f64,
         ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(graph, &mut caches.se3, config, levenberg, initial_lambda, None)
+            optimize(
+                graph,
+                &mut caches.se3,
+                config,
+                levenberg,
+                initial_lambda,
+                None,
+            )
         }
 
         fn graduate(
@@ -278,7 +286,14 @@ pub(crate) mod sealed {
             levenberg: bool,
             initial_lambda: f64,
         ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(graph, &mut caches.se2, config, levenberg, initial_lambda, None)
+            optimize(
+                graph,
+                &mut caches.se2,
+                config,
+                levenberg,
+                initial_lambda,
+                None,
+            )
         }
 
         fn graduate(
