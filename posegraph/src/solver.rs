@@ -76,15 +76,16 @@ fn cost_with<P: Linearize<D>, const D: usize>(
     weights: Option<&[f64]>,
     gm_scale: f64,
 ) -> f64 {
-    let edges = graph.edges().iter().enumerate();
+    let edges = graph.edges().iter();
     match weights {
         None => edges
-            .map(|(_, e)| {
+            .map(|e| {
                 let s = chi2(e, poses, model);
                 e.kernel.map_or(s, |k| graduated(k, gm_scale).rho(s))
             })
             .sum(),
         Some(w) => edges
+            .enumerate()
             .filter(|&(k, _)| w[k] != 0.0)
             .map(|(k, e)| w[k] * chi2(e, poses, model))
             .sum(),
