@@ -13,7 +13,7 @@ rounds="${1:-1}"
 venv=target/peers/gtsam-venv
 if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
-    "$venv/bin/pip" install -q gtsam
+    "$venv/bin/pip" install -q gtsam==4.3.0
 fi
 cargo build --release -q --example g2o
 ours() {  # best of five wall times (ms) of our LM on $1 with extra arguments

@@ -2,8 +2,11 @@
 //! final cost in both conventions (log-map `sum e^T Omega e`, and g2o's own chi2) and milliseconds.
 //!
 //! `cargo run --release --example g2o -- FILE [--optimizer gn|lm] [--init file|chordal]
-//! [--error logmap|g2o] [--out OUT.g2o]`
+//! [--error logmap|g2o] [--robust none|gnc] [--out OUT.g2o]`
 //!
+//! `--robust gnc` optimises with graduated non-convexity (truncated least squares; odometry, the
+//! edges between consecutive ids, as known inliers; its inner solver is always LM) and prints how
+//! many edges it weighted out; `--out` then writes the graph without them.
 //! The first node is fixed when the file fixes none. `--init chordal` replaces the file's initial
 //! guess by the chordal initialisation before optimising (its time is included). `--error g2o`
 //! minimises g2o's error convention instead of the log map (GTSAM's). Exits with status 1 when the
@@ -17,7 +20,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
 use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o, write_g2o};
 use posegraph::toro::read_toro;
-use posegraph::{ChordalInitialization, ErrorModel, GaussNewton, LevenbergMarquardt, SolverConfig};
+use posegraph::{
+    ChordalInitialization, ErrorModel, GaussNewton, GncConfig, GraduatedNonConvexity,
+    LevenbergMarquardt, SolverConfig, SolverPose,
+};
 use slam_core::{GraphPose, OptimizationReport, Optimizer, Pose2, Pose3, PoseGraph, StopReason};
 use spot_nav_examples::{out, value_name};
 
@@ -27,8 +33,9 @@ use spot_nav_examples::{out, value_name};
 /// iterations and stop reason, the cost before and after in both conventions (the log map's
 /// `sum e^T Omega e` and g2o's chi2), and the milliseconds.
 ///
-/// The first node is fixed when the file fixes none. Fails when the optimiser stopped at its
-/// iteration cap (after printing the figures and writing `--out`).
+/// The first node is fixed when the file fixes none. `--robust gnc` weights out wrong loop
+/// closures (graduated non-convexity) and prints how many. Fails when the optimiser stopped at
+/// its iteration cap (after printing the figures and writing `--out`).
 #[derive(Debug, Parser)]
 #[command(name = "g2o")]
 struct Args {
@@ -45,7 +52,11 @@ struct Args {
     /// The error convention minimised.
     #[arg(long, value_enum, default_value_t = ErrorChoice::LogMap)]
     error: ErrorChoice,
-    /// Write the optimised graph here (g2o).
+    /// Outlier-robust optimisation: `gnc` weights out wrong loop closures (graduated
+    /// non-convexity with truncated least squares over LM; `--optimizer` is then unused).
+    #[arg(long, value_enum, default_value_t = Robust::None)]
+    robust: Robust,
+    /// Write the optimised graph here (g2o; with `--robust gnc` without the edges weighted out).
     #[arg(long, value_name = "OUT.g2o")]
     out: Option<PathBuf>,
 }
@@ -70,6 +81,18 @@ enum Init {
     /// The chordal initialisation (rotations by the chordal relaxation, then translations).
     #[value(name = "chordal")]
     Chordal,
+}
+
+/// `--robust`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Robust {
+    /// Plain least squares (the file's robust kernels, if any, apply).
+    #[value(name = "none")]
+    None,
+    /// Graduated non-convexity (Yang et al., RA-L 2020), truncated least squares, odometry as
+    /// known inliers.
+    #[value(name = "gnc")]
+    Gnc,
 }
 
 /// `--error`.
@@ -107,6 +130,41 @@ where
     Ok(optimizer.optimize(g)?)
 }
 
+/// Graduated non-convexity on `g`; returns the report and the number of edges weighted out, and
+/// drops those edges from `g` (for `--out`).
+fn run_gnc<P>(
+    g: &mut PoseGraph<P>,
+    config: SolverConfig,
+    chordal: bool,
+) -> Result<(OptimizationReport, usize)>
+where
+    P: ChordalInitialization + SolverPose,
+    GraduatedNonConvexity: Optimizer<P>,
+{
+    let mut gnc = GraduatedNonConvexity::try_new(GncConfig {
+        solver: config,
+        ..GncConfig::default()
+    })?;
+    let report = run(g, &mut gnc, chordal)?;
+    let weights = gnc.weights();
+    let rejected = weights.iter().filter(|&&w| w < 0.5).count();
+    let mut kept = PoseGraph::new();
+    for n in g.nodes() {
+        kept.add_node(n.id, n.pose)?;
+        if n.fixed {
+            kept.fix(n.id)?;
+        }
+    }
+    for (e, &w) in g.edges().iter().zip(weights) {
+        if w >= 0.5 {
+            let (a, b) = (g.nodes()[e.from].id, g.nodes()[e.to].id);
+            kept.add_edge(a, b, e.measurement, e.information, e.kernel)?;
+        }
+    }
+    *g = kept;
+    Ok((report, rejected))
+}
+
 fn optimise(args: &Args) -> Result<()> {
     let file = &args.file;
     let is_toro = file
@@ -131,17 +189,28 @@ fn optimise(args: &Args) -> Result<()> {
     };
     let g2o_before = g2o_chi2(&graph);
     let t = Instant::now();
-    let report = match (&mut graph, args.optimizer) {
-        (G2oGraph::Se3(g), OptimizerChoice::LevenbergMarquardt) => {
+    let mut rejected = None;
+    let report = match (&mut graph, args.robust, args.optimizer) {
+        (G2oGraph::Se3(g), Robust::Gnc, _) => {
+            let (r, n) = run_gnc::<Pose3>(g, config, chordal)?;
+            rejected = Some(n);
+            r
+        }
+        (G2oGraph::Se2(g), Robust::Gnc, _) => {
+            let (r, n) = run_gnc::<Pose2>(g, config, chordal)?;
+            rejected = Some(n);
+            r
+        }
+        (G2oGraph::Se3(g), Robust::None, OptimizerChoice::LevenbergMarquardt) => {
             run::<Pose3, _>(g, &mut LevenbergMarquardt::new(config), chordal)?
         }
-        (G2oGraph::Se3(g), OptimizerChoice::GaussNewton) => {
+        (G2oGraph::Se3(g), Robust::None, OptimizerChoice::GaussNewton) => {
             run::<Pose3, _>(g, &mut GaussNewton::new(config), chordal)?
         }
-        (G2oGraph::Se2(g), OptimizerChoice::LevenbergMarquardt) => {
+        (G2oGraph::Se2(g), Robust::None, OptimizerChoice::LevenbergMarquardt) => {
             run::<Pose2, _>(g, &mut LevenbergMarquardt::new(config), chordal)?
         }
-        (G2oGraph::Se2(g), OptimizerChoice::GaussNewton) => {
+        (G2oGraph::Se2(g), Robust::None, OptimizerChoice::GaussNewton) => {
             run::<Pose2, _>(g, &mut GaussNewton::new(config), chordal)?
         }
     };
@@ -155,13 +224,21 @@ fn optimise(args: &Args) -> Result<()> {
             "SE(2)"
         }
     )?;
+    let method = match args.robust {
+        Robust::None => value_name(&args.optimizer),
+        Robust::Gnc => value_name(&args.robust),
+    };
     out!(
-        "optimizer   {} from the {} guess: {} iterations, {:?}",
-        value_name(&args.optimizer),
+        "optimizer   {method} from the {} guess: {} iterations, {:?}",
         value_name(&args.init),
         report.iterations,
         report.stop_reason
     )?;
+    if let Some(n) = rejected {
+        out!(
+            "robust      {n} of {edges} edges weighted out (graduated non-convexity, TLS); the costs after are over the edges kept"
+        )?;
+    }
     out!(
         "minimised   {} cost {:.6} -> {:.6} (from the --init guess)",
         value_name(&args.error),

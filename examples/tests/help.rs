@@ -19,11 +19,13 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--optimizer",
             "--init",
             "--error",
+            "--robust",
             "--out",
             "gn",
             "lm",
             "chordal",
             "logmap",
+            "gnc",
         ],
     ),
     (

@@ -10,6 +10,15 @@
 //! translations; Carlone et al., ICRA 2015). [`g2o`] reads and writes g2o files and evaluates
 //! g2o's own chi2 convention.
 //!
+//! Outlier-robust optimisation: [`GraduatedNonConvexity`] (Yang, Antonante, Tzoumas, Carlone,
+//! "Graduated Non-Convexity for Robust Spatial Perception", RA-L 2020) over this crate's LM, with
+//! the truncated least squares and Geman-McClure losses ([`GncLoss`]), known-inlier edges
+//! ([`KnownInliers`]: odometry by default), a pairwise consistency test of candidate loops on
+//! short odometry chains (the test of PCM, Mangelson et al., ICRA 2018) and every edge's final
+//! weight in its [`GncReport`]; [`wrong_loops`] adds random wrong loop closures to test it
+//! (Sünderhauf and Protzel's protocol, IROS 2012). A Geman-McClure kernel on an edge is graduated
+//! the same way inside [`LevenbergMarquardt`] and [`GaussNewton`].
+//!
 //! ```
 //! use posegraph::LevenbergMarquardt;
 //! use slam_core::{GraphPose, Optimizer, PoseGraph, Pose2};
@@ -38,16 +47,22 @@ mod chordal;
 mod error;
 pub mod g2o;
 mod gauss_newton;
+mod gnc;
+mod gnc_loss;
 mod levenberg_marquardt;
 mod linearize;
+mod loop_support;
 mod normal_equations;
 mod solver;
 mod sparse_cholesky;
 pub mod toro;
+pub mod wrong_loops;
 
 pub use chordal::{ChordalInitialization, initialize_chordal};
-pub use error::{GraphFileError, UnknownTag};
+pub use error::{GraphFileError, InvalidConfig, UnknownTag};
 pub use gauss_newton::GaussNewton;
+pub use gnc::{GncConfig, GncReport, GraduatedNonConvexity, KnownInliers};
+pub use gnc_loss::GncLoss;
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
 pub use solver::{SolverConfig, SolverPose};

@@ -264,9 +264,14 @@ impl<const D: usize> NormalEquations<D> {
         }
     }
 
-    /// Fill `values` and `gradient` at the current poses for `model` (robust kernels as IRLS
-    /// weights).
-    pub(crate) fn assemble<P: Linearize<D>>(&mut self, graph: &PoseGraph<P>, model: ErrorModel) {
+    /// Fill `values` and `gradient` at the current poses for `model`: robust kernels as IRLS
+    /// weights, or, with `weights` (one per edge), those weights instead of the kernels.
+    pub(crate) fn assemble<P: Linearize<D>>(
+        &mut self,
+        graph: &PoseGraph<P>,
+        model: ErrorModel,
+        weights: Option<&[f64]>,
+    ) {
         self.clear();
         let nodes = graph.nodes();
         for (k, e) in graph.edges().iter().enumerate() {
@@ -278,7 +283,15 @@ impl<const D: usize> NormalEquations<D> {
             );
             let mut omega = P::info(&e.information);
             let mut oe: SVector<f64, D> = omega * err;
-            if let Some(kernel) = e.kernel {
+            if let Some(w) = weights {
+                let w = w[k];
+                if w == 0.0 {
+                    // An edge weighted out adds nothing (its entries stay in the pattern).
+                    continue;
+                }
+                omega *= w;
+                oe *= w;
+            } else if let Some(kernel) = e.kernel {
                 let w = kernel.weight(err.dot(&oe));
                 omega *= w;
                 oe *= w;
