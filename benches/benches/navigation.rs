@@ -1,44 +1,60 @@
-//! The navigator's cycle on the simulated Spot (seed 3): localising one scan against the map,
-//! replanning across the building and the command, with the map built once; and the map's
-//! preparation (occupancy grid, inflation, the registrator's target; the planner's labelling of
-//! the grid happens once more in `Navigator::new`).
+//! The navigator on the simulated Spot (seed 3), with the map built once:
+//! - `navigation_seed3/prepare_map`: the navigation map from the lap's scans (floor, obstacle
+//!   band, free space from the beams) and the registrator's target;
+//! - `navigation_seed3/cycle`: one full cycle on a scan (localise against the whole map, fuse
+//!   the scan into the live layer, plan across the building, command);
+//! - printed after the criterion groups: every cycle of a walk into the farthest room (mean,
+//!   p99 and max), the cost users see, replans included.
 //!
 //! `cargo bench -p spot-nav-benches --bench navigation`
 
 use std::hint::black_box;
+use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use slam_core::{PointCloud, Registrator};
-use spot_adapter::nav::{Navigator, NavigatorConfig, navigation_grid};
+use slam_core::{PointCloud, Pose3, Registrator};
+use spot_adapter::nav::{NavigationMap, NavigationStep, Navigator, NavigatorConfig};
 use spot_adapter::pipelines::point_to_plane_tracker;
-use spot_adapter::robot::Robot;
+use spot_adapter::robot::{MobilityCommand, Robot};
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, Route, SimulatedSpot, SimulationConfig,
 };
 
-fn navigation(c: &mut Criterion) {
+/// Scans with their `map_T_lidar`.
+type Scans = Vec<(Pose3, PointCloud)>;
+
+/// Building 3, its map cloud and its navigation map from every 4th scan of one lap at its true
+/// pose (as the navigation tests build them).
+fn setup() -> Option<(Building, PointCloud, Scans)> {
     let config = SimulationConfig::default();
-    // Building 3 with the noise and drift of seed 0, as the navigation test's map.
-    let sim = Building::generate(3, &BuildingConfig::default())
-        .and_then(|b| SimulatedSpot::new(b.clone(), &Route::corridor_loop(&b), &config));
-    let Ok(sim) = sim else {
+    let building = Building::generate(3, &BuildingConfig::default()).ok()?;
+    let sim =
+        SimulatedSpot::new(building.clone(), &Route::corridor_loop(&building), &config).ok()?;
+    let body_t_lidar = sim.body_t_lidar();
+    let mut points = Vec::new();
+    let mut scans = Vec::new();
+    for sample in sim.step_by(4) {
+        let world_t_lidar = sample.ground_truth? * body_t_lidar;
+        points.extend_from_slice(sample.cloud.transformed(&world_t_lidar).points());
+        scans.push((world_t_lidar, sample.cloud.voxel_downsample(0.05).ok()?));
+    }
+    let map = PointCloud::from_points(points)
+        .voxel_downsample(0.05)
+        .ok()?;
+    Some((building, map, scans))
+}
+
+fn navigation(c: &mut Criterion) {
+    let Some((building, map, scans)) = setup() else {
         eprintln!("navigation bench: simulation failed; skipping");
         return;
     };
-    let building = sim.building().clone();
-    let body_t_lidar = sim.body_t_lidar();
-    // The map: every 4th scan of one lap at its true pose, thinned to 5 cm (as the tests).
-    let mut points = Vec::new();
-    for sample in sim.step_by(4) {
-        if let Some(truth) = sample.ground_truth {
-            points.extend_from_slice(sample.cloud.transformed(&(truth * body_t_lidar)).points());
-        }
-    }
-    let Ok(map) = PointCloud::from_points(points).voxel_downsample(0.05) else {
-        return;
-    };
+    let config = SimulationConfig::default();
+    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
+    let nav_config = NavigatorConfig::default();
     let start = building.corridor_loop()[0];
-    // The farthest room's entry: every cycle plans across the building.
+    // The farthest room's entry: every plan crosses the building.
     let Some(goal) = building
         .rooms()
         .iter()
@@ -47,32 +63,29 @@ fn navigation(c: &mut Criterion) {
     else {
         return;
     };
-    let Ok(mut spot) = CommandedSpot::new(building, start, 0.0, &config) else {
-        return;
-    };
-    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
-    let start_pose = spot.body_pose();
     let mut group = c.benchmark_group("navigation_seed3");
     group.sample_size(10);
-    let nav_config = NavigatorConfig::default();
     group.bench_function("prepare_map", |b| {
         b.iter(|| {
-            let grid = navigation_grid(&map, lidar_height, &nav_config);
+            let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config);
             let target = point_to_plane_tracker().prepare_target(&map);
-            black_box((grid.is_ok(), target.is_ok()))
+            black_box((navigation.is_ok(), target.is_ok()))
         });
     });
-    let Ok(grid) = navigation_grid(&map, lidar_height, &nav_config) else {
-        eprintln!("navigation bench: grid failed; skipping");
+    let Ok(navigation) = NavigationMap::from_scans(&refs, lidar_height, &nav_config) else {
+        eprintln!("navigation bench: navigation map failed; skipping");
+        return;
+    };
+    let Ok(mut spot) = CommandedSpot::new(building.clone(), start, 0.0, &config) else {
         return;
     };
     let Ok(mut nav) = Navigator::new(
         point_to_plane_tracker(),
         &map,
-        &grid,
-        start_pose,
+        &navigation,
+        spot.body_pose(),
         spot.description(),
-        nav_config,
+        nav_config.clone(),
     ) else {
         eprintln!("navigation bench: navigator failed; skipping");
         return;
@@ -84,10 +97,69 @@ fn navigation(c: &mut Criterion) {
         return;
     }
     group.sample_size(30);
-    group.bench_function("cycle_localise_plan_command", |b| {
-        b.iter(|| black_box(nav.step(&sample, goal)));
+    // The same scan again and again: each cycle localises and fuses it; stamps may not go back,
+    // so each cycle's sample is a little later.
+    let mut later = sample.clone();
+    group.bench_function("cycle", |b| {
+        b.iter(|| {
+            later.stamp += 0.2;
+            black_box(nav.step(&later, goal).ok())
+        });
     });
     group.finish();
+    walk_cycles(&building, &map, &navigation, start, goal, &nav_config);
+}
+
+/// Every cycle's time over a walk into the farthest room, printed.
+fn walk_cycles(
+    building: &Building,
+    map: &PointCloud,
+    navigation: &NavigationMap,
+    start: nalgebra::Vector2<f64>,
+    goal: nalgebra::Vector2<f64>,
+    config: &NavigatorConfig,
+) {
+    let sim = SimulationConfig::default();
+    let Ok(mut spot) = CommandedSpot::new(building.clone(), start, 0.0, &sim) else {
+        return;
+    };
+    let Ok(mut nav) = Navigator::new(
+        point_to_plane_tracker(),
+        map,
+        navigation,
+        spot.body_pose(),
+        spot.description(),
+        config.clone(),
+    ) else {
+        return;
+    };
+    let mut ms = Vec::new();
+    for _ in 0..1500 {
+        let Ok(sample) = spot.next_sample() else {
+            return;
+        };
+        let t = Instant::now();
+        let step = nav.step(&sample, goal);
+        ms.push(t.elapsed().as_secs_f64() * 1e3);
+        match step {
+            Ok(NavigationStep::Walk(command)) => {
+                let _ = spot.send(&MobilityCommand::Velocity(command));
+            }
+            Ok(NavigationStep::Hold) => {
+                let _ = spot.stop();
+            }
+            _ => break,
+        }
+    }
+    ms.sort_by(f64::total_cmp);
+    let mean = ms.iter().sum::<f64>() / ms.len().max(1) as f64;
+    let p99 = ms[((ms.len() as f64 * 0.99) as usize).min(ms.len() - 1)];
+    println!(
+        "navigation_seed3/walk: {} cycles ({} plans): mean {mean:.2} ms, p99 {p99:.2} ms, max {:.2} ms per cycle",
+        ms.len(),
+        nav.replans(),
+        ms[ms.len() - 1]
+    );
 }
 
 criterion_group!(benches, navigation);

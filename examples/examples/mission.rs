@@ -24,7 +24,7 @@ use serde::Serialize;
 use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
 use spot_adapter::nav::{
-    Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind, navigation_grid,
+    Goal, NavigationMap, NavigationStep, Navigator, NavigatorConfig, PlannerKind,
 };
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
@@ -87,7 +87,7 @@ struct Args {
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
     registration: Registration,
     /// The navigator's planner.
-    #[arg(long, value_enum, default_value_t = PlannerChoice::Jps)]
+    #[arg(long, value_enum, default_value_t = PlannerChoice::CostAware)]
     planner: PlannerChoice,
     /// Where the outputs go.
     #[arg(long, value_name = "DIR", default_value = "mission-out")]
@@ -97,6 +97,8 @@ struct Args {
 /// `--planner`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum PlannerChoice {
+    /// A* under the clearance cost (least cost: keeps to the middle of corridors).
+    CostAware,
     /// Jump Point Search.
     Jps,
     /// A* with the octile heuristic.
@@ -112,6 +114,8 @@ const REACHED_WITHIN: f64 = 0.10;
 /// The map and where the robot ended, from one mapped lap.
 struct Mapped {
     map: PointCloud,
+    /// The occupancy (obstacles from the floor up, free from the beams, unknown elsewhere).
+    navigation: NavigationMap,
     /// The engine's estimate of the body at the last scan (map frame).
     map_t_body: Pose3,
     summary: MappingSummary,
@@ -156,8 +160,13 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let map_t_lidar = slam
         .current_lidar_pose()
         .context("the lap gave the engine no scan")?;
+    let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
+    let sim_config = SimulationConfig::default();
+    let lidar_height = sim_config.spot.body_height + sim_config.spot.body_t_lidar.translation.z;
+    let navigation = NavigationMap::from_scans(&scans, lidar_height, &NavigatorConfig::default())?;
     Ok(Mapped {
         map: slam.map(0.05)?,
+        navigation,
         map_t_body: map_t_lidar * body_t_lidar.inverse(),
         summary: MappingSummary {
             scans: report.scans,
@@ -189,6 +198,10 @@ struct LegSummary {
     /// Length of the shortest collision-free route on the building's true floor plan.
     shortest_m: Option<f64>,
     localisation_error_max_m: f64,
+    /// Plans made on the leg (the first, blocked paths, the periodic ones).
+    plans: usize,
+    /// Times the robot was stuck and backed off.
+    recoveries: usize,
     cycle_ms_mean: f64,
     cycle_ms_p99: f64,
     cycle_ms_max: f64,
@@ -228,11 +241,12 @@ impl Frames {
 }
 
 /// `count` goals in the building (world frame): at least 0.6 m from every obstacle, in space
-/// the lap saw (a floor point of the map within 0.25 m), at least 5 m from the one before and
-/// reachable from it with Spot's clearance.
+/// the lap saw (a floor point of the map within 0.25 m, free on the planning `grid`), at least
+/// 5 m from the one before and reachable from it with Spot's clearance.
 fn random_goals(
     building: &Building,
     map: &PointCloud,
+    grid: &slam_core::BitGrid,
     frames: &Frames,
     start: Vector2<f64>,
     count: usize,
@@ -256,7 +270,11 @@ fn random_goals(
         }
         let from = goals.last().copied().unwrap_or(start);
         let p = Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
+        let free_on_map = grid
+            .cell_at(frames.to_map(p))
+            .is_some_and(|c| !grid.is_blocked(c));
         if seen.contains(&key(p))
+            && free_on_map
             && building.clearance(p) >= 0.6
             && (p - from).norm() >= 5.0
             && Route::between(building, from, p, &RouteConfig::default()).is_ok()
@@ -310,7 +328,7 @@ struct Leg {
 /// Runs `nav` on `spot` to `goal` (map frame) until it arrives, stops or reaches the scan
 /// limit, through the `Robot` interface; appends the estimate and the truth (map frame).
 fn leg<R: Registrator>(
-    nav: &mut Navigator<'_, R>,
+    nav: &mut Navigator<R>,
     spot: &mut CommandedSpot,
     goal: Vector2<f64>,
     frames: &Frames,
@@ -412,19 +430,7 @@ fn mission(args: &Args) -> Result<()> {
         Registration::Loam => map_building(loam_slam(slam_config()), sim)?,
     };
 
-    // Goals (world frame) from where the lap ended.
     let start = lap_end.translation.vector.xy();
-    let goals_world: Vec<Vector2<f64>> = if args.goal.is_empty() {
-        random_goals(&building, &mapped.map, &frames, start, args.goals, seed)?
-    } else {
-        args.goal.iter().map(|&g| frames.to_world(g)).collect()
-    };
-    let goals: Vec<Vector2<f64>> = goals_world.iter().map(|&g| frames.to_map(g)).collect();
-    // Legs that get a box on their route: spread over the legs after the first.
-    let boxed: Vec<usize> = (0..args.obstacles.min(goals.len().saturating_sub(1)))
-        .map(|k| 1 + k * (goals.len() - 1) / args.obstacles.max(1))
-        .collect();
-
     let mut spot = CommandedSpot::new(
         building.clone(),
         start,
@@ -433,16 +439,15 @@ fn mission(args: &Args) -> Result<()> {
     )?;
     // The map frame's origin is the body at the lap's start: the LiDAR sits its mounting height
     // above it.
-    let lidar_height = config.spot.body_t_lidar.translation.z;
     let nav_config = NavigatorConfig {
         planner: match args.planner {
+            PlannerChoice::CostAware => PlannerKind::CellCostAStar,
             PlannerChoice::Jps => PlannerKind::JumpPointSearch,
             PlannerChoice::Astar => PlannerKind::AStar,
         },
         ..NavigatorConfig::default()
     };
     let started = Instant::now();
-    let grid = navigation_grid(&mapped.map, lidar_height, &nav_config)?;
     let kidnap = args
         .kidnap
         .map_or_else(Pose3::identity, |[metres, degrees]| {
@@ -455,19 +460,39 @@ fn mission(args: &Args) -> Result<()> {
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         &mapped.map,
-        &grid,
+        &mapped.navigation,
         mapped.map_t_body * kidnap,
         spot.description(),
         nav_config,
     )?;
     out!(
-        "grid        {} x {} cells of {:.2} m, obstacles inflated by {:.2} m ({:.1} s)",
+        "grid        {} x {} cells of {:.2} m, obstacles from the floor up, inflated by {:.2} m plus a clearance cost ({:.1} s)",
         nav.grid().width(),
         nav.grid().height(),
         nav.grid().geometry().resolution,
-        NavigatorConfig::default().clearance,
+        NavigatorConfig::default().planning.inflation,
         started.elapsed().as_secs_f64()
     )?;
+
+    // Goals (world frame) from where the lap ended.
+    let goals_world: Vec<Vector2<f64>> = if args.goal.is_empty() {
+        random_goals(
+            &building,
+            &mapped.map,
+            nav.grid(),
+            &frames,
+            start,
+            args.goals,
+            seed,
+        )?
+    } else {
+        args.goal.iter().map(|&g| frames.to_world(g)).collect()
+    };
+    let goals: Vec<Vector2<f64>> = goals_world.iter().map(|&g| frames.to_map(g)).collect();
+    // Legs that get a box on their route: spread over the legs after the first.
+    let boxed: Vec<usize> = (0..args.obstacles.min(goals.len().saturating_sub(1)))
+        .map(|k| 1 + k * (goals.len() - 1) / args.obstacles.max(1))
+        .collect();
 
     let mut trajectories = (Vec::new(), Vec::new());
     let mut overlay = Overlay {
@@ -502,6 +527,7 @@ fn mission(args: &Args) -> Result<()> {
             .ok()
             .map(|r| r.length());
         let collisions_before = spot.collisions();
+        let (plans_before, recoveries_before) = (nav.replans(), nav.recoveries());
         let label = format!("goal {}/{}", k + 1, goals.len());
         let walk = leg(
             &mut nav,
@@ -524,12 +550,14 @@ fn mission(args: &Args) -> Result<()> {
             walked_m: walk.walked,
             shortest_m: shortest,
             localisation_error_max_m: walk.worst,
+            plans: nav.replans() - plans_before,
+            recoveries: nav.recoveries() - recoveries_before,
             cycle_ms_mean: times.as_ref().map_or(0.0, Timings::mean),
             cycle_ms_p99: times.as_ref().map_or(0.0, |t| t.quantile(0.99)),
             cycle_ms_max: times.as_ref().map_or(0.0, Timings::max),
         };
         out!(
-            "goal {:>2}     ({:6.2}, {:6.2}): {} after {} scans, {:.1} m walked (shortest {}), {:.3} m from the goal, {} collisions, localisation error up to {:.3} m, {:.1} ms mean per cycle",
+            "goal {:>2}     ({:6.2}, {:6.2}): {} after {} scans, {:.1} m walked (shortest {}), {:.3} m from the goal, {} collisions, localisation error up to {:.3} m, {} plans, {} recoveries, {:.1} ms mean per cycle",
             k + 1,
             goal.x,
             goal.y,
@@ -540,6 +568,8 @@ fn mission(args: &Args) -> Result<()> {
             error,
             collisions,
             summary.localisation_error_max_m,
+            summary.plans,
+            summary.recoveries,
             summary.cycle_ms_mean
         )?;
         overlay.planned.push(walk.planned);
@@ -567,7 +597,7 @@ fn mission(args: &Args) -> Result<()> {
     write_outputs(
         &args.out,
         &mapped.map,
-        lidar_height,
+        mapped.navigation.occupancy(),
         nav.grid(),
         &overlay,
         &trajectories,
@@ -591,7 +621,7 @@ fn mission(args: &Args) -> Result<()> {
 fn write_outputs(
     dir: &Path,
     map: &PointCloud,
-    lidar_height: f64,
+    occupancy: &gridmap::OccupancyGrid,
     inflated: &slam_core::BitGrid,
     overlay: &Overlay,
     trajectories: &(Vec<StampedPose>, Vec<StampedPose>),
@@ -599,10 +629,8 @@ fn write_outputs(
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     write_ply(dir.join("map.ply"), map, PlyEncoding::BinaryLittleEndian)?;
-    let occupancy = gridmap::OccupancyGridBuilder::new(NavigatorConfig::default().grid)?
-        .build(map, lidar_height)?;
-    picture::write_png(&dir.join("grid.png"), &occupancy, inflated, overlay)?;
-    gridmap::write_ros_map(&occupancy, dir.join("map.yaml"))?;
+    picture::write_png(&dir.join("grid.png"), occupancy, inflated, overlay)?;
+    gridmap::write_ros_map(occupancy, dir.join("map.yaml"))?;
     write_tum(dir.join("estimate.tum"), &trajectories.0)?;
     write_tum(dir.join("ground_truth.tum"), &trajectories.1)?;
     let json = serde_json::to_string_pretty(summary)?;

@@ -51,6 +51,7 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--out",
             "p2plane",
             "loam",
+            "cost-aware",
             "jps",
             "astar",
         ],

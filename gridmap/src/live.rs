@@ -34,6 +34,11 @@ pub struct LiveLayerConfig {
     /// Points closer to the sensor than this (horizontally) are ignored, 0.0 m; raise it to drop
     /// returns from the robot itself.
     pub min_range: f64,
+    /// A beam clears only the cells it crosses at most this high above the floor, 0.3 m: a
+    /// beam passing at height h over a cell shows only that nothing taller than h stands there,
+    /// so beams passing over a low obstacle (a crate the LiDAR no longer sees from close by)
+    /// must not clear it.
+    pub clear_below: f64,
 }
 
 impl Default for LiveLayerConfig {
@@ -44,6 +49,7 @@ impl Default for LiveLayerConfig {
             min_points: 1,
             decay: 5.0,
             min_range: 0.0,
+            clear_below: 0.3,
         }
     }
 }
@@ -56,6 +62,12 @@ impl LiveLayerConfig {
     /// 1000 m, an invalid band, `min_points == 0` or above 65,535, or a decay or minimum range
     /// that is not finite and non-negative.
     pub fn validate(&self) -> Result<(), GridMapError> {
+        check(
+            self.clear_below.is_finite() && self.clear_below >= 0.0,
+            "LiveLayerConfig::clear_below",
+            self.clear_below,
+            "finite and not negative",
+        )?;
         check(
             self.window.is_finite() && self.window > 0.0 && self.window <= 1000.0,
             "LiveLayerConfig::window",
@@ -465,22 +477,32 @@ impl LiveLayer {
             }
             let limits = band_at(floor, band, p.x, p.y);
             let kind = classify(p.z, limits);
-            let Some((a, b)) = below_top(origin, p, limits.1) else {
+            if kind == Height::Obstacle {
+                let w = to_window(p);
+                if w.x >= 0.0 && w.y >= 0.0 && w.x < size.x && w.y < size.y {
+                    let k = w.y as usize * n_us + w.x as usize;
+                    self.counts[k] = self.counts[k].saturating_add(1);
+                }
+            }
+            // The part of the beam low enough to show the cells it crosses are free.
+            let clear_top = (limits.0 - band.above_floor + self.config.clear_below).min(limits.1);
+            let Some((a, b)) = below_top(origin, p, clear_top) else {
                 continue;
             };
             let Some((a, b, cut)) = clip_to_box(to_window(a), to_window(b), size) else {
                 continue;
             };
             let k = b.y as usize * n_us + b.x as usize;
-            if kind == Height::Obstacle && !cut {
-                self.counts[k] = self.counts[k].saturating_add(1);
-                if self.hit_stamp[k] != self.stamp {
-                    self.hit_stamp[k] = self.stamp;
-                    self.beams.push((a, b, false));
-                }
-            } else if self.free_stamp[k] != self.stamp {
-                self.free_stamp[k] = self.stamp;
-                self.beams.push((a, b, true));
+            // The end cell is free when the beam ended on the floor there.
+            let include_end = kind != Height::Obstacle && !cut;
+            let seen = if include_end {
+                &mut self.free_stamp[k]
+            } else {
+                &mut self.hit_stamp[k]
+            };
+            if *seen != self.stamp {
+                *seen = self.stamp;
+                self.beams.push((a, b, include_end));
             }
         }
         let min_points = self.config.min_points as u16;

@@ -36,6 +36,16 @@ fn static_map(world: &World) -> OccupancyGrid {
         .unwrap()
 }
 
+/// Beams clear every cell they cross below the band's top: these tests look at what a scan from
+/// close by shows of a removed crate, which the default (clear only below 0.3 m) leaves to
+/// scans from farther away.
+fn every_beam_clears() -> LiveLayerConfig {
+    LiveLayerConfig {
+        clear_below: ObstacleBandConfig::default().up_to,
+        ..LiveLayerConfig::default()
+    }
+}
+
 fn cell(grid: &OccupancyGrid, x: f64, y: f64) -> Cell {
     grid.occupied().cell_at(Vector2::new(x, y)).unwrap()
 }
@@ -49,7 +59,7 @@ fn dropped_box_in_removed_crate_out_then_both_decay() {
     let world = room(FLOOR);
     let map = static_map(&world);
     let floor = FloorMap::flat(FLOOR).unwrap();
-    let mut layer = LiveLayer::new(map.clone(), LiveLayerConfig::default()).unwrap();
+    let mut layer = LiveLayer::new(map.clone(), every_beam_clears()).unwrap();
     // After mapping: the crate (index 7) is gone and a 0.6 m box stands at (4.2..4.8, 1.2..1.8).
     let mut now = world.clone();
     now.blocks.remove(7);
@@ -136,7 +146,7 @@ fn a_moving_box_leaves_no_trail_and_seen_cells_stay() {
     let world = room(FLOOR);
     let map = static_map(&world);
     let floor = FloorMap::flat(FLOOR).unwrap();
-    let mut layer = LiveLayer::new(map.clone(), LiveLayerConfig::default()).unwrap();
+    let mut layer = LiveLayer::new(map.clone(), every_beam_clears()).unwrap();
     let person = |x: f64| {
         let mut w = world.clone();
         w.blocks
@@ -322,4 +332,37 @@ fn bad_input_is_an_error() {
         layer.update(&nan, &pose, &floor, 2.0),
         Err(GridMapError::NonFinitePoints { count: 1 })
     ));
+}
+
+/// A box the LiDAR saw from afar is not cleared by the beams that pass over it once the robot is
+/// so close that it no longer sees it (the VLP-16's lowest beam meets a 0.6 m top 0.75 m away):
+/// by default a beam clears only the cells it crosses below 0.3 m.
+#[test]
+fn beams_passing_over_a_low_box_do_not_clear_it() {
+    let world = room(FLOOR);
+    let map = static_map(&world);
+    let floor = FloorMap::flat(FLOOR).unwrap();
+    let mut now = world.clone();
+    now.blocks
+        .push(block(6.0, 2.7, FLOOR, 6.6, 3.3, FLOOR + 0.6));
+    // The face the robot walks toward: from 3 m its lowest beams hit it, from 0.5 m they pass
+    // over it.
+    let box_cell = cell(&map, 6.05, 3.0);
+    let mut states = Vec::new();
+    for config in [LiveLayerConfig::default(), every_beam_clears()] {
+        let mut layer = LiveLayer::new(map.clone(), config).unwrap();
+        // Seen from 3 m, then from 0.5 m where no beam hits it any more.
+        let (pose, scan) = now.scan(sensor(3.3, 3.0), 1800);
+        layer.update(&scan, &pose, &floor, 0.0).unwrap();
+        assert_eq!(layer.combined().state(box_cell), CellState::Occupied);
+        let (pose, scan) = now.scan(sensor(5.5, 3.0), 1800);
+        layer.update(&scan, &pose, &floor, 0.2).unwrap();
+        states.push(layer.combined().state(box_cell));
+    }
+    assert_eq!(states[0], CellState::Occupied, "the default keeps it");
+    assert_eq!(
+        states[1],
+        CellState::Free,
+        "clearing with every beam loses it"
+    );
 }

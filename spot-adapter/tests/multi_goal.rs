@@ -12,12 +12,13 @@ use spot_adapter::nav::{DriveOutcome, NavigatorConfig};
 /// 20 random goals on `seed`'s building: prints the legs, returns (reached within 0.10 m,
 /// collisions).
 fn twenty_goals(seed: u64) -> (usize, usize) {
-    let (building, map) = building_and_map(seed);
+    let (building, map, navigation) = building_and_map(seed);
     let start = building.corridor_loop()[0];
     let goals = random_goals(&building, &map, start, 20, seed);
     let legs = run_legs(
         &building,
         &map,
+        &navigation,
         &Start::at(start),
         &goals,
         1500,
@@ -46,7 +47,6 @@ fn twenty_goals(seed: u64) -> (usize, usize) {
 }
 
 #[test]
-#[ignore = "target not met yet on buildings 5 and 6 (doors closed by inflation, a crate below the slice); run with --ignored"]
 fn twenty_random_goals_on_building_4() {
     let (reached, collisions) = twenty_goals(4);
     assert!(reached >= 19, "{reached} of 20");
@@ -54,7 +54,6 @@ fn twenty_random_goals_on_building_4() {
 }
 
 #[test]
-#[ignore = "target not met yet on buildings 5 and 6 (doors closed by inflation, a crate below the slice); run with --ignored"]
 fn twenty_random_goals_on_building_5() {
     let (reached, collisions) = twenty_goals(5);
     assert!(reached >= 19, "{reached} of 20");
@@ -62,7 +61,6 @@ fn twenty_random_goals_on_building_5() {
 }
 
 #[test]
-#[ignore = "target not met yet on buildings 5 and 6 (doors closed by inflation, a crate below the slice); run with --ignored"]
 fn twenty_random_goals_on_building_6() {
     let (reached, collisions) = twenty_goals(6);
     assert!(reached >= 19, "{reached} of 20");
@@ -72,7 +70,7 @@ fn twenty_random_goals_on_building_6() {
 /// Navigation starts with the estimate 0.5 m and 10 degrees off the truth: the localiser finds
 /// the robot again within 10 s (50 scans) and it reaches its goal, in every building.
 fn kidnapped(seed: u64) {
-    let (building, map) = building_and_map(seed);
+    let (building, map, navigation) = building_and_map(seed);
     let start = building.corridor_loop()[0];
     let goals = random_goals(&building, &map, start, 1, seed + 100);
     let kidnap = Pose3::from_parts(
@@ -86,6 +84,7 @@ fn kidnapped(seed: u64) {
     let legs = run_legs(
         &building,
         &map,
+        &navigation,
         &start,
         &goals,
         1500,
@@ -106,7 +105,6 @@ fn a_kidnapped_start_recovers_on_building_4() {
 }
 
 #[test]
-#[ignore = "relocalises after 5 scans, but the goal lies behind a door the 0.40 m inflation closes; run with --ignored"]
 fn a_kidnapped_start_recovers_on_building_5() {
     kidnapped(5);
 }

@@ -54,7 +54,7 @@ pub struct DriveCycle<'a> {
 /// sent a stop first (if that fails too, the first error is the one returned).
 pub fn drive<R: Robot, G: Registrator>(
     robot: &mut R,
-    navigator: &mut Navigator<'_, G>,
+    navigator: &mut Navigator<G>,
     goal: impl Into<Goal>,
     max_cycles: usize,
     mut observe: impl FnMut(&DriveCycle<'_>),

@@ -7,12 +7,12 @@
 
 mod drive;
 mod localiser;
+mod navigation_map;
 mod navigator;
 mod stuck;
 
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
-pub use navigator::{
-    Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind, navigation_grid,
-};
+pub use navigation_map::NavigationMap;
+pub use navigator::{Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind};
 pub use stuck::StuckConfig;

@@ -1,25 +1,40 @@
 //! `Navigator`: walks the robot to a goal in a mapped building. Each cycle it localises the live
-//! scan against the map, replans on the map's occupancy grid, and turns the first leg of the
-//! filtered path into a velocity command.
+//! scan against the map, fuses the scan into a live layer over the map's occupancy, replans
+//! when the path is blocked (or every few seconds), and turns the path into a velocity command.
 
-use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, inflate};
+use gridmap::{
+    CellRect, CellState, FloorConfig, LiveLayer, LiveLayerConfig, ObstacleBandConfig,
+    OccupancyGridConfig, PlanningGrid, PlanningGridConfig,
+};
 use nalgebra::Vector2;
-use pathfind::{AStar, JumpPointSearch, filter_path};
-use slam_core::{BitGrid, Cell, Planner, PointCloud, Pose3, Registrator};
+use pathfind::{AStar, CellCostAStar, JumpPointSearch, filter_path, line_of_sight};
+use slam_core::{BitGrid, Cell, GridPath, Planner, PointCloud, Pose3, Registrator};
 
 use crate::error::AdapterError;
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser, LocaliserConfig};
+use crate::nav::navigation_map::NavigationMap;
 use crate::nav::stuck::{StuckConfig, StuckMonitor, StuckState};
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 
-/// Settings of [`Navigator`]. Lengths in metres, angles in radians, speeds per second.
+/// Settings of [`Navigator`] (and of the [`NavigationMap`] it plans on). Lengths in metres,
+/// angles in radians, speeds per second.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NavigatorConfig {
-    /// The occupancy grid of the map (0.10 m cells, the slice 0.2 m either side of the LiDAR).
+    /// The occupancy grid's cells (0.10 m) and limits.
     pub grid: OccupancyGridConfig,
-    /// Obstacles are inflated by this much: the robot's half width (0.25 m) and a margin for
-    /// localisation and control error, 0.40 m.
-    pub clearance: f64,
+    /// How the floor under the map is found (1 m tiles).
+    pub floor: FloorConfig,
+    /// The obstacle band above the floor: from 0.08 m to 0.94 m (Spot with its LiDAR plus
+    /// 0.10 m).
+    pub band: ObstacleBandConfig,
+    /// Hard inflation by the half width plus 0.05 m (0.30 m), the clearance cost, and how
+    /// unknown cells count (not traversable by default).
+    pub planning: PlanningGridConfig,
+    /// The live layer each scan is fused into (8 m window; beams clear only below 0.3 m;
+    /// changes decay after 20 s unseen).
+    pub live: LiveLayerConfig,
+    /// Replan at least every this many cycles even when the path stays clear, 25 (5 s).
+    pub replan_every: usize,
     /// Arrived when the estimated body is this close to the goal, 0.05 m (localisation is good
     /// to a few centimetres, so the true body ends within 0.10 m).
     pub goal_tolerance: f64,
@@ -38,7 +53,13 @@ pub struct NavigatorConfig {
     pub speed: f64,
     /// Turn rate per radian of heading error, 1.5 /s (capped at the robot's limit).
     pub heading_gain: f64,
-    /// The planner on the navigation grid (Jump Point Search).
+    /// Straight segments between waypoints keep at least this clearance where they can, 0.45 m;
+    /// in narrower places (doors) the path's own cells are followed.
+    pub shortcut_clearance: f64,
+    /// Along closely spaced waypoints the robot steers at the farthest one within this
+    /// distance that a straight line clear of the hard inflation reaches, 0.8 m.
+    pub lookahead: f64,
+    /// The planner on the planning grid.
     pub planner: PlannerKind,
     /// Localisation against the map: corrections, health, the wide search when lost.
     pub localiser: LocaliserConfig,
@@ -50,7 +71,16 @@ impl Default for NavigatorConfig {
     fn default() -> Self {
         Self {
             grid: OccupancyGridConfig::default(),
-            clearance: 0.40,
+            floor: FloorConfig::default(),
+            band: ObstacleBandConfig::default(),
+            planning: PlanningGridConfig::default(),
+            // Changes live 20 s unseen: an obstacle too close to see stays until beams low enough
+            // to see the floor behind it show it gone.
+            live: LiveLayerConfig {
+                decay: 300.0,
+                ..LiveLayerConfig::default()
+            },
+            replan_every: 25,
             goal_tolerance: 0.05,
             heading_tolerance: 0.1,
             approach_distance: 0.6,
@@ -59,6 +89,8 @@ impl Default for NavigatorConfig {
             turn_in_place_above: 0.5,
             speed: 0.6,
             heading_gain: 1.5,
+            shortcut_clearance: 0.45,
+            lookahead: 0.8,
             planner: PlannerKind::default(),
             localiser: LocaliserConfig::default(),
             stuck: StuckConfig::default(),
@@ -67,14 +99,14 @@ impl Default for NavigatorConfig {
 }
 
 impl NavigatorConfig {
-    /// Every length, angle, speed and gain finite and positive; the localiser's and the stuck
-    /// monitor's settings valid.
+    /// Every length, angle, speed and gain finite and positive; the grids', the localiser's
+    /// and the stuck monitor's settings valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting.
+    /// [`AdapterError::InvalidConfig`] naming the first bad setting, or
+    /// [`AdapterError::NavigationGrid`] with gridmap's error for a bad grid setting.
     pub fn validate(&self) -> Result<(), AdapterError> {
         for (setting, value) in [
-            ("clearance", self.clearance),
             ("goal_tolerance", self.goal_tolerance),
             ("heading_tolerance", self.heading_tolerance),
             ("approach_distance", self.approach_distance),
@@ -83,44 +115,41 @@ impl NavigatorConfig {
             ("turn_in_place_above", self.turn_in_place_above),
             ("speed", self.speed),
             ("heading_gain", self.heading_gain),
+            ("shortcut_clearance", self.shortcut_clearance),
+            ("lookahead", self.lookahead),
         ] {
             if !(value.is_finite() && value > 0.0) {
                 return Err(AdapterError::invalid(setting, value, "finite and positive"));
             }
         }
+        if self.replan_every == 0 {
+            return Err(AdapterError::invalid("replan_every", 0.0, "at least 1"));
+        }
+        self.floor
+            .validate()
+            .map_err(AdapterError::NavigationGrid)?;
+        self.band.validate().map_err(AdapterError::NavigationGrid)?;
+        self.planning
+            .validate()
+            .map_err(AdapterError::NavigationGrid)?;
+        self.live.validate().map_err(AdapterError::NavigationGrid)?;
         self.localiser.validate()?;
         self.stuck.validate()
     }
 }
 
-/// The grid a [`Navigator`] plans on: the occupancy of `map` (a map cloud whose LiDAR sits
-/// `lidar_height` above the frame's origin) with obstacles inflated by `config.clearance`. Built
-/// once per map; the navigator borrows it, so its planner labels the grid once, not per cycle.
-///
-/// # Errors
-/// [`AdapterError::InvalidConfig`] for invalid settings, [`AdapterError::NavigationGrid`]
-/// (with the grid builder's error as its source) for a grid that cannot be built.
-pub fn navigation_grid(
-    map: &PointCloud,
-    lidar_height: f64,
-    config: &NavigatorConfig,
-) -> Result<BitGrid, AdapterError> {
-    config.validate()?;
-    let occupancy = OccupancyGridBuilder::new(config.grid.clone())
-        .and_then(|b| b.build(map, lidar_height))
-        .map_err(AdapterError::NavigationGrid)?;
-    Ok(inflate(occupancy.occupied(), config.clearance))
-}
-
-/// The shortest-path planner a [`Navigator`] uses; both are optimal on the grid, Jump Point
-/// Search is the faster (pathfind/README.md).
+/// The planner a [`Navigator`] uses on its planning grid.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum PlannerKind {
-    /// [`JumpPointSearch`] with word scans.
+    /// [`CellCostAStar`]: least cost under the clearance cost (paths keep to the middle of
+    /// corridors, yet pass doors the hard inflation leaves open); shortest paths when the cost
+    /// is off.
     #[default]
+    CellCostAStar,
+    /// [`JumpPointSearch`] with word scans: shortest paths, the clearance cost ignored.
     JumpPointSearch,
-    /// [`AStar`] with the octile heuristic.
+    /// [`AStar`] with the octile heuristic: shortest paths, the clearance cost ignored.
     AStar,
 }
 
@@ -163,39 +192,56 @@ pub enum NavigationStep {
 
 /// Walks the robot to goals in a mapped building (map frame = the map cloud's frame).
 ///
-/// Each [`Navigator::step`] predicts the body pose from the odometry since the previous scan and
-/// corrects it by registering the scan against the map (prepared once; the localiser tracks its
-/// health, takes a large correction only once consecutive scans confirm it, and searches wide
-/// when the robot seems lost), replans with [`JumpPointSearch`] on the map's inflated occupancy
-/// grid and keeps the turning points that a straight collision-free segment cannot skip
-/// ([`filter_path`]); then it turns in place while the heading error to the next waypoint is
-/// large, walks toward it steering proportionally otherwise, and near the goal walks straight
-/// at it (sideways too) ever slower. A robot that makes no progress backs off and tries again,
-/// and is reported [`NavigationStep::Blocked`] after a few attempts. A goal that cannot be
-/// reached is answered with [`NavigationStep::NoPath`]; nothing loops forever.
-pub struct Navigator<'g, R: Registrator> {
+/// Each [`Navigator::step`]:
+/// 1. predicts the body pose from the odometry since the previous scan and corrects it by
+///    registering the scan against the map (prepared once; the localiser tracks its health,
+///    takes a large correction only once consecutive scans confirm it, and searches wide when
+///    the robot seems lost);
+/// 2. fuses the scan's obstacle band into a live layer over the map's occupancy (fresh
+///    obstacles in, cells seen clear taken out, unseen changes decaying back to the map) and
+///    brings the planning grid (hard inflation, clearance cost) up to date where it changed;
+/// 3. replans when there is no path yet, the path crosses a newly blocked cell, or every few
+///    seconds, and keeps the turning points a straight segment with room to spare cannot skip;
+/// 4. turns in place while the heading error to the next waypoint is large, walks toward it
+///    steering proportionally otherwise, and near the goal walks straight at it (sideways too)
+///    ever slower.
+///
+/// A robot that makes no progress marks what lies ahead of it as blocked, backs off and
+/// replans, and is reported [`NavigationStep::Blocked`] after a few attempts. A goal that cannot
+/// be reached is answered with [`NavigationStep::NoPath`]; nothing loops forever.
+pub struct Navigator<R: Registrator> {
     config: NavigatorConfig,
     limits: MotionLimits,
     localiser: Localiser<R>,
-    grid: &'g BitGrid,
-    planner: Box<dyn Planner + 'g>,
+    map: NavigationMap,
+    live: LiveLayer,
+    planning: PlanningGrid,
     waypoints: Vec<Vector2<f64>>,
+    /// Every cell of the current path, for the blocked-path test.
+    path_cells: Vec<Cell>,
+    /// The goal the path leads to.
+    planned_for: Option<Vector2<f64>>,
+    cycles_since_plan: usize,
+    replans: usize,
+    recoveries: usize,
     stuck: StuckMonitor,
 }
 
-impl<'g, R: Registrator> Navigator<'g, R> {
-    /// A navigator for `robot` on `map` (a map cloud, e.g. [`slam_core::GraphSlam::map`]) and
-    /// its `grid` ([`navigation_grid`]), localising with `registrator`, starting from
-    /// `map_t_body`. Its commands keep to the robot's motion limits.
+impl<R: Registrator> Navigator<R> {
+    /// A navigator for `robot` on `map` (a map cloud to localise against, e.g.
+    /// [`slam_core::GraphSlam::map`]) and `navigation` (its occupancy and floor, a
+    /// [`NavigationMap`]), localising with `registrator`, starting from `map_t_body`. Its
+    /// commands keep to the robot's motion limits.
     ///
     /// # Errors
     /// [`AdapterError::InvalidConfig`] for invalid settings or limits,
+    /// [`AdapterError::NavigationGrid`] for grid settings gridmap refuses,
     /// [`AdapterError::LocalisationMap`] (with the registrator's error as its source) for a
     /// map the registrator refuses.
     pub fn new(
         registrator: R,
         map: &PointCloud,
-        grid: &'g BitGrid,
+        navigation: &NavigationMap,
         map_t_body: Pose3,
         robot: &RobotDescription,
         config: NavigatorConfig,
@@ -205,17 +251,24 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         let target = registrator
             .prepare_target(map)
             .map_err(AdapterError::LocalisationMap)?;
+        let live = LiveLayer::new(navigation.occupancy().clone(), config.live.clone())
+            .map_err(AdapterError::NavigationGrid)?;
+        let planning = PlanningGrid::new(live.combined(), config.planning.clone())
+            .map_err(AdapterError::NavigationGrid)?;
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone()),
             stuck: StuckMonitor::new(config.stuck.clone()),
-            planner: match config.planner {
-                PlannerKind::JumpPointSearch => Box::new(JumpPointSearch::new(grid)),
-                PlannerKind::AStar => Box::new(AStar::new(grid)),
-            },
+            map: navigation.clone(),
+            live,
+            planning,
             config,
             limits: robot.limits.clone(),
-            grid,
             waypoints: Vec::new(),
+            path_cells: Vec::new(),
+            planned_for: None,
+            cycles_since_plan: 0,
+            replans: 0,
+            recoveries: 0,
         })
     }
 
@@ -225,7 +278,8 @@ impl<'g, R: Registrator> Navigator<'g, R> {
     /// # Errors
     /// [`AdapterError::NonFiniteGoal`] for a goal that is not a finite point or heading
     /// (checked before anything else); [`AdapterError::Planner`] when the planner refuses its
-    /// arguments, which the navigator's own checks rule out (a defect, not an answer).
+    /// arguments and [`AdapterError::NavigationGrid`] when the live layer refuses the scan
+    /// (out-of-order stamps), which the navigator's own checks rule out in normal use.
     pub fn step(
         &mut self,
         sample: &Sample,
@@ -242,7 +296,13 @@ impl<'g, R: Registrator> Navigator<'g, R> {
                 y: target.y,
             });
         }
-        match self.localiser.update(sample) {
+        if self.planned_for != Some(target) {
+            self.stuck.reset();
+            self.waypoints.clear();
+            self.path_cells.clear();
+        }
+        let status = self.localiser.update(sample);
+        match status {
             LocalisationStatus::Searching => {
                 self.stuck.reset();
                 return Ok(NavigationStep::Hold);
@@ -254,6 +314,14 @@ impl<'g, R: Registrator> Navigator<'g, R> {
             _ => {}
         }
         let pose = self.localiser.pose();
+        // Only scans the map confirmed go into the live layer: a scan placed wrongly would
+        // paint obstacles where there are none.
+        if matches!(
+            status,
+            LocalisationStatus::Corrected | LocalisationStatus::Relocalised
+        ) {
+            self.fuse(sample, &pose)?;
+        }
         let position = pose.translation.vector.xy();
         let yaw = pose.rotation.euler_angles().2;
         let distance = (target - position).norm();
@@ -268,6 +336,12 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         match self.stuck.check(position) {
             StuckState::Free => {}
             StuckState::BackingOff => {
+                if self.stuck.just_started() {
+                    self.recoveries += 1;
+                    self.mark_ahead(&pose, sample.stamp)?;
+                }
+                // Replan once free.
+                self.path_cells.clear();
                 let command = VelocityCommand::new(-self.config.stuck.backoff_speed, 0.0);
                 return Ok(NavigationStep::Walk(command));
             }
@@ -277,16 +351,13 @@ impl<'g, R: Registrator> Navigator<'g, R> {
                 return Ok(NavigationStep::Blocked);
             }
         }
-        let Some(waypoints) = self.plan(position, target)? else {
-            self.waypoints.clear();
-            // "No path" from an estimate the last scan did not confirm may be the estimate's
-            // fault: stand and localise first.
-            if self.localiser.health().consecutive_failures > 0 {
-                return Ok(NavigationStep::Hold);
-            }
-            return Ok(NavigationStep::NoPath);
-        };
-        self.waypoints = waypoints;
+        if let Some(answer) = self.replan_if_needed(position, target)? {
+            return Ok(answer);
+        }
+        let near = 0.5 * self.config.goal_tolerance;
+        while self.waypoints.len() > 1 && (self.waypoints[0] - position).norm() <= near {
+            self.waypoints.remove(0);
+        }
         let command = if distance <= self.config.goal_tolerance {
             // In place: only the heading is left.
             let rate = (self.config.heading_gain * heading_error)
@@ -299,6 +370,96 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         };
         self.stuck.commanded(&command);
         Ok(NavigationStep::Walk(command))
+    }
+
+    /// Replan when there is no path, the path crosses a newly blocked cell, or the periodic
+    /// replan is due; an answer when no path is left (`NoPath`, or `Hold` while the estimate is
+    /// unconfirmed).
+    fn replan_if_needed(
+        &mut self,
+        position: Vector2<f64>,
+        target: Vector2<f64>,
+    ) -> Result<Option<NavigationStep>, AdapterError> {
+        self.cycles_since_plan += 1;
+        let replan = self.path_cells.is_empty()
+            || self.planning.blocks_any(&self.path_cells)
+            || self.cycles_since_plan >= self.config.replan_every;
+        if !replan {
+            return Ok(None);
+        }
+        if let Some((waypoints, cells)) = self.plan(position, target)? {
+            self.waypoints = waypoints;
+            self.path_cells = cells;
+            self.planned_for = Some(target);
+            self.cycles_since_plan = 0;
+            self.replans += 1;
+            return Ok(None);
+        }
+        self.waypoints.clear();
+        self.path_cells.clear();
+        // "No path" from an estimate the last scan did not confirm may be the estimate's
+        // fault: stand and localise first.
+        if self.localiser.health().consecutive_failures > 0 {
+            return Ok(Some(NavigationStep::Hold));
+        }
+        Ok(Some(NavigationStep::NoPath))
+    }
+
+    /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
+    /// where it changed.
+    fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), AdapterError> {
+        let map_t_lidar = pose * sample.body_t_lidar;
+        let update = self
+            .live
+            .update(&sample.cloud, &map_t_lidar, self.map.floor(), sample.stamp)
+            .map_err(AdapterError::NavigationGrid)?;
+        if let Some(changed) = update.changed {
+            self.refresh(changed)?;
+        }
+        Ok(())
+    }
+
+    fn refresh(&mut self, changed: CellRect) -> Result<(), AdapterError> {
+        self.planning
+            .refresh(self.live.combined(), changed)
+            .map_err(AdapterError::NavigationGrid)?;
+        Ok(())
+    }
+
+    /// Mark the cells just ahead of the body (0.3-0.6 m ahead, 0.5 m wide) as occupied in the
+    /// live layer: what the robot could not walk through.
+    fn mark_ahead(&mut self, pose: &Pose3, stamp: f64) -> Result<(), AdapterError> {
+        let yaw = pose.rotation.euler_angles().2;
+        let (ahead, left) = (
+            Vector2::new(yaw.cos(), yaw.sin()),
+            Vector2::new(-yaw.sin(), yaw.cos()),
+        );
+        let at = pose.translation.vector.xy();
+        let grid = self.live.combined();
+        let mut cells = Vec::new();
+        for f in [0.3, 0.4, 0.5, 0.6] {
+            for s in [-0.25, -0.15, -0.05, 0.05, 0.15, 0.25] {
+                if let Some(c) = grid.occupied().cell_at(at + ahead * f + left * s) {
+                    cells.push(c);
+                }
+            }
+        }
+        let mut changed = CellRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+        for c in cells {
+            let update = self
+                .live
+                .mark(c, CellState::Occupied, stamp)
+                .map_err(AdapterError::NavigationGrid)?;
+            if let Some(r) = update.changed {
+                changed = changed.union(&r);
+            }
+        }
+        self.refresh(changed)
     }
 
     /// The final approach: straight at the goal in the body frame (forward and sideways, no
@@ -320,42 +481,50 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         }
     }
 
-    /// Waypoints (metres) from `position` to `goal` after the start, or `None` when none joins
-    /// them (the goal off the map or blocked, the robot off the map, or no path). A start
-    /// inside the inflated obstacles (the robot brushed a wall) plans from the nearest free
-    /// cell.
+    /// Waypoints (metres) from `position` to `goal` after the start and the dense cells of the
+    /// path, or `None` when none joins them (the goal off the map or blocked, the robot off the
+    /// map, or no path). A start inside the inflated obstacles (the robot brushed a wall) plans
+    /// from the nearest free cell.
+    #[allow(clippy::type_complexity)]
     fn plan(
         &mut self,
         position: Vector2<f64>,
         goal: Vector2<f64>,
-    ) -> Result<Option<Vec<Vector2<f64>>>, AdapterError> {
-        let Some(goal_cell) = self
-            .grid
-            .cell_at(goal)
-            .filter(|&c| !self.grid.is_blocked(c))
-        else {
+    ) -> Result<Option<(Vec<Vector2<f64>>, Vec<Cell>)>, AdapterError> {
+        let grid = self.planning.blocked();
+        let Some(goal_cell) = grid.cell_at(goal).filter(|&c| !grid.is_blocked(c)) else {
             return Ok(None);
         };
-        let Some(start) = self
-            .grid
-            .cell_at(position)
-            .and_then(|c| nearest_free(self.grid, c))
-        else {
+        let Some(start) = grid.cell_at(position).and_then(|c| nearest_free(grid, c)) else {
             return Ok(None);
         };
-        let Some(path) = self
-            .planner
-            .plan(start, goal_cell)
-            .map_err(AdapterError::Planner)?
-        else {
+        let path: Option<GridPath> = match self.config.planner {
+            PlannerKind::CellCostAStar => CellCostAStar::new(grid, self.planning.step_costs())
+                .map_err(|_| AdapterError::invalid("planning costs", f64::NAN, "valid"))?
+                .plan(start, goal_cell),
+            PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
+            PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
+        }
+        .map_err(AdapterError::Planner)?;
+        let Some(path) = path else {
             return Ok(None);
         };
-        let filtered = filter_path(self.grid, &path);
+        let cells = path.expand();
+        // Shortcuts only where they keep room to spare; in narrow places the path's cells.
+        let roomy = self.roomy_grid();
+        let filtered = filter_path(
+            &roomy,
+            &GridPath {
+                cells: cells.clone(),
+                length: path.length,
+                expanded: path.expanded,
+            },
+        );
         let mut waypoints: Vec<Vector2<f64>> = filtered
             .waypoints
             .iter()
             .skip(1)
-            .map(|&c| self.grid.cell_center(c))
+            .map(|&c| grid.cell_center(c))
             .collect();
         // The goal itself, not its cell's centre, ends the path.
         if let Some(last) = waypoints.last_mut() {
@@ -363,19 +532,53 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         } else {
             waypoints.push(goal);
         }
-        Ok(Some(waypoints))
+        Ok(Some((waypoints, cells)))
+    }
+
+    /// The planning grid with every cell closer than the shortcut clearance to an obstacle
+    /// blocked too: the grid straight segments between waypoints must keep to.
+    fn roomy_grid(&self) -> BitGrid {
+        let grid = self.planning.blocked();
+        let limit = self.config.shortcut_clearance as f32;
+        let clearance = self.planning.clearance();
+        let mut roomy = grid.clone();
+        let w = grid.width() as usize;
+        for (k, &d) in clearance.iter().enumerate() {
+            if d < limit {
+                let c = Cell::new((k % w) as u32, (k / w) as u32);
+                // The cell exists: k indexes the grid's cells.
+                let _ = roomy.set(c, true);
+            }
+        }
+        roomy
     }
 
     /// The command toward the first waypoint that is not already underfoot.
     fn command(&self, position: Vector2<f64>, yaw: f64) -> VelocityCommand {
         let near = 0.5 * self.config.goal_tolerance;
-        let target = self
+        let next = self
             .waypoints
             .iter()
-            .find(|w| (*w - position).norm() > near)
-            .or(self.waypoints.last())
-            .copied()
-            .unwrap_or(position);
+            .position(|w| (*w - position).norm() > near)
+            .unwrap_or(self.waypoints.len().saturating_sub(1));
+        // Look ahead along closely spaced waypoints (a path through a narrow place) to the
+        // farthest one within reach that a straight, hard-inflation-free line joins: steering at
+        // a cell 0.1 m ahead would turn the robot in place at every small offset.
+        let grid = self.planning.blocked();
+        let here = grid.cell_at(position);
+        let mut target = self.waypoints.get(next).copied().unwrap_or(position);
+        for w in self.waypoints.iter().skip(next + 1) {
+            if (w - position).norm() > self.config.lookahead {
+                break;
+            }
+            let visible = here
+                .zip(grid.cell_at(*w))
+                .is_some_and(|(a, b)| line_of_sight(grid, a, b));
+            if !visible {
+                break;
+            }
+            target = *w;
+        }
         let to = target - position;
         let error = wrap(to.y.atan2(to.x) - yaw);
         let max_yaw_rate = self.limits.max_yaw_rate;
@@ -407,10 +610,28 @@ impl<'g, R: Registrator> Navigator<'g, R> {
         &self.waypoints
     }
 
-    /// The planning grid: the map's occupancy with obstacles inflated by the clearance.
+    /// The planning grid: the occupancy with the live layer, hard-inflated.
     #[must_use]
     pub fn grid(&self) -> &BitGrid {
-        self.grid
+        self.planning.blocked()
+    }
+
+    /// The live layer (the static map with the scans' changes).
+    #[must_use]
+    pub fn live(&self) -> &LiveLayer {
+        &self.live
+    }
+
+    /// Plans made so far (the first of each goal, blocked paths, the periodic ones).
+    #[must_use]
+    pub fn replans(&self) -> usize {
+        self.replans
+    }
+
+    /// Times the robot was stuck and backed off, so far.
+    #[must_use]
+    pub fn recoveries(&self) -> usize {
+        self.recoveries
     }
 
     /// Cycles whose registration failed, did not converge, matched too little or was an

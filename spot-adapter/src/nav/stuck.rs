@@ -82,6 +82,8 @@ pub(crate) struct StuckMonitor {
     walking: bool,
     backoff_left: usize,
     attempts: usize,
+    /// Whether the last check started a back-off.
+    started: bool,
 }
 
 impl StuckMonitor {
@@ -92,7 +94,14 @@ impl StuckMonitor {
             walking: false,
             backoff_left: 0,
             attempts: 0,
+            started: false,
         }
+    }
+
+    /// Whether the last [`StuckMonitor::check`] began a back-off (the moment to mark what
+    /// blocks the robot).
+    pub(crate) fn just_started(&self) -> bool {
+        self.started
     }
 
     /// Forget the history (a new goal, a relocalisation, an arrival).
@@ -101,11 +110,13 @@ impl StuckMonitor {
         self.walking = false;
         self.backoff_left = 0;
         self.attempts = 0;
+        self.started = false;
     }
 
     /// The state for a cycle at `position` (the estimate), after the command of the cycle
     /// before was recorded by [`StuckMonitor::commanded`].
     pub(crate) fn check(&mut self, position: Vector2<f64>) -> StuckState {
+        self.started = false;
         if self.backoff_left > 0 {
             self.backoff_left -= 1;
             return StuckState::BackingOff;
@@ -132,6 +143,7 @@ impl StuckMonitor {
             return StuckState::Blocked;
         }
         self.backoff_left = self.config.backoff_cycles - 1;
+        self.started = true;
         StuckState::BackingOff
     }
 

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::nav::{DriveOutcome, Navigator, NavigatorConfig, drive, navigation_grid};
+use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_tracker;
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
@@ -12,23 +12,31 @@ use spot_adapter::sim::{
     SimulationConfig,
 };
 
-/// The building of `seed` and a map of it: every 4th scan of one lap of its corridor loop (with
-/// the noise of seed 0), at its true pose, thinned to 5 cm.
-pub fn building_and_map(seed: u64) -> (Building, PointCloud) {
+/// The building of `seed`, a map cloud of it and its navigation map: every 4th scan of one lap
+/// of its corridor loop (with the noise of seed 0), at its true pose (map frame = world frame),
+/// the cloud thinned to 5 cm.
+pub fn building_and_map(seed: u64) -> (Building, PointCloud, NavigationMap) {
     let building = Building::generate(seed, &BuildingConfig::default()).unwrap();
     let lap = Route::corridor_loop(&building);
-    let sim = SimulatedSpot::new(building, &lap, &SimulationConfig::default()).unwrap();
+    let config = SimulationConfig::default();
+    let sim = SimulatedSpot::new(building, &lap, &config).unwrap();
     let building = sim.building().clone();
     let body_t_lidar = sim.body_t_lidar();
     let mut points = Vec::new();
+    let mut scans = Vec::new();
     for sample in sim.step_by(4) {
         let world_t_lidar = sample.ground_truth.unwrap() * body_t_lidar;
         points.extend_from_slice(sample.cloud.transformed(&world_t_lidar).points());
+        scans.push((world_t_lidar, sample.cloud.voxel_downsample(0.05).unwrap()));
     }
     let map = PointCloud::from_points(points)
         .voxel_downsample(0.05)
         .unwrap();
-    (building, map)
+    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
+    let navigation =
+        NavigationMap::from_scans(&refs, lidar_height, &NavigatorConfig::default()).unwrap();
+    (building, map, navigation)
 }
 
 /// `count` goals drawn in rooms and corridors of `building`: at least 0.6 m from every
@@ -109,6 +117,7 @@ impl Start {
 pub fn run_legs(
     building: &Building,
     map: &PointCloud,
+    navigation: &NavigationMap,
     start: &Start,
     goals: &[Vector2<f64>],
     cycles: usize,
@@ -117,12 +126,10 @@ pub fn run_legs(
     let kidnap = &start.kidnap;
     let sim = SimulationConfig::default();
     let mut spot = CommandedSpot::new(building.clone(), start.position, start.yaw, &sim).unwrap();
-    let lidar_height = sim.spot.body_height + sim.spot.body_t_lidar.translation.z;
-    let grid = navigation_grid(map, lidar_height, config).unwrap();
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         map,
-        &grid,
+        navigation,
         // The estimate starts `kidnap` away from the truth.
         spot.body_pose() * kidnap,
         spot.description(),

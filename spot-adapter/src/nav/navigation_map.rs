@@ -1,0 +1,77 @@
+//! The map a navigator plans on, built once per map: the occupancy of the obstacle band above
+//! the floor found under the robot's paths, with free space from the scans' beams and unknown
+//! cells where no beam went.
+
+use gridmap::{FloorMap, OccupancyGrid, OccupancyGridBuilder, floor_hints_below};
+use slam_core::{PointCloud, Pose3};
+
+use crate::error::AdapterError;
+use crate::nav::navigator::NavigatorConfig;
+
+/// The static layer of navigation: occupancy (obstacles from the floor up, free where beams
+/// passed, unknown elsewhere) and the floor under it.
+#[derive(Clone, Debug)]
+pub struct NavigationMap {
+    occupancy: OccupancyGrid,
+    floor: FloorMap,
+}
+
+impl NavigationMap {
+    /// From scans with their poses (`map_T_lidar`, e.g. [`slam_core::GraphSlam::keyframe_scans`])
+    /// of a LiDAR mounted `lidar_height` metres above the floor: the floor is found under the
+    /// scan poses, obstacles are the points of the band above it (`config.band`), free space
+    /// the cells the beams crossed; cells no beam reached are unknown.
+    ///
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for invalid settings, [`AdapterError::NavigationGrid`]
+    /// (with gridmap's error as its source) when the grid cannot be built.
+    pub fn from_scans(
+        scans: &[(Pose3, &PointCloud)],
+        lidar_height: f64,
+        config: &NavigatorConfig,
+    ) -> Result<Self, AdapterError> {
+        config.validate()?;
+        let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
+        let hints = floor_hints_below(&poses, lidar_height);
+        let floor = FloorMap::estimate_from_scans(scans, &hints, &config.floor)
+            .map_err(AdapterError::NavigationGrid)?;
+        let occupancy = OccupancyGridBuilder::new(config.grid.clone())
+            .and_then(|b| b.build_floor_band_from_scans(scans, &floor, &config.band))
+            .map_err(AdapterError::NavigationGrid)?;
+        Ok(Self { occupancy, floor })
+    }
+
+    /// From a map cloud alone (no beams, so no unknown cells: every cell without obstacle
+    /// points is free), the floor found under `sensor_poses` (`map_T_lidar` of a LiDAR
+    /// `lidar_height` metres above the floor).
+    ///
+    /// # Errors
+    /// As [`NavigationMap::from_scans`].
+    pub fn from_cloud(
+        map: &PointCloud,
+        sensor_poses: &[Pose3],
+        lidar_height: f64,
+        config: &NavigatorConfig,
+    ) -> Result<Self, AdapterError> {
+        config.validate()?;
+        let hints = floor_hints_below(sensor_poses, lidar_height);
+        let floor =
+            FloorMap::estimate(map, &hints, &config.floor).map_err(AdapterError::NavigationGrid)?;
+        let occupancy = OccupancyGridBuilder::new(config.grid.clone())
+            .and_then(|b| b.build_floor_band(map, &floor, &config.band))
+            .map_err(AdapterError::NavigationGrid)?;
+        Ok(Self { occupancy, floor })
+    }
+
+    /// The occupancy grid (occupied, free, unknown).
+    #[must_use]
+    pub fn occupancy(&self) -> &OccupancyGrid {
+        &self.occupancy
+    }
+
+    /// The floor under the map.
+    #[must_use]
+    pub fn floor(&self) -> &FloorMap {
+        &self.floor
+    }
+}
