@@ -48,6 +48,7 @@ mod cell_cost_astar;
 mod closed_set;
 mod components;
 mod cost;
+mod cost_ring;
 mod dijkstra;
 mod error;
 mod jps;
