@@ -302,9 +302,11 @@ impl FloorMap {
     /// Index of the tile containing (x, y), clamped to the tiles.
     #[inline]
     fn tile_index(&self, x: f64, y: f64) -> usize {
-        let clamp = |v: f64, n: u32| (v.floor().max(0.0) as u64).min(u64::from(n) - 1) as usize;
-        let tx = clamp((x - self.origin.x) / self.tile, self.width);
-        let ty = clamp((y - self.origin.y) / self.tile, self.height);
+        // Truncation is the floor for the non-negative values kept; NaN becomes 0.
+        let clamp = |v: f64, n: u32| (v.max(0.0) as u64).min(u64::from(n) - 1) as usize;
+        let inv = 1.0 / self.tile;
+        let tx = clamp((x - self.origin.x) * inv, self.width);
+        let ty = clamp((y - self.origin.y) * inv, self.height);
         ty * self.width as usize + tx
     }
 

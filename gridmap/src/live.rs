@@ -468,8 +468,16 @@ impl LiveLayer {
             let Some((a, b)) = below_top(origin, p, limits.1) else {
                 continue;
             };
-            let Some((a, b, cut)) = clip_to_box(to_window(a), to_window(b), size) else {
-                continue;
+            let (a, b) = (to_window(a), to_window(b));
+            let within = |v: Vector2<f64>| v.x >= 0.0 && v.y >= 0.0 && v.x < size.x && v.y < size.y;
+            // The sensor is at the window's centre: clip only beams that leave it.
+            let (a, b, cut) = if within(a) && within(b) {
+                (a, b, false)
+            } else {
+                let Some(clipped) = clip_to_box(a, b, size) else {
+                    continue;
+                };
+                clipped
             };
             let k = b.y as usize * n_us + b.x as usize;
             if kind == Height::Obstacle && !cut {
