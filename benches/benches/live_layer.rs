@@ -55,7 +55,7 @@ fn live_layer(c: &mut Criterion) {
                 let r = layer
                     .update(scan, pose, &mapped.floor, stamp)
                     .unwrap_or_else(|e| panic!("{e}"));
-                if let Some(changed) = r.changed {
+                for changed in [r.observed, r.reverted].into_iter().flatten() {
                     planning
                         .refresh(layer.combined(), changed)
                         .unwrap_or_else(|e| panic!("{e}"));

@@ -94,9 +94,15 @@ pub struct LiveUpdate {
     /// Cells that returned to the static map's state because they were not observed for
     /// [`LiveLayerConfig::decay`] seconds.
     pub decayed: usize,
-    /// The rectangle holding every cell whose state changed (empty when none did): pass it to
+    /// The rectangle holding every cell whose state changed (`None` when none did): pass it to
     /// [`PlanningGrid::refresh`](crate::PlanningGrid::refresh).
     pub changed: Option<CellRect>,
+    /// The rectangle of the cells the scan (or mark) changed: inside the window.
+    pub observed: Option<CellRect>,
+    /// The rectangle of the cells that decayed back to the static map: where the window was
+    /// [`LiveLayerConfig::decay`] seconds ago. Refreshing `observed` and `reverted` separately
+    /// does less work than their union `changed` when they lie apart.
+    pub reverted: Option<CellRect>,
     /// The window's cells on the map this update.
     pub window: Option<CellRect>,
 }
@@ -364,6 +370,7 @@ impl LiveLayer {
                 CellState::Unknown => {}
             }
             grow(&mut report.changed, cell);
+            grow(&mut report.observed, cell);
         }
         if seen != self.static_map.state(cell) {
             let i = cell.y as usize * self.combined.width() as usize + cell.x as usize;
@@ -405,6 +412,7 @@ impl LiveLayer {
             self.combined.set(cell, original)?;
             report.decayed += 1;
             grow(&mut report.changed, cell);
+            grow(&mut report.reverted, cell);
         }
         Ok(())
     }
