@@ -49,7 +49,8 @@ impl FloorConfig {
     /// # Errors
     /// [`GridMapError::InvalidConfig`] for a tile, search, bin or span that is not finite and
     /// positive,
-    /// a bin larger than the search window (`2 search`), or `min_points == 0`.
+    /// a bin larger than the search window (`2 search`) or below a 10,000th of it, or
+    /// `min_points == 0`.
     pub fn validate(&self) -> Result<(), GridMapError> {
         for (setting, v) in [
             ("FloorConfig::tile", self.tile),
@@ -60,10 +61,10 @@ impl FloorConfig {
             check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
         }
         check(
-            self.bin <= 2.0 * self.search,
+            self.bin <= 2.0 * self.search && 2.0 * self.search <= 10_000.0 * self.bin,
             "FloorConfig::bin",
             self.bin,
-            "at most 2 FloorConfig::search",
+            "from 2 FloorConfig::search / 10,000 to 2 FloorConfig::search",
         )?;
         check(
             self.min_points > 0,

@@ -232,6 +232,12 @@ fn bad_floor_settings_and_input_are_errors() {
             invalid(FloorMap::estimate(&cloud, &hint, &config), name);
         }
     }
+    let fine = FloorConfig {
+        search: 1.0e300,
+        bin: 1.0e-300,
+        ..FloorConfig::default()
+    };
+    invalid(FloorMap::estimate(&cloud, &hint, &fine), "FloorConfig::bin");
     let zero = FloorConfig {
         min_points: 0,
         ..FloorConfig::default()

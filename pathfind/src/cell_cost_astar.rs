@@ -134,9 +134,9 @@ impl Units {
 /// let costs: Vec<f32> = (0..27).map(|i| if i / 9 == 1 { 3.0 } else { 1.0 }).collect();
 /// let mut planner = CellCostAStar::new(&grid, &costs)?;
 /// let found = planner.plan_with_cost(Cell::new(0, 1), Cell::new(8, 1))?.expect("a free strip");
-/// // Up into the cheap row, along it, and back down: 2 diagonal steps into cost-1 and cost-3
-/// // cells and 6 straight cost-1 steps.
-/// assert!((found.cost - (6.0 + 4.0 * std::f64::consts::SQRT_2)).abs() < 1e-9);
+/// // Diagonally up into the cheap row, along it, and straight down into the goal: one diagonal
+/// // and seven straight steps into cost-1 cells, one straight step into the cost-3 goal.
+/// assert!((found.cost - (10.0 + std::f64::consts::SQRT_2)).abs() < 1e-9);
 /// // The plain `Planner` answer is the same path.
 /// assert_eq!(planner.plan(Cell::new(0, 1), Cell::new(8, 1))?, Some(found.path));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
