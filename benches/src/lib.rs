@@ -88,3 +88,59 @@ pub mod pathfinding_peer {
         Some(cost as f64 / STRAIGHT as f64)
     }
 }
+
+/// A simulated building mapped as the navigator maps it: one lap of the corridor loop on the
+/// simulated Spot, every few scans kept with its true LiDAR pose, the floor found under the
+/// LiDAR poses and the obstacle band's occupancy with free space from the beams.
+pub mod mapped_building {
+    use gridmap::{
+        FloorConfig, FloorMap, GridMapError, ObstacleBandConfig, OccupancyGrid,
+        OccupancyGridBuilder, OccupancyGridConfig, floor_hints_below,
+    };
+    use slam_core::{PointCloud, Pose3};
+    use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
+
+    /// The mapped building.
+    pub struct MappedBuilding {
+        /// Kept scans (LiDAR frame) with their true `world_T_lidar`.
+        pub scans: Vec<(Pose3, PointCloud)>,
+        /// The floor under the LiDAR poses (0.80 m above the floor).
+        pub floor: FloorMap,
+        /// The obstacle band's occupancy at 0.10 m, unknown where no beam passed.
+        pub occupancy: OccupancyGrid,
+    }
+
+    /// Building `seed` of the default generator, mapped from every `every`-th scan of one lap
+    /// (noise and drift of the default simulation).
+    ///
+    /// # Errors
+    /// The simulation's or the grid's error, as text.
+    pub fn map(seed: u64, every: usize) -> Result<MappedBuilding, String> {
+        let config = SimulationConfig::default();
+        let sim = Building::generate(seed, &BuildingConfig::default())
+            .and_then(|b| SimulatedSpot::new(b.clone(), &Route::corridor_loop(&b), &config))
+            .map_err(|e| e.to_string())?;
+        let body_t_lidar = sim.body_t_lidar();
+        let scans: Vec<(Pose3, PointCloud)> = sim
+            .step_by(every.max(1))
+            .filter_map(|s| s.ground_truth.map(|t| (t * body_t_lidar, s.cloud)))
+            .collect();
+        let grid = |e: GridMapError| e.to_string();
+        let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
+        let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
+        let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+        let hints = floor_hints_below(&poses, lidar_height);
+        let floor =
+            FloorMap::estimate_from_scans(&refs, &hints, &FloorConfig::default()).map_err(grid)?;
+        let occupancy = OccupancyGridBuilder::new(OccupancyGridConfig::default())
+            .and_then(|b| {
+                b.build_floor_band_from_scans(&refs, &floor, &ObstacleBandConfig::default())
+            })
+            .map_err(grid)?;
+        Ok(MappedBuilding {
+            scans,
+            floor,
+            occupancy,
+        })
+    }
+}

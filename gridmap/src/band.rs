@@ -188,7 +188,7 @@ impl OccupancyGridBuilder {
                     if let Some(i) = end {
                         let c = Cell::new((i % w as usize) as u32, (i / w as usize) as u32);
                         if min_points > 1 {
-                            counts[i] += 1;
+                            counts[i] = counts[i].saturating_add(1);
                             if counts[i] >= min_points {
                                 grid.set(c, CellState::Occupied)?;
                             }

@@ -23,6 +23,9 @@ pub struct FloorConfig {
     /// the points in the lowest dense bin and the bin above it. Tiles with no dense bin take
     /// their neighbours' floor.
     pub min_points: u32,
+    /// The floor lies within this distance of the hints' heights, 1.0 m: points farther above
+    /// or below them (most of the walls, the ceiling) are not looked at.
+    pub span: f64,
     /// The largest number of tiles allocated (guards against a stray far point), 10,000,000.
     pub max_tiles: u64,
 }
@@ -34,6 +37,7 @@ impl Default for FloorConfig {
             search: 0.15,
             bin: 0.02,
             min_points: 5,
+            span: 1.0,
             max_tiles: 10_000_000,
         }
     }
@@ -43,21 +47,24 @@ impl FloorConfig {
     /// Check every setting.
     ///
     /// # Errors
-    /// [`GridMapError::InvalidConfig`] for a tile, search or bin that is not finite and positive,
-    /// a bin larger than the search window (`2 search`), or `min_points == 0`.
+    /// [`GridMapError::InvalidConfig`] for a tile, search, bin or span that is not finite and
+    /// positive,
+    /// a bin larger than the search window (`2 search`) or below a 10,000th of it, or
+    /// `min_points == 0`.
     pub fn validate(&self) -> Result<(), GridMapError> {
         for (setting, v) in [
             ("FloorConfig::tile", self.tile),
             ("FloorConfig::search", self.search),
             ("FloorConfig::bin", self.bin),
+            ("FloorConfig::span", self.span),
         ] {
             check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
         }
         check(
-            self.bin <= 2.0 * self.search,
+            self.bin <= 2.0 * self.search && 2.0 * self.search <= 10_000.0 * self.bin,
             "FloorConfig::bin",
             self.bin,
-            "at most 2 FloorConfig::search",
+            "from 2 FloorConfig::search / 10,000 to 2 FloorConfig::search",
         )?;
         check(
             self.min_points > 0,
@@ -103,7 +110,9 @@ impl FloorMap {
         })
     }
 
-    /// The floor of `cloud` (map frame, z up), per tile of `config.tile` over the cloud's extent.
+    /// The floor of `cloud` (map frame, z up), per tile of `config.tile` over the extent of its
+    /// points within `config.span` of the hints' heights (one flat tile at the hints' mean height
+    /// when there is none).
     ///
     /// `hints` are points on the floor under the robot's paths (map frame; the feet of the robot
     /// at its poses, or the LiDAR's positions lowered by its height above the ground: see
@@ -155,21 +164,26 @@ impl FloorMap {
         if scans.iter().all(|(_, c)| c.is_empty()) {
             return Err(GridMapError::EmptyCloud);
         }
-        let mut bad = 0;
-        let mut points = Vec::new();
-        for (pose, cloud) in scans {
-            for p in cloud.points() {
-                if p.iter().all(|v| v.is_finite()) {
-                    points.push(pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)));
-                } else {
-                    bad += 1;
-                }
-            }
-        }
+        let bad: usize = scans
+            .iter()
+            .map(|(_, c)| {
+                c.points()
+                    .iter()
+                    .filter(|p| !p.iter().all(|v| v.is_finite()))
+                    .count()
+            })
+            .sum();
         if bad > 0 {
             return Err(GridMapError::NonFinitePoints { count: bad });
         }
-        Self::estimate_points(points.iter().copied(), hints, config)
+        // Transformed on every pass rather than stored: a map's scans hold millions of points.
+        let points = scans.iter().flat_map(|(pose, cloud)| {
+            cloud
+                .points()
+                .iter()
+                .map(move |p| pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
+        });
+        Self::estimate_points(points, hints, config)
     }
 
     fn estimate_points(
@@ -200,6 +214,11 @@ impl FloorMap {
         for p in points.clone() {
             lo = lo.inf(&p.coords.xy());
             hi = hi.sup(&p.coords.xy());
+        }
+        if lo.x > hi.x {
+            // No point near the hints' heights: one tile at the hints' mean height.
+            let mean = hints.iter().map(|h| h.z).sum::<f64>() / hints.len() as f64;
+            return Self::flat(mean);
         }
         let t = config.tile;
         let origin = Vector2::new((lo.x / t).floor() * t, (lo.y / t).floor() * t);
@@ -302,9 +321,11 @@ impl FloorMap {
     /// Index of the tile containing (x, y), clamped to the tiles.
     #[inline]
     fn tile_index(&self, x: f64, y: f64) -> usize {
-        let clamp = |v: f64, n: u32| (v.floor().max(0.0) as u64).min(u64::from(n) - 1) as usize;
-        let tx = clamp((x - self.origin.x) / self.tile, self.width);
-        let ty = clamp((y - self.origin.y) / self.tile, self.height);
+        // Truncation is the floor for the non-negative values kept; NaN becomes 0.
+        let clamp = |v: f64, n: u32| (v.max(0.0) as u64).min(u64::from(n) - 1) as usize;
+        let inv = 1.0 / self.tile;
+        let tx = clamp((x - self.origin.x) * inv, self.width);
+        let ty = clamp((y - self.origin.y) * inv, self.height);
         ty * self.width as usize + tx
     }
 

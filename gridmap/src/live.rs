@@ -106,9 +106,15 @@ pub struct LiveUpdate {
     /// Cells that returned to the static map's state because they were not observed for
     /// [`LiveLayerConfig::decay`] seconds.
     pub decayed: usize,
-    /// The rectangle holding every cell whose state changed (empty when none did): pass it to
+    /// The rectangle holding every cell whose state changed (`None` when none did): pass it to
     /// [`PlanningGrid::refresh`](crate::PlanningGrid::refresh).
     pub changed: Option<CellRect>,
+    /// The rectangle of the cells the scan (or mark) changed: inside the window.
+    pub observed: Option<CellRect>,
+    /// The rectangle of the cells that decayed back to the static map: where the window was
+    /// [`LiveLayerConfig::decay`] seconds ago. Refreshing `observed` and `reverted` separately
+    /// does less work than their union `changed` when they lie apart.
+    pub reverted: Option<CellRect>,
     /// The window's cells on the map this update.
     pub window: Option<CellRect>,
 }
@@ -376,6 +382,7 @@ impl LiveLayer {
                 CellState::Unknown => {}
             }
             grow(&mut report.changed, cell);
+            grow(&mut report.observed, cell);
         }
         if seen != self.static_map.state(cell) {
             let i = cell.y as usize * self.combined.width() as usize + cell.x as usize;
@@ -417,6 +424,7 @@ impl LiveLayer {
             self.combined.set(cell, original)?;
             report.decayed += 1;
             grow(&mut report.changed, cell);
+            grow(&mut report.reverted, cell);
         }
         Ok(())
     }
@@ -489,8 +497,16 @@ impl LiveLayer {
             let Some((a, b)) = below_top(origin, p, clear_top) else {
                 continue;
             };
-            let Some((a, b, cut)) = clip_to_box(to_window(a), to_window(b), size) else {
-                continue;
+            let (a, b) = (to_window(a), to_window(b));
+            let within = |v: Vector2<f64>| v.x >= 0.0 && v.y >= 0.0 && v.x < size.x && v.y < size.y;
+            // The sensor is at the window's centre: clip only beams that leave it.
+            let (a, b, cut) = if within(a) && within(b) {
+                (a, b, false)
+            } else {
+                let Some(clipped) = clip_to_box(a, b, size) else {
+                    continue;
+                };
+                clipped
             };
             let k = b.y as usize * n_us + b.x as usize;
             // The end cell is free when the beam ended on the floor there.

@@ -6,7 +6,7 @@ use slam_core::{BitGrid, Cell};
 
 use crate::distance::{DistanceField, squared_distance_cells};
 use crate::error::{GridMapError, check};
-use crate::occupancy::{CellState, OccupancyGrid, UnknownCells};
+use crate::occupancy::{OccupancyGrid, UnknownCells};
 
 /// The clearance cost: entering a cell `d` metres from the nearest obstacle costs the step's
 /// length times `1 + weight * penalty(d)`, with
@@ -141,6 +141,41 @@ impl PlanningGridConfig {
             self.inflation
         }
     }
+}
+
+/// The obstacles of `occupancy` inside `rect` (non-empty, on the grid) as a grid of its own:
+/// occupied cells, and unknown cells when they count as blocked. Word by word.
+fn obstacles(
+    occupancy: &OccupancyGrid,
+    rect: CellRect,
+    unknown: UnknownCells,
+) -> Result<BitGrid, GridMapError> {
+    let (w, h) = (rect.x1 - rect.x0, rect.y1 - rect.y0);
+    let mut sub = BitGrid::new(w, h)?;
+    let (occupied, free) = (occupancy.occupied(), occupancy.known_free());
+    for y in 0..h {
+        let row = sub.row_words_mut(y);
+        for (k, word) in row.iter_mut().enumerate() {
+            let x = rect.x0 + 64 * k as u32;
+            // Cells past the source's east edge read as blocked; the padding is restored below.
+            let occ = occupied.word_at(x, rect.y0 + y);
+            *word = if unknown == UnknownCells::Blocked {
+                occ | !free.word_at(x, rect.y0 + y)
+            } else {
+                occ
+            };
+        }
+    }
+    // Bits past the rectangle's east edge: clear them, then set the padding.
+    let tail = w % 64;
+    if tail != 0 {
+        let last = sub.stride_words() - 1;
+        for y in 0..h {
+            sub.row_words_mut(y)[last] &= (1u64 << tail) - 1;
+        }
+    }
+    sub.restore_padding();
+    Ok(sub)
 }
 
 /// A rectangle of cells, `x0..x1` by `y0..y1` (ends excluded).
@@ -304,15 +339,7 @@ impl PlanningGrid {
             return Ok(());
         }
         let source = written.grown(self.reach_cells(), w, h);
-        let unknown_blocked = self.config.unknown == UnknownCells::Blocked;
-        let obstacle = |x: u32, y: u32| match occupancy.state(Cell::new(x, y)) {
-            CellState::Occupied => true,
-            CellState::Unknown => unknown_blocked,
-            CellState::Free => false,
-        };
-        let sub = BitGrid::from_fn(source.x1 - source.x0, source.y1 - source.y0, |x, y| {
-            obstacle(source.x0 + x, source.y0 + y)
-        })?;
+        let sub = obstacles(occupancy, source, self.config.unknown)?;
         let d2 = squared_distance_cells(&sub);
         let res = occupancy.geometry().resolution;
         let reach = self.config.reach();

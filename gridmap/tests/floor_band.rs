@@ -69,6 +69,13 @@ fn floor_follows_a_gentle_ramp_and_skips_the_crate() {
             assert!(err.abs() < 0.012, "tile ({i}, {j}): off by {err}");
         }
     }
+    // No point within the span (1 m) of the hints: the hints' height, flat.
+    let high = PointCloud::from_points(vec![Point3::new(1.0, 1.0, 2.5); 10]);
+    let flat = FloorMap::estimate(&high, &hints[..1], &FloorConfig::default()).unwrap();
+    assert_eq!(
+        (flat.measured_tiles(), flat.floor_at(9.0, 9.0)),
+        (0, hints[0].z)
+    );
     // Outside the tiles: the nearest tile.
     assert!((floor.floor_at(-50.0, 3.0) - floor.floor_at(0.5, 3.0)).abs() < 1e-12);
     // One flat height would be 6 cm off at the ends (the hints' mean): inside the default band's
@@ -214,10 +221,23 @@ fn bad_floor_settings_and_input_are_errors() {
                     ..FloorConfig::default()
                 },
             ),
+            (
+                "FloorConfig::span",
+                FloorConfig {
+                    span: v,
+                    ..FloorConfig::default()
+                },
+            ),
         ] {
             invalid(FloorMap::estimate(&cloud, &hint, &config), name);
         }
     }
+    let fine = FloorConfig {
+        search: 1.0e300,
+        bin: 1.0e-300,
+        ..FloorConfig::default()
+    };
+    invalid(FloorMap::estimate(&cloud, &hint, &fine), "FloorConfig::bin");
     let zero = FloorConfig {
         min_points: 0,
         ..FloorConfig::default()

@@ -138,6 +138,15 @@ fn dropped_box_in_removed_crate_out_then_both_decay() {
     assert_eq!(layer.combined().state(box_face), CellState::Occupied);
     let r = layer.update(&far_scan, &far, &floor, 5.0).unwrap();
     assert_eq!(r.decayed, differing);
+    let reverted = r.reverted.unwrap();
+    assert!(
+        reverted.x0 >= window.x0 && reverted.x1 <= window.x1,
+        "{reverted:?}"
+    );
+    assert_eq!(
+        r.changed.unwrap(),
+        reverted.union(&r.observed.unwrap_or(reverted))
+    );
     assert_eq!(layer.combined(), &map);
 }
 

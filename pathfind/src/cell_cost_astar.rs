@@ -6,12 +6,19 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner, validate_endpoints}
 
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
+use crate::cost_ring::CostRing;
 use crate::error::PathfindError;
-use crate::movement::{DIRECTIONS, SQRT_2, octile, path_cost};
+use crate::movement::{DIRECTIONS, SQRT_2, path_cost};
 use crate::open_list::{KeyHeap, Open, OpenList};
 
-/// Length of a step in each of the [`DIRECTIONS`]: four straight, then four diagonal.
-const STEP_LENGTH: [f64; 8] = [1.0, 1.0, 1.0, 1.0, SQRT_2, SQRT_2, SQRT_2, SQRT_2];
+/// Fractional bits of the fixed-point costs at most (as [`crate::cost`]: 2^-29 cells).
+const MAX_FRACTION_BITS: u32 = 29;
+/// ... and at least: fewer would round the multipliers too coarsely.
+const MIN_FRACTION_BITS: u32 = 16;
+
+/// Above this largest multiplier the open list is a binary heap, below it a bucket ring (whose
+/// buckets would grow too wide to be worth it).
+const RING_UP_TO: f32 = 64.0;
 
 /// A least-cost path found by [`CellCostAStar`].
 #[derive(Clone, Debug, PartialEq)]
@@ -27,7 +34,7 @@ pub struct CostedPath {
 /// One cell's search record.
 #[derive(Clone, Copy, Debug)]
 struct Node {
-    g: f64,
+    g: u64,
     parent: u32,
     /// `generation << 1 | closed`: `g` and `parent` are valid when the generation is current.
     stamp: u32,
@@ -35,6 +42,68 @@ struct Node {
 
 /// Generations run from 1 to this value, then the stamps are cleared once.
 const MAX_GENERATION: u32 = u32::MAX >> 1;
+
+/// The open list: a ring of buckets when the multipliers are bounded (a successor's priority
+/// exceeds its parent's by at most its step's cost plus its length), else a heap.
+enum Queue {
+    Ring(CostRing),
+    Heap(KeyHeap),
+}
+
+impl Queue {
+    #[inline]
+    fn clear(&mut self) {
+        match self {
+            Self::Ring(r) => r.clear(),
+            Self::Heap(h) => h.clear(),
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, f: u64, tie: u32, index: u32) {
+        match self {
+            Self::Ring(r) => r.push(f, tie, index),
+            Self::Heap(h) => h.push(Open { f, tie, index }),
+        }
+    }
+
+    #[inline]
+    fn pop(&mut self) -> Option<(u64, u32)> {
+        match self {
+            Self::Ring(r) => r.pop().map(|e| (e.f, e.index)),
+            Self::Heap(h) => h.pop().map(|o| (o.f, o.index)),
+        }
+    }
+}
+
+/// Fixed-point path costs in units of `2^-bits` cells.
+#[derive(Clone, Copy, Debug)]
+struct Units {
+    bits: u32,
+    straight: u64,
+    diagonal: u64,
+}
+
+impl Units {
+    fn new(bits: u32) -> Self {
+        let straight = 1u64 << bits;
+        Self {
+            bits,
+            straight,
+            diagonal: (SQRT_2 * straight as f64).round() as u64,
+        }
+    }
+
+    /// The octile distance: the exact cost on an empty grid of unit multipliers, never above the
+    /// fixed-point cost of any path (every step costs at least `straight` or `diagonal`).
+    #[inline]
+    fn octile(&self, a: Cell, b: Cell) -> u64 {
+        let dx = a.x.abs_diff(b.x);
+        let dy = a.y.abs_diff(b.y);
+        let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+        u64::from(hi - lo) * self.straight + u64::from(lo) * self.diagonal
+    }
+}
 
 /// A* for per-cell traversal costs: a step from a cell to a neighbour costs the step's length
 /// (1 straight, sqrt(2) diagonal) times the neighbour's cost multiplier, so the planner returns
@@ -65,9 +134,9 @@ const MAX_GENERATION: u32 = u32::MAX >> 1;
 /// let costs: Vec<f32> = (0..27).map(|i| if i / 9 == 1 { 3.0 } else { 1.0 }).collect();
 /// let mut planner = CellCostAStar::new(&grid, &costs)?;
 /// let found = planner.plan_with_cost(Cell::new(0, 1), Cell::new(8, 1))?.expect("a free strip");
-/// // Up into the cheap row, along it, and back down: 2 diagonal steps into cost-1 and cost-3
-/// // cells and 6 straight cost-1 steps.
-/// assert!((found.cost - (6.0 + 4.0 * std::f64::consts::SQRT_2)).abs() < 1e-9);
+/// // Diagonally up into the cheap row, along it, and straight down into the goal: one diagonal
+/// // and seven straight steps into cost-1 cells, one straight step into the cost-3 goal.
+/// assert!((found.cost - (10.0 + std::f64::consts::SQRT_2)).abs() < 1e-9);
 /// // The plain `Planner` answer is the same path.
 /// assert_eq!(planner.plan(Cell::new(0, 1), Cell::new(8, 1))?, Some(found.path));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
@@ -79,7 +148,12 @@ pub struct CellCostAStar<'g> {
     closed: ClosedSet,
     nodes: Vec<Node>,
     generation: u32,
-    open: KeyHeap,
+    open: Queue,
+    /// Cells queued with `f` equal to `current_f`: expanded before anything on the open list.
+    same_f: Vec<u32>,
+    /// `f` of the last cell taken off the open list.
+    current_f: u64,
+    units: Units,
     /// Whether the octile heuristic guides the search (off: Dijkstra's order, an ablation).
     heuristic: bool,
 }
@@ -91,12 +165,43 @@ impl<'g> CellCostAStar<'g> {
     /// Labels the grid's connected components once and allocates 16 bytes of search records per
     /// cell, reused by every query.
     ///
+    /// The search adds costs in fixed point, `2^-b` cells with `b` = 29 (as the other planners
+    /// of this crate) unless the largest multiplier times the free cells needs fewer bits (`b`
+    /// down to 16), so that no path's cost can overflow; each step's cost is rounded down to a
+    /// unit, never below its length. The path found is optimal for those costs, which differ
+    /// from the exact ones by less than one unit per step (`2^-29` cells, relative `2e-9`).
+    ///
     /// # Errors
     /// [`PathfindError::CellCostCount`] when `costs` does not have one value per cell,
     /// [`PathfindError::InvalidCellCost`] for a free cell whose multiplier is not finite or is
-    /// below 1 (a multiplier below 1 would make the octile heuristic overestimate).
+    /// below 1 (a multiplier below 1 would make the octile heuristic overestimate),
+    /// [`PathfindError::CellCostsTooLarge`] when the largest multiplier times the free cells
+    /// exceeds `2^46 / sqrt(2)` (about 5e13).
     pub fn new(grid: &'g BitGrid, costs: &'g [f32]) -> Result<Self, PathfindError> {
-        check_costs(grid, costs)?;
+        let largest = check_costs(grid, costs)?;
+        // The costliest simple path visits every free cell once: keep it and its priority (g
+        // plus a heuristic of at most the grid's octile diameter) below 2^62.
+        let free = (grid.len() - grid.count_blocked()) as f64;
+        let worst = SQRT_2
+            * (f64::from(largest) * (free + 1.0)
+                + f64::from(grid.width())
+                + f64::from(grid.height()));
+        let room = (62.0 - worst.log2()).floor();
+        if room < f64::from(MIN_FRACTION_BITS) {
+            return Err(PathfindError::CellCostsTooLarge {
+                largest: f64::from(largest),
+                cells: grid.len() - grid.count_blocked(),
+            });
+        }
+        let units = Units::new((room as u32).min(MAX_FRACTION_BITS));
+        let open = if largest <= RING_UP_TO {
+            // A step costs at most sqrt(2) times the largest multiplier (in units, rounded down)
+            // and lowers the octile heuristic by at most one diagonal.
+            let window = (units.diagonal as f64 * f64::from(largest)) as u64 + units.diagonal + 1;
+            Queue::Ring(CostRing::new(window, units.bits.saturating_sub(6)))
+        } else {
+            Queue::Heap(KeyHeap::default())
+        };
         Ok(Self {
             grid,
             costs,
@@ -104,20 +209,23 @@ impl<'g> CellCostAStar<'g> {
             closed: ClosedSet::new(grid),
             nodes: vec![
                 Node {
-                    g: 0.0,
+                    g: 0,
                     parent: 0,
                     stamp: 0,
                 };
                 grid.len()
             ],
             generation: 0,
-            open: KeyHeap::default(),
+            open,
+            same_f: Vec::new(),
+            current_f: 0,
+            units,
             heuristic: true,
         })
     }
 
     /// The same search without a heuristic (uniform-cost search, Dijkstra's order): an ablation
-    /// that shows what the octile heuristic saves. Same paths costs, more expansions.
+    /// that shows what the octile heuristic saves. Same path costs, more expansions.
     ///
     /// # Errors
     /// As [`CellCostAStar::new`].
@@ -143,36 +251,30 @@ impl<'g> CellCostAStar<'g> {
             return Ok(None);
         }
         let width = self.grid.width();
-        let index = |c: Cell| c.y * width + c.x;
-        let (s, t) = (index(start), index(goal));
+        let (s, t) = (start.y * width + start.x, goal.y * width + goal.x);
         self.reset();
         self.closed.reset();
         let generation = self.generation << 1;
         self.nodes[s as usize] = Node {
-            g: 0.0,
+            g: 0,
             parent: s,
             stamp: generation,
         };
-        let h = |c: Cell, on: bool| if on { octile(c, goal) } else { 0.0 };
-        self.open.push(entry(h(start, self.heuristic), 0.0, s));
+        let (units, heuristic) = (self.units, self.heuristic);
+        let h = |c: Cell| if heuristic { units.octile(c, goal) } else { 0 };
+        self.open.push(h(start), u32::MAX, s);
         // Index offset of the neighbour in each direction (row-major), modulo 2^32.
         let offset = DIRECTIONS.map(|(dx, dy)| {
             dy.cast_unsigned()
                 .wrapping_mul(width)
                 .wrapping_add(dx.cast_unsigned())
         });
+        let step = [units.straight as f64, units.diagonal as f64];
         let mut expanded = 0;
-        while let Some(o) = self.open.pop() {
-            let i = o.index;
-            let node = &mut self.nodes[i as usize];
-            if node.stamp & 1 != 0 {
-                continue; // A stale entry of a cell already expanded.
-            }
-            node.stamp |= 1;
-            let g = node.g;
+        while let Some((i, g)) = self.pop() {
             expanded += 1;
             if i == t {
-                return Ok(Some(self.path(s, t, g, expanded)));
+                return Ok(Some(self.path(s, t, expanded)));
             }
             let c = Cell::new(i % width, i / width);
             self.closed.insert(c);
@@ -181,9 +283,11 @@ impl<'g> CellCostAStar<'g> {
                 let d = steps.trailing_zeros() as usize;
                 steps &= steps - 1;
                 let j = i.wrapping_add(offset[d]);
-                let g_new = g + STEP_LENGTH[d] * f64::from(self.costs[j as usize]);
+                // Rounded down, but never below the step's length (multipliers are at least 1).
+                let cost = (step[d / 4] * f64::from(self.costs[j as usize])) as u64;
+                let g_new = g + cost;
                 let n = &mut self.nodes[j as usize];
-                if n.stamp >> 1 == self.generation && n.g <= g_new {
+                if n.stamp >> 1 == self.generation && (n.g <= g_new || n.stamp & 1 != 0) {
                     continue;
                 }
                 *n = Node {
@@ -192,18 +296,53 @@ impl<'g> CellCostAStar<'g> {
                     stamp: generation,
                 };
                 let (dx, dy) = DIRECTIONS[d];
-                let nc = Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
-                self.open
-                    .push(entry(g_new + h(nc, self.heuristic), g_new, j));
+                let f = g_new
+                    + h(Cell::new(
+                        c.x.wrapping_add_signed(dx),
+                        c.y.wrapping_add_signed(dy),
+                    ));
+                // `f` never decreases along the expansions (consistent heuristic, exact integer
+                // costs), so `f <= current_f` means equal: expand it next, off the open list.
+                if f <= self.current_f {
+                    self.same_f.push(j);
+                } else {
+                    // Among equal `f`, the larger `g` first.
+                    let tie = u32::MAX - u32::try_from(g_new >> units.bits).unwrap_or(u32::MAX);
+                    self.open.push(f, tie, j);
+                }
             }
         }
         // The open list ran dry: unreachable (the component check above normally answers first).
         Ok(None)
     }
 
+    /// The next cell to expand (not expanded before in this query), marked expanded, with its
+    /// cost.
+    #[inline]
+    fn pop(&mut self) -> Option<(u32, u64)> {
+        while let Some(i) = self.same_f.pop() {
+            let n = &mut self.nodes[i as usize];
+            if n.stamp & 1 == 0 {
+                n.stamp |= 1;
+                return Some((i, n.g));
+            }
+        }
+        while let Some((f, i)) = self.open.pop() {
+            let n = &mut self.nodes[i as usize];
+            if n.stamp & 1 == 0 {
+                n.stamp |= 1;
+                self.current_f = f;
+                return Some((i, n.g));
+            }
+        }
+        None
+    }
+
     /// Forget the last query.
     fn reset(&mut self) {
         self.open.clear();
+        self.same_f.clear();
+        self.current_f = 0;
         if self.generation >= MAX_GENERATION {
             for n in &mut self.nodes {
                 n.stamp = 0;
@@ -213,8 +352,8 @@ impl<'g> CellCostAStar<'g> {
         self.generation += 1;
     }
 
-    /// The path to `goal` by following parents back to `start`.
-    fn path(&self, start: u32, goal: u32, cost: f64, expanded: usize) -> CostedPath {
+    /// The path to `goal` by following parents back to `start`, with its cost summed in `f64`.
+    fn path(&self, start: u32, goal: u32, expanded: usize) -> CostedPath {
         let width = self.grid.width();
         let cell = |i: u32| Cell::new(i % width, i / width);
         let mut cells = vec![cell(goal)];
@@ -224,6 +363,14 @@ impl<'g> CellCostAStar<'g> {
             cells.push(cell(i));
         }
         cells.reverse();
+        let cost = cells
+            .windows(2)
+            .map(|w| {
+                let diagonal = w[0].x != w[1].x && w[0].y != w[1].y;
+                let m = f64::from(self.costs[(w[1].y * width + w[1].x) as usize]);
+                if diagonal { SQRT_2 * m } else { m }
+            })
+            .sum();
         CostedPath {
             path: GridPath {
                 length: path_cost(&cells),
@@ -235,19 +382,9 @@ impl<'g> CellCostAStar<'g> {
     }
 }
 
-/// An open-list entry of priority `f` (positive, so its bits order as the numbers do), ties to
-/// the larger `g`.
-#[inline]
-fn entry(f: f64, g: f64, index: u32) -> Open {
-    Open {
-        f: f.to_bits(),
-        tie: u32::MAX - (g as f32).to_bits(),
-        index,
-    }
-}
-
-/// One multiplier per cell, finite and at least 1 on every free cell.
-fn check_costs(grid: &BitGrid, costs: &[f32]) -> Result<(), PathfindError> {
+/// One multiplier per cell, finite and at least 1 on every free cell; returns the largest on a
+/// free cell.
+fn check_costs(grid: &BitGrid, costs: &[f32]) -> Result<f32, PathfindError> {
     if costs.len() != grid.len() {
         return Err(PathfindError::CellCostCount {
             got: costs.len(),
@@ -256,12 +393,18 @@ fn check_costs(grid: &BitGrid, costs: &[f32]) -> Result<(), PathfindError> {
         });
     }
     let width = grid.width() as usize;
+    let mut largest = 1.0f32;
     for (row, values) in costs.chunks_exact(width).enumerate() {
         for (x, &v) in values.iter().enumerate() {
             // `!(v >= 1)` also catches NaN.
-            if !(v >= 1.0 && v.is_finite()) {
+            if !(v >= 1.0 && v.is_finite()) || v > largest {
                 let c = Cell::new(x as u32, row as u32);
-                if !grid.is_blocked(c) {
+                if grid.is_blocked(c) {
+                    continue;
+                }
+                if v > largest && v.is_finite() {
+                    largest = v;
+                } else {
                     return Err(PathfindError::InvalidCellCost {
                         x: c.x,
                         y: c.y,
@@ -271,7 +414,7 @@ fn check_costs(grid: &BitGrid, costs: &[f32]) -> Result<(), PathfindError> {
             }
         }
     }
-    Ok(())
+    Ok(largest)
 }
 
 impl Planner for CellCostAStar<'_> {

@@ -36,6 +36,17 @@ pub enum PathfindError {
         /// The multiplier given.
         value: f64,
     },
+    /// The multipliers are too large for the grid: the costliest path could overflow the
+    /// search's fixed-point costs.
+    #[error(
+        "cost multipliers up to {largest} on {cells} free cells: their product must stay below 5e13"
+    )]
+    CellCostsTooLarge {
+        /// The largest multiplier on a free cell.
+        largest: f64,
+        /// Free cells.
+        cells: usize,
+    },
     /// A Moving AI file could not be parsed.
     #[error("line {line}: {message}")]
     Parse {

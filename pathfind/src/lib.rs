@@ -9,6 +9,9 @@
 //!   2014), or one cell at a time with [`JumpPointSearch::with_cell_scans`].
 //! - [`JumpPointSearchPlus`]: JPS+ (Harabor & Grastien, ICAPS 2014), the same search with jump
 //!   distances precomputed per grid, O(1) per jump.
+//! - [`CellCostAStar`]: A* on per-cell cost multipliers (each at least 1, so the octile heuristic
+//!   stays admissible): least-cost paths for a clearance cost from a distance field, the
+//!   thesis' future work f = g + h + o. With every multiplier 1 it returns `AStar`'s lengths.
 //! - [`filter_path`]: the thesis' path filter, keeping only the waypoints a straight
 //!   collision-free segment cannot skip ([`line_of_sight`] walks every touched cell).
 //! - [`movingai`]: readers for the Moving AI `.map` and `.scen` benchmark files.
@@ -37,9 +40,10 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! When not to use it: for any-angle optimal paths (Theta*, Anya) or weighted terrain costs, these
-//! planners give grid-optimal paths on a binary grid only; the filter shortens them but does not
-//! make them any-angle optimal.
+//! When not to use it: for any-angle optimal paths (Theta*, Anya) these planners give
+//! grid-optimal paths only; the filter shortens them but does not make them any-angle optimal.
+//! Per-cell costs are for [`CellCostAStar`] alone (the jump-point planners search binary grids),
+//! and costs below the step length (multipliers under 1) are not supported.
 
 mod astar;
 mod best_first;
@@ -48,6 +52,7 @@ mod cell_cost_astar;
 mod closed_set;
 mod components;
 mod cost;
+mod cost_ring;
 mod dijkstra;
 mod error;
 mod jps;

@@ -25,13 +25,15 @@ fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
     BitGrid::from_fn(w, h, |_, _| (r() % 100) < u64::from(density)).unwrap()
 }
 
-/// Random multipliers: all 1, uniform in [1, 6), or a few expensive cells among cheap ones.
+/// Random multipliers: all 1, uniform in [1, 6), a few expensive cells among cheap ones, or
+/// multipliers up to 1000 (past the bucket ring's range: the heap).
 fn random_costs(n: usize, kind: u8, seed: u64) -> Vec<f32> {
     let mut r = xorshift(seed ^ 0x9E37_79B9_7F4A_7C15);
     (0..n)
         .map(|_| match kind {
             0 => 1.0,
             1 => 1.0 + (r() % 5000) as f32 / 1000.0,
+            3 => 1.0 + (r() % 1000) as f32,
             _ => {
                 if r().is_multiple_of(10) {
                     20.0
@@ -118,7 +120,7 @@ proptest! {
 
     #[test]
     fn cost_equals_brute_force_dijkstra(
-        w in 1u32..70, h in 1u32..70, density in 0u32..=40, seed in any::<u64>(), kind in 0u8..3,
+        w in 1u32..70, h in 1u32..70, density in 0u32..=40, seed in any::<u64>(), kind in 0u8..4,
         picks in proptest::collection::vec((any::<u64>(), any::<u64>()), 1..5),
     ) {
         let grid = random_grid(w, h, density, seed);
@@ -182,6 +184,27 @@ fn bad_costs_and_endpoints_are_errors() {
         costs[3 * 10 + 5] = bad;
         assert!(CellCostAStar::new(&grid, &costs).is_ok());
     }
+    // Multipliers so large that the costliest path could overflow the fixed-point costs.
+    let mut huge = vec![1.0; 100];
+    huge[0] = 1.0e30;
+    assert!(matches!(
+        CellCostAStar::new(&grid, &huge),
+        Err(PathfindError::CellCostsTooLarge { cells: 90, .. })
+    ));
+    // Large but representable with fewer fractional bits: still least-cost paths.
+    let mut large = vec![1.0; 100];
+    large[2 * 10 + 2] = 1.0e9;
+    let mut p = CellCostAStar::new(&grid, &large).unwrap();
+    let around = p
+        .plan_with_cost(Cell::new(1, 2), Cell::new(3, 2))
+        .unwrap()
+        .unwrap();
+    assert!((around.cost - 2.0 * std::f64::consts::SQRT_2).abs() < 1e-9);
+    let through = p
+        .plan_with_cost(Cell::new(1, 2), Cell::new(2, 2))
+        .unwrap()
+        .unwrap();
+    assert!((through.cost - 1.0e9).abs() < 1e-3);
     let costs = vec![1.0; 100];
     let mut p = CellCostAStar::new(&grid, &costs).unwrap();
     assert!(matches!(
