@@ -31,8 +31,7 @@ use spot_adapter::pipelines::{
 };
 use spot_adapter::robot::{MobilityCommand, Robot};
 use spot_adapter::sim::{
-    BoxKind, Building, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot, SimulationConfig,
-    SolidBox,
+    Building, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot, SimulationConfig,
 };
 use spot_nav_examples::picture::{self, Overlay};
 use spot_nav_examples::{
@@ -285,36 +284,6 @@ fn random_goals(
     bail!("found only {} of {count} reachable goals", goals.len())
 }
 
-/// A 0.6 x 0.6 x 0.6 m box on the route from `from` to `goal` (world frame): halfway along it,
-/// shifted sideways as little as needed for the goal to stay reachable; `None` when no such
-/// place is 2 m from both ends.
-fn drop_box(building: &Building, from: Vector2<f64>, goal: Vector2<f64>) -> Option<SolidBox> {
-    let config = RouteConfig::default();
-    let route = Route::between(building, from, goal, &config).ok()?;
-    let at = route.point_at(0.5 * route.length());
-    if (at - from).norm() < 2.0 || (at - goal).norm() < 2.0 {
-        return None;
-    }
-    let ahead = route.point_at(0.5 * route.length() + 0.2) - at;
-    let side = Vector2::new(-ahead.y, ahead.x).normalize();
-    for shift in [0.0, 0.2, -0.2, 0.4, -0.4, 0.6, -0.6] {
-        let c = at + side * shift;
-        let solid = SolidBox {
-            min: Point3::new(c.x - 0.3, c.y - 0.3, 0.0),
-            max: Point3::new(c.x + 0.3, c.y + 0.3, 0.6),
-            kind: BoxKind::Obstacle,
-        };
-        let mut trial = building.clone();
-        if trial.add_box(solid).is_ok()
-            && trial.clearance(from) >= 0.5
-            && Route::between(&trial, from, goal, &config).is_ok()
-        {
-            return Some(solid);
-        }
-    }
-    None
-}
-
 /// What one leg did, measured on the ground truth.
 struct Leg {
     outcome: &'static str,
@@ -505,7 +474,9 @@ fn mission(args: &Args) -> Result<()> {
     for (k, (&goal, &goal_world)) in goals.iter().zip(&goals_world).enumerate() {
         let from = spot.position();
         if boxed.contains(&k)
-            && let Some(solid) = drop_box(spot.building(), from, goal_world)
+            && let Some(solid) =
+                spot.building()
+                    .obstacle_on_route(from, goal_world, 0.6, &RouteConfig::default())
         {
             spot.building_mut().add_box(solid)?;
             building.add_box(solid)?;

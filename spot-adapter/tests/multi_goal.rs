@@ -9,17 +9,21 @@ use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 use spot_adapter::nav::{DriveOutcome, NavigatorConfig};
 
-/// 20 random goals on `seed`'s building: prints the legs, returns (reached within 0.10 m,
-/// collisions).
-fn twenty_goals(seed: u64) -> (usize, usize) {
+/// 20 random goals on `seed`'s building, with 0.6 m boxes dropped after mapping on the routes
+/// of the legs in `boxes_before`: prints the legs, returns (reached within 0.10 m, collisions).
+fn twenty_goals(seed: u64, boxes_before: &[usize]) -> (usize, usize) {
     let (building, map, navigation) = building_and_map(seed);
     let start = building.corridor_loop()[0];
     let goals = random_goals(&building, &map, start, 20, seed);
+    let start = Start {
+        boxes_before: boxes_before.to_vec(),
+        ..Start::at(start)
+    };
     let legs = run_legs(
         &building,
         &map,
         &navigation,
-        &Start::at(start),
+        &start,
         &goals,
         1500,
         &NavigatorConfig::default(),
@@ -48,21 +52,21 @@ fn twenty_goals(seed: u64) -> (usize, usize) {
 
 #[test]
 fn twenty_random_goals_on_building_4() {
-    let (reached, collisions) = twenty_goals(4);
+    let (reached, collisions) = twenty_goals(4, &[]);
     assert!(reached >= 19, "{reached} of 20");
     assert_eq!(collisions, 0);
 }
 
 #[test]
 fn twenty_random_goals_on_building_5() {
-    let (reached, collisions) = twenty_goals(5);
+    let (reached, collisions) = twenty_goals(5, &[]);
     assert!(reached >= 19, "{reached} of 20");
     assert_eq!(collisions, 0);
 }
 
 #[test]
 fn twenty_random_goals_on_building_6() {
-    let (reached, collisions) = twenty_goals(6);
+    let (reached, collisions) = twenty_goals(6, &[]);
     assert!(reached >= 19, "{reached} of 20");
     assert_eq!(collisions, 0);
 }
@@ -112,4 +116,26 @@ fn a_kidnapped_start_recovers_on_building_5() {
 #[test]
 fn a_kidnapped_start_recovers_on_building_6() {
     kidnapped(6);
+}
+
+/// The same with two boxes dropped on routes after mapping (before legs 3 and 11).
+fn twenty_goals_two_boxes(seed: u64) {
+    let (reached, collisions) = twenty_goals(seed, &[3, 11]);
+    assert!(reached >= 19, "{reached} of 20");
+    assert_eq!(collisions, 0);
+}
+
+#[test]
+fn twenty_random_goals_and_two_boxes_on_building_4() {
+    twenty_goals_two_boxes(4);
+}
+
+#[test]
+fn twenty_random_goals_and_two_boxes_on_building_5() {
+    twenty_goals_two_boxes(5);
+}
+
+#[test]
+fn twenty_random_goals_and_two_boxes_on_building_6() {
+    twenty_goals_two_boxes(6);
 }

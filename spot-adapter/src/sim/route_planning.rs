@@ -124,3 +124,45 @@ impl Route {
         Self::new(points, closed)
     }
 }
+
+impl Building {
+    /// A `size`-metre cube of [`BoxKind::Obstacle`](crate::sim::BoxKind::Obstacle) on the
+    /// route from `from` to `goal` (as [`Route::between`] plans it): halfway along, shifted
+    /// sideways as little as needed for the goal to stay reachable with `config`'s clearance;
+    /// `None` when no such place lies 2 m from both ends. The box is not added: pass it to
+    /// [`Building::add_box`].
+    #[must_use]
+    pub fn obstacle_on_route(
+        &self,
+        from: Vector2<f64>,
+        goal: Vector2<f64>,
+        size: f64,
+        config: &RouteConfig,
+    ) -> Option<crate::sim::SolidBox> {
+        let route = Route::between(self, from, goal, config).ok()?;
+        let at = route.point_at(0.5 * route.length());
+        if !(size.is_finite() && size > 0.0) || (at - from).norm() < 2.0 || (at - goal).norm() < 2.0
+        {
+            return None;
+        }
+        let ahead = route.point_at(0.5 * route.length() + 0.2) - at;
+        let side = Vector2::new(-ahead.y, ahead.x).try_normalize(1e-12)?;
+        let half = 0.5 * size;
+        for shift in [0.0, 0.2, -0.2, 0.4, -0.4, 0.6, -0.6] {
+            let c = at + side * shift;
+            let solid = crate::sim::SolidBox {
+                min: nalgebra::Point3::new(c.x - half, c.y - half, 0.0),
+                max: nalgebra::Point3::new(c.x + half, c.y + half, size),
+                kind: crate::sim::BoxKind::Obstacle,
+            };
+            let mut trial = self.clone();
+            if trial.add_box(solid).is_ok()
+                && trial.clearance(from) >= 0.5
+                && Route::between(&trial, from, goal, config).is_ok()
+            {
+                return Some(solid);
+            }
+        }
+        None
+    }
+}

@@ -99,6 +99,9 @@ pub struct Start {
     pub position: Vector2<f64>,
     pub yaw: f64,
     pub kidnap: Pose3,
+    /// Legs (0-based) before which a 0.6 m box is dropped on the route to their goal (or of
+    /// the next leg whose route has room for one 2 m from both ends).
+    pub boxes_before: Vec<usize>,
 }
 
 impl Start {
@@ -108,6 +111,7 @@ impl Start {
             position,
             yaw: 0.0,
             kidnap: Pose3::identity(),
+            boxes_before: Vec::new(),
         }
     }
 }
@@ -137,7 +141,20 @@ pub fn run_legs(
     )
     .unwrap();
     let mut legs = Vec::new();
-    for &goal in goals {
+    let mut pending = 0;
+    for (k, &goal) in goals.iter().enumerate() {
+        pending += start.boxes_before.iter().filter(|&&b| b == k).count();
+        if pending > 0
+            && let Some(solid) = spot.building().obstacle_on_route(
+                spot.position(),
+                goal,
+                0.6,
+                &RouteConfig::default(),
+            )
+        {
+            spot.building_mut().add_box(solid).unwrap();
+            pending -= 1;
+        }
         let collisions_before = spot.collisions();
         let (mut worst, mut walked) = (0.0f64, 0.0);
         let mut last: Option<Vector2<f64>> = None;
@@ -168,5 +185,6 @@ pub fn run_legs(
             localised_after: localised_from,
         });
     }
+    assert_eq!(pending, 0, "no room for every box on the routes");
     legs
 }
