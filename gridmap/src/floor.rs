@@ -134,17 +134,7 @@ impl FloorMap {
         hints: &[Point3<f64>],
         config: &FloorConfig,
     ) -> Result<Self, GridMapError> {
-        if cloud.is_empty() {
-            return Err(GridMapError::EmptyCloud);
-        }
-        let bad = cloud
-            .points()
-            .iter()
-            .filter(|p| !p.iter().all(|v| v.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(GridMapError::NonFinitePoints { count: bad });
-        }
+        crate::OccupancyGridBuilder::check_cloud(cloud)?;
         let points = cloud
             .points()
             .iter()
