@@ -13,7 +13,7 @@ use spot_adapter::AdapterError;
 use spot_adapter::nav::{DriveOutcome, LocaliserConfig, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_tracker;
 use spot_adapter::robot::Robot;
-use spot_adapter::sim::{CommandedSpot, SimulationConfig};
+use spot_adapter::sim::{Building, CommandedSpot, Room, SimulationConfig};
 
 /// From the corridor into the room whose door is farthest away: arrives within 0.10 m
 /// (measured on the ground truth), never bumps into anything, and stays localised.
@@ -59,6 +59,82 @@ fn walks_into_rooms_without_touching_anything() {
         "localisation error {} m",
         o.worst_localisation
     );
+}
+
+/// A door on the south corridor at least 5 m from both its corners, the corridor's centre
+/// line where it crosses, and the unit vector along the corridor (east).
+fn south_door(building: &Building) -> (Room, Vector2<f64>, Vector2<f64>) {
+    let corners = building.corridor_loop();
+    let (west, east) = (corners[0], corners[1]);
+    let ahead = (east - west).normalize();
+    let room = building
+        .rooms()
+        .iter()
+        .find(|r| {
+            (r.door.y - west.y).abs() < building.corridor_width()
+                && r.door.x > west.x + 5.0
+                && r.door.x < east.x - 5.0
+        })
+        .copied()
+        .unwrap();
+    (room, Vector2::new(room.door.x, west.y), ahead)
+}
+
+/// The 9 m walk down building 3's south corridor past its door, among `walkers` (the door's
+/// room, and where the walk starts and ends given): arrives within 0.10 m, untouched, without a
+/// detour.
+fn walk_among(
+    walkers: impl Fn(&Building, Room, Vector2<f64>, Vector2<f64>) -> Vec<(Vector2<f64>, Vector2<f64>)>,
+) {
+    let (building, map, navigation) = building_and_map(3);
+    let (room, crossing, ahead) = south_door(&building);
+    let start = crossing - 5.0 * ahead;
+    let goal = crossing + 4.0 * ahead;
+    let legs = run_legs(
+        &building,
+        &map,
+        &navigation,
+        &Start {
+            walkers: walkers(&building, room, start, goal),
+            ..Start::at(start)
+        },
+        &[goal],
+        600,
+        &NavigatorConfig::default(),
+    );
+    let o = &legs[0];
+    eprintln!("{o:?}");
+    assert_eq!(o.outcome, DriveOutcome::Arrived);
+    assert!(o.error <= 0.10, "ended {} m off", o.error);
+    assert_eq!(o.collisions, 0);
+    assert!(o.walked < 12.0, "walked {} m for 9 m", o.walked);
+}
+
+/// A person walks to and fro (1 m/s) between a room 2 m behind its door and the far side of
+/// the corridor, across the robot's way: the robot waits while they cross (rather than going
+/// round the building) and passes when the way is clear.
+#[test]
+fn waits_for_a_person_crossing_the_corridor() {
+    walk_among(|building, room, _, _| {
+        let inside = room.door + 2.0 * room.inward;
+        let across = room.door - (building.corridor_width() - 0.4) * room.inward;
+        vec![(inside, across)]
+    });
+}
+
+/// A person walks to and fro along the corridor's left half (from 1 m past the goal to 3 m
+/// past the start, 1 m/s), toward the robot and away: the robot passes them.
+#[test]
+fn passes_a_person_walking_down_the_corridor() {
+    walk_among(|building, _, start, goal| {
+        let ahead = (goal - start).normalize();
+        let left = Vector2::new(-ahead.y, ahead.x);
+        let lane = 0.5 * building.corridor_width() - 0.45;
+        vec![(
+            goal + 1.0 * ahead + lane * left,
+            start + 3.0 * ahead + lane * left,
+        )]
+    });
 }
 
 /// A goal off the map is answered with `NoPath` on the first cycle, without a step.

@@ -35,6 +35,13 @@ pub struct NavigatorConfig {
     pub live: LiveLayerConfig,
     /// Replan at least every this many cycles even when the path stays clear, 25 (5 s).
     pub replan_every: usize,
+    /// When something new blocks the path and the way around is this much longer than the
+    /// blocked way (or there is none), 5 m, the robot stands and waits for it to clear (a
+    /// person crossing, a door held) ...
+    pub detour_extra: f64,
+    /// ... for at most this many cycles, 40 (8 s), before it takes the way around (or answers
+    /// `NoPath`).
+    pub detour_patience: usize,
     /// Arrived when the estimated body is this close to the goal, 0.05 m (localisation is good
     /// to a few centimetres, so the true body ends within 0.10 m).
     pub goal_tolerance: f64,
@@ -81,6 +88,8 @@ impl Default for NavigatorConfig {
                 ..LiveLayerConfig::default()
             },
             replan_every: 25,
+            detour_extra: 5.0,
+            detour_patience: 40,
             goal_tolerance: 0.05,
             heading_tolerance: 0.1,
             approach_distance: 0.6,
@@ -117,6 +126,7 @@ impl NavigatorConfig {
             ("heading_gain", self.heading_gain),
             ("shortcut_clearance", self.shortcut_clearance),
             ("lookahead", self.lookahead),
+            ("detour_extra", self.detour_extra),
         ] {
             if !(value.is_finite() && value > 0.0) {
                 return Err(AdapterError::invalid(setting, value, "finite and positive"));
@@ -216,12 +226,23 @@ pub struct Navigator<R: Registrator> {
     map: NavigationMap,
     live: LiveLayer,
     planning: PlanningGrid,
+    /// The planning grid of the map alone, without the live layer's changes: how far the way
+    /// would be if what is new moved away.
+    static_planning: PlanningGrid,
     waypoints: Vec<Vector2<f64>>,
     /// Every cell of the current path, for the blocked-path test.
     path_cells: Vec<Cell>,
     /// The goal the path leads to.
     planned_for: Option<Vector2<f64>>,
     cycles_since_plan: usize,
+    /// Cycles waited so far for the current path's blockage to clear.
+    waited: usize,
+    /// Which cells of the map's own path were blocked when last waiting, and for how many
+    /// cycles in a row they stayed the same (what blocks the way does not move).
+    waiting_on: (Option<Blockage>, usize),
+    /// The goal for which the robot already waited its patience out: it does not wait again on
+    /// the way there (a box that stays would have it turn back and forth).
+    waited_out_for: Option<Vector2<f64>>,
     replans: usize,
     recoveries: usize,
     stuck: StuckMonitor,
@@ -255,18 +276,23 @@ impl<R: Registrator> Navigator<R> {
             .map_err(AdapterError::NavigationGrid)?;
         let planning = PlanningGrid::new(live.combined(), config.planning.clone())
             .map_err(AdapterError::NavigationGrid)?;
+        let static_planning = planning.clone();
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone()),
             stuck: StuckMonitor::new(config.stuck.clone()),
             map: navigation.clone(),
             live,
             planning,
+            static_planning,
             config,
             limits: robot.limits.clone(),
             waypoints: Vec::new(),
             path_cells: Vec::new(),
             planned_for: None,
             cycles_since_plan: 0,
+            waited: 0,
+            waiting_on: (None, 0),
+            waited_out_for: None,
             replans: 0,
             recoveries: 0,
         })
@@ -385,9 +411,36 @@ impl<R: Registrator> Navigator<R> {
             || self.planning.blocks_any(&self.path_cells)
             || self.cycles_since_plan >= self.config.replan_every;
         if !replan {
+            self.waited = 0;
             return Ok(None);
         }
-        if let Some((waypoints, cells)) = self.plan(position, target)? {
+        let plan = self.plan(position, target)?;
+        let resolution = self.planning.blocked().geometry().resolution;
+        let live_length = plan
+            .as_ref()
+            .map(|(_, cells)| cells_length(cells) * resolution);
+        if self.waited_out_for != Some(target)
+            && let Some(blockage) = self.worth_waiting(position, target, live_length)?
+        {
+            // Something new stands in the way and the way around is far longer (or there is
+            // none): wait for it to move on, while it moves. The next cycle plans again.
+            let (last, same) = self.waiting_on;
+            let unchanged = last == Some(blockage);
+            self.waiting_on = (Some(blockage), if unchanged { same + 1 } else { 0 });
+            self.waited += 1;
+            if self.waited < self.config.detour_patience
+                && self.waiting_on.1 < STILL_BLOCKAGE_CYCLES
+            {
+                self.stuck.commanded(&VelocityCommand::new(0.0, 0.0));
+                return Ok(Some(NavigationStep::Hold));
+            }
+            // Waited long enough, or what blocks does not move: go round, and do not wait
+            // again on the way to this goal.
+            self.waited_out_for = Some(target);
+        }
+        self.waiting_on = (None, 0);
+        self.waited = 0;
+        if let Some((waypoints, cells)) = plan {
             self.waypoints = waypoints;
             self.path_cells = cells;
             self.planned_for = Some(target);
@@ -481,6 +534,50 @@ impl<R: Registrator> Navigator<R> {
         }
     }
 
+    /// What blocks the way, when the live path (its length `live_length` in metres, `None`
+    /// when there is none) is more than `detour_extra` longer than the path on the map alone,
+    /// which exists: something new stands on the map's path. `None` when there is nothing to
+    /// wait for.
+    fn worth_waiting(
+        &self,
+        position: Vector2<f64>,
+        goal: Vector2<f64>,
+        live_length: Option<f64>,
+    ) -> Result<Option<Blockage>, AdapterError> {
+        let resolution = self.planning.blocked().geometry().resolution;
+        let extra = self.config.detour_extra;
+        // No path can be shorter than the straight line: most plans need no second search.
+        if live_length.is_some_and(|l| l <= (goal - position).norm() + extra) {
+            return Ok(None);
+        }
+        let Some(map_only) =
+            plan_cells(&self.static_planning, self.config.planner, position, goal)?
+        else {
+            return Ok(None);
+        };
+        let map_length = cells_length(&map_only) * resolution;
+        if live_length.is_some_and(|l| l <= map_length + extra) {
+            return Ok(None);
+        }
+        let grid = self.planning.blocked();
+        let mut blocked = map_only
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| grid.is_blocked(**c))
+            .map(|(k, _)| k);
+        let Some(first) = blocked.next() else {
+            // The map's path is clear on the live grid yet the planner went round: nothing new
+            // stands on it to wait for.
+            return Ok(None);
+        };
+        let (last, count) = blocked.fold((first, 1), |(_, n), k| (k, n + 1));
+        Ok(Some(Blockage {
+            first: map_only[first],
+            last: map_only[last],
+            count,
+        }))
+    }
+
     /// Waypoints (metres) from `position` to `goal` after the start and the dense cells of the
     /// path, or `None` when none joins them (the goal off the map or blocked, the robot off the
     /// map, or no path). A start inside the inflated obstacles (the robot brushed a wall) plans
@@ -491,33 +588,18 @@ impl<R: Registrator> Navigator<R> {
         position: Vector2<f64>,
         goal: Vector2<f64>,
     ) -> Result<Option<(Vec<Vector2<f64>>, Vec<Cell>)>, AdapterError> {
+        let Some(cells) = plan_cells(&self.planning, self.config.planner, position, goal)? else {
+            return Ok(None);
+        };
         let grid = self.planning.blocked();
-        let Some(goal_cell) = grid.cell_at(goal).filter(|&c| !grid.is_blocked(c)) else {
-            return Ok(None);
-        };
-        let Some(start) = grid.cell_at(position).and_then(|c| nearest_free(grid, c)) else {
-            return Ok(None);
-        };
-        let path: Option<GridPath> = match self.config.planner {
-            PlannerKind::CellCostAStar => CellCostAStar::new(grid, self.planning.step_costs())
-                .map_err(|_| AdapterError::invalid("planning costs", f64::NAN, "valid"))?
-                .plan(start, goal_cell),
-            PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
-            PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
-        }
-        .map_err(AdapterError::Planner)?;
-        let Some(path) = path else {
-            return Ok(None);
-        };
-        let cells = path.expand();
         // Shortcuts only where they keep room to spare; in narrow places the path's cells.
         let roomy = self.roomy_grid();
         let filtered = filter_path(
             &roomy,
             &GridPath {
+                length: cells_length(&cells),
+                expanded: 0,
                 cells: cells.clone(),
-                length: path.length,
-                expanded: path.expanded,
             },
         );
         let mut waypoints: Vec<Vector2<f64>> = filtered
@@ -643,6 +725,61 @@ impl<R: Registrator> Navigator<R> {
 }
 
 /// `angle` wrapped to (-pi, pi].
+/// The blocked stretch of the map's own path: its first and last blocked cells and how many
+/// are blocked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Blockage {
+    first: Cell,
+    last: Cell,
+    count: usize,
+}
+
+/// Waiting cycles with the blocked way unchanged after which the blockage counts as still (a
+/// box, not a person walking): 10 (2 s).
+const STILL_BLOCKAGE_CYCLES: usize = 10;
+
+/// The dense cells of a path on `planning` from `position` to `goal` by `planner`, or `None`
+/// when none joins them (either end off the map, the goal blocked, or no path). A start inside
+/// the inflated obstacles plans from the nearest free cell.
+fn plan_cells(
+    planning: &PlanningGrid,
+    planner: PlannerKind,
+    position: Vector2<f64>,
+    goal: Vector2<f64>,
+) -> Result<Option<Vec<Cell>>, AdapterError> {
+    let grid = planning.blocked();
+    let Some(goal_cell) = grid.cell_at(goal).filter(|&c| !grid.is_blocked(c)) else {
+        return Ok(None);
+    };
+    let Some(start) = grid.cell_at(position).and_then(|c| nearest_free(grid, c)) else {
+        return Ok(None);
+    };
+    let path: Option<GridPath> = match planner {
+        PlannerKind::CellCostAStar => CellCostAStar::new(grid, planning.step_costs())
+            .map_err(|_| AdapterError::invalid("planning costs", f64::NAN, "valid"))?
+            .plan(start, goal_cell),
+        PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
+        PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
+    }
+    .map_err(AdapterError::Planner)?;
+    Ok(path.map(|p| p.expand()))
+}
+
+/// Length of a chain of 8-connected cells, in cells.
+fn cells_length(cells: &[Cell]) -> f64 {
+    cells
+        .windows(2)
+        .map(|w| {
+            let diagonal = w[0].x != w[1].x && w[0].y != w[1].y;
+            if diagonal {
+                std::f64::consts::SQRT_2
+            } else {
+                1.0
+            }
+        })
+        .sum()
+}
+
 fn wrap(angle: f64) -> f64 {
     let a = angle.rem_euclid(std::f64::consts::TAU);
     if a > std::f64::consts::PI {

@@ -102,6 +102,9 @@ pub struct Start {
     /// Legs (0-based) before which a 0.6 m box is dropped on the route to their goal (or of
     /// the next leg whose route has room for one 2 m from both ends).
     pub boxes_before: Vec<usize>,
+    /// People walking to and fro between two points at 1 m/s from the start (0.5 m square,
+    /// 1.7 m tall), seen by the LiDAR and counted by the collision check.
+    pub walkers: Vec<(Vector2<f64>, Vector2<f64>)>,
 }
 
 impl Start {
@@ -112,6 +115,7 @@ impl Start {
             yaw: 0.0,
             kidnap: Pose3::identity(),
             boxes_before: Vec::new(),
+            walkers: Vec::new(),
         }
     }
 }
@@ -130,6 +134,10 @@ pub fn run_legs(
     let kidnap = &start.kidnap;
     let sim = SimulationConfig::default();
     let mut spot = CommandedSpot::new(building.clone(), start.position, start.yaw, &sim).unwrap();
+    for &(from, to) in &start.walkers {
+        spot.add_walker(from, to, 1.0, Vector2::new(0.25, 0.25), 1.7)
+            .unwrap();
+    }
     let mut nav = Navigator::new(
         point_to_plane_tracker(),
         map,
@@ -154,6 +162,12 @@ pub fn run_legs(
         {
             spot.building_mut().add_box(solid).unwrap();
             pending -= 1;
+            eprintln!("box before leg {k}: {solid:?}");
+        } else if pending > 0 {
+            eprintln!(
+                "no room for a box before leg {k}, from {:?} to {goal:?}",
+                spot.position()
+            );
         }
         let collisions_before = spot.collisions();
         let (mut worst, mut walked) = (0.0f64, 0.0);
