@@ -58,8 +58,10 @@ mod lidar_layout;
 mod loam;
 mod loam_features;
 mod neighbour_cache;
+mod place_index;
 mod point_to_plane;
 mod point_to_point;
+mod scan_context;
 mod sym3;
 mod target;
 mod voxel_hash_map;
@@ -69,7 +71,11 @@ pub use kernel::IcpKernel;
 pub use lidar_layout::LidarLayout;
 pub use loam::{LoamConfig, LoamRegistrator, LoamTarget};
 pub use loam_features::{LoamFeatureConfig, LoamFeatures};
+pub use place_index::{
+    PlaceCandidate, ScanContextIndex, ScanContextIndexConfig, ScanContextRecognizer,
+};
 pub use point_to_plane::PointToPlaneIcp;
 pub use point_to_point::PointToPointIcp;
+pub use scan_context::{SCAN_CONTEXT_RINGS, ScanContext, ScanContextConfig, ScanContextMatch};
 pub use target::PreparedTarget;
 pub use voxel_hash_map::VoxelHashMap;

@@ -57,5 +57,6 @@ pub use slam::{
     SlamReport, deskew,
 };
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
+pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
 pub use traits::registrator::{Alignment, MapRegistrator, Registrator};

@@ -5,8 +5,9 @@
 use posegraph::LevenbergMarquardt;
 use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
+    ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
 };
-use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator};
+use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator, PlaceRecognizer};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
 pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, LevenbergMarquardt>;
@@ -97,4 +98,23 @@ pub fn loam_slam(config: GraphSlamConfig) -> LoamSlam {
         },
     };
     assemble(config, odometry, refine)
+}
+
+/// Scan Context place recognition with its defaults, for
+/// [`GraphSlam::with_place_recognizer`]: the engine then seeks loops by appearance as well as
+/// by position.
+///
+/// # Panics
+/// Never: the default settings are valid (a test checks it).
+#[must_use]
+pub fn scan_context_places() -> Box<dyn PlaceRecognizer + Send> {
+    // The defaults are valid; `new` only refuses invalid settings.
+    #[allow(clippy::expect_used)]
+    let places = ScanContextRecognizer::new(
+        ScanContextConfig::default(),
+        ScanContextIndexConfig::default(),
+        ScanContextRecognizer::default_offset(),
+    )
+    .expect("default Scan Context settings are valid");
+    Box::new(places)
 }

@@ -14,6 +14,7 @@ use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_log};
 use crate::io::StampedPose;
 use crate::pose_graph::PoseGraph;
 use crate::traits::optimizer::Optimizer;
+use crate::traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 use crate::traits::registrator::MapRegistrator;
 
 /// One LiDAR scan with the robot's odometry at the same instant (the `spot-adapter` sample).
@@ -59,6 +60,10 @@ struct LoopCandidate {
     old: usize,
     /// Index of the new keyframe.
     new: usize,
+    /// Where place recognition puts the new keyframe (the old keyframe's pose turned by the
+    /// heading between the scans), when the candidate came from it: the start of the check
+    /// instead of the new keyframe's own estimate, which may have drifted far.
+    guess: Option<Pose3>,
 }
 
 /// The target the odometry registers against: the last `local_map_keyframes` keyframes placed
@@ -95,6 +100,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     last_stamp: f64,
     /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
     last_odometry: Option<StampedPose>,
+    /// Place recognition over keyframe scans, when set: loops sought by appearance too.
+    places: Option<Box<dyn PlaceRecognizer + Send>>,
     report: SlamReport,
 }
 
@@ -124,8 +131,20 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
             last_odometry: None,
+            places: None,
             report: SlamReport::default(),
         }
+    }
+
+    /// The engine seeking loops by appearance too: each keyframe's scan goes to `places`, and a
+    /// keyframe with no old keyframe within [`GraphSlamConfig::loop_search_radius`] of its
+    /// estimate asks `places` for one that looks alike, however far the estimate has drifted.
+    /// The candidate is checked as any other (coarse and refined registration, from the old
+    /// keyframe's pose turned by the heading the recognizer gives).
+    #[must_use]
+    pub fn with_place_recognizer(mut self, places: Box<dyn PlaceRecognizer + Send>) -> Self {
+        self.places = Some(places);
+        self
     }
 
     /// The settings.
@@ -397,11 +416,25 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         ) else {
             return self.skip(SkipReason::PreparationFailed, started);
         };
+        let index = self.keyframes.len();
+        // Appearance first (before this keyframe joins the recognizer); a scan the recognizer
+        // refuses is counted, and the keyframe goes on without a place match.
+        let look_alike = match self
+            .places
+            .as_mut()
+            .map(|p| p.candidates_then_add(index, &cloud))
+        {
+            Some(Ok(found)) => found.into_iter().next(),
+            Some(Err(_)) => {
+                self.report.place_refusals += 1;
+                None
+            }
+            None => None,
+        };
         let map_cloud = cloud
             .voxel_downsample(self.config.map_voxel_size)
             .unwrap_or(cloud);
 
-        let index = self.keyframes.len();
         let mut pose = predicted;
         let mut registered = false;
         let mut reg_info = None;
@@ -456,23 +489,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             keyframe_t_lidar: Pose3::identity(),
         });
 
-        // Queue a loop candidate: the oldest keyframe near this one outside the local window.
-        let window = self.config.local_map_keyframes;
-        let may_try = self
-            .last_loop_attempt
-            .is_none_or(|l| index >= l + self.config.loop_min_keyframe_gap);
-        if index > window
-            && may_try
-            && let Some(candidate) =
-                self.node_index
-                    .oldest_within(&pose, self.config.loop_search_radius, index - window)
-        {
-            self.pending_loops.push(LoopCandidate {
-                old: candidate,
-                new: index,
-            });
-            self.last_loop_attempt = Some(index);
-        }
+        self.queue_loop_candidate(index, &pose, look_alike);
         self.node_index.insert(index, &pose);
         self.report
             .scan_ms
@@ -481,6 +498,39 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             self.loop_closure_step();
         }
         ScanOutcome::Keyframe { id, registered }
+    }
+
+    /// Queue a loop candidate for keyframe `index` at `pose`: the oldest keyframe near it outside
+    /// the local window, or else the look-alike place recognition found.
+    fn queue_loop_candidate(&mut self, index: usize, pose: &Pose3, look_alike: Option<PlaceMatch>) {
+        let window = self.config.local_map_keyframes;
+        let may_try = self
+            .last_loop_attempt
+            .is_none_or(|l| index >= l + self.config.loop_min_keyframe_gap);
+        if index > window && may_try {
+            let near =
+                self.node_index
+                    .oldest_within(pose, self.config.loop_search_radius, index - window);
+            let candidate = match near {
+                Some(old) => Some((old, None)),
+                None => look_alike.filter(|m| m.keyframe < index - window).map(|m| {
+                    let turn = Pose3::from_parts(
+                        nalgebra::Translation3::identity(),
+                        nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, m.yaw),
+                    );
+                    (m.keyframe, Some(self.keyframe_pose(m.keyframe) * turn))
+                }),
+            };
+            if let Some((old, guess)) = candidate {
+                self.report.place_candidates += usize::from(guess.is_some());
+                self.pending_loops.push(LoopCandidate {
+                    old,
+                    new: index,
+                    guess,
+                });
+                self.last_loop_attempt = Some(index);
+            }
+        }
     }
 
     /// Try the oldest queued loop candidate: coarse alignment of the new keyframe to the
@@ -493,14 +543,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let started = Instant::now();
         let candidate = self.pending_loops.remove(0);
         self.report.loops_attempted += 1;
-        let outcome = self.try_loop(candidate.old, candidate.new);
+        let outcome = self.try_loop(&candidate);
         self.report
             .loop_ms
             .push(started.elapsed().as_secs_f64() * 1e3);
         outcome
     }
 
-    fn try_loop(&mut self, cand: usize, new: usize) -> LoopOutcome {
+    fn try_loop(&mut self, candidate: &LoopCandidate) -> LoopOutcome {
+        let (cand, new) = (candidate.old, candidate.new);
         let rejected = LoopOutcome::Rejected {
             from: cand as u64,
             to: new as u64,
@@ -515,7 +566,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let refine_parts: Vec<(&R::Source, Pose3)> = (lo..=hi.max(cand))
             .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
             .collect();
-        let initial = self.keyframe_pose(new);
+        let initial = candidate.guess.unwrap_or_else(|| self.keyframe_pose(new));
         let Ok(coarse_target) = self.loop_coarse.target_from_sources(&coarse_parts) else {
             return rejected;
         };
@@ -571,6 +622,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             self.report.optimizer_failures += 1;
         }
         self.report.loops_closed += 1;
+        self.report.place_loops_closed += usize::from(candidate.guess.is_some());
         // The keyframes moved: rebuild the local map now, within this step, so that the next
         // scan's odometry does not pay for it.
         self.local_map = None;

@@ -84,6 +84,12 @@ pub struct SlamReport {
     pub loops_attempted: usize,
     /// Loops accepted.
     pub loops_closed: usize,
+    /// Loop candidates that came from place recognition (none found by position).
+    pub place_candidates: usize,
+    /// Loops accepted among those.
+    pub place_loops_closed: usize,
+    /// Keyframe scans the place recognizer refused (too few points in its range).
+    pub place_refusals: usize,
     /// Optimiser runs that returned an error (the graph was kept as it was).
     pub optimizer_failures: usize,
     /// Milliseconds of each `process` call (odometry path), in order.

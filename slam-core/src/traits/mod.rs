@@ -1,5 +1,7 @@
-//! The three backend traits: registration, pose-graph optimisation and grid planning.
+//! The backend traits: registration, pose-graph optimisation, grid planning, and place
+//! recognition for loop closure.
 
 pub mod optimizer;
+pub mod place_recognizer;
 pub mod planner;
 pub mod registrator;
