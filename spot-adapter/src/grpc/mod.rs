@@ -59,3 +59,5 @@ pub use frame_tree::{FrameError, FrameTree};
 pub use local_grid::LocalGrid;
 pub use point_cloud::SpotCloud;
 pub use spot_client::SpotClient;
+/// gRPC status codes, as [`SpotError::Rpc`] reports them.
+pub use tonic::Code as RpcCode;

@@ -228,37 +228,37 @@ impl Drop for SpotClient {
 /// a lost lease is recorded by the retain and refused at the next command, a stale time sync
 /// is refused at the next motion, a failed renewal is retried on the next tick.
 fn spawn_background(runtime: &Runtime, session: &Arc<Session>) -> Vec<JoinHandle<()>> {
-    let ticks = |period: Duration| {
-        let mut ticks = tokio::time::interval_at(tokio::time::Instant::now() + period, period);
-        ticks.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
-        ticks
-    };
-    let (retain, sync, renew) = (
-        Arc::clone(session),
-        Arc::clone(session),
-        Arc::clone(session),
-    );
-    let mut retain_ticks = ticks(session.config.lease_retain_interval);
-    let mut sync_ticks = ticks(session.config.time_sync.resync_interval);
-    let mut renew_ticks = ticks(session.config.token_refresh_interval);
+    let retain = Arc::clone(session);
+    let sync = Arc::clone(session);
+    let renew = Arc::clone(session);
     vec![
         runtime.spawn(async move {
+            let mut ticks = ticks(retain.config.lease_retain_interval);
             loop {
-                retain_ticks.tick().await;
+                ticks.tick().await;
                 let _ = retain.retain_lease().await;
             }
         }),
         runtime.spawn(async move {
+            let mut ticks = ticks(sync.config.time_sync.resync_interval);
             loop {
-                sync_ticks.tick().await;
+                ticks.tick().await;
                 let _ = sync.time_sync_round().await;
             }
         }),
         runtime.spawn(async move {
+            let mut ticks = ticks(renew.config.token_refresh_interval);
             loop {
-                renew_ticks.tick().await;
+                ticks.tick().await;
                 let _ = renew.refresh_token(renew.current_token()).await;
             }
         }),
     ]
+}
+
+/// Ticks every `period`, the first one `period` from now; late ticks are not bunched up.
+fn ticks(period: Duration) -> tokio::time::Interval {
+    let mut ticks = tokio::time::interval_at(tokio::time::Instant::now() + period, period);
+    ticks.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    ticks
 }

@@ -132,11 +132,13 @@ class Robot:
         ts.FromNanoseconds(int(round((self.now() if seconds is None else seconds) * 1e9)))
         return ts
 
-    def record(self, method, context, request):
+    def record(self, method, context, request, **decoded):
+        """Log a request as the official classes decode it; `decoded` adds derived numbers."""
         metadata = dict(context.invocation_metadata())
         entry = {"method": method, "authority": authority(context),
                  "authorization": metadata.get("authorization"), "robot_time": self.now(),
-                 "request": json_format.MessageToDict(request, preserving_proto_field_name=True)}
+                 "request": json_format.MessageToDict(request, preserving_proto_field_name=True),
+                 "decoded": decoded}
         with self.lock:
             self.log.write(json.dumps(entry) + "\n")
 
@@ -528,6 +530,27 @@ class LocalGrids(local_grid_service_pb2_grpc.LocalGridServiceServicer):
         return response
 
 
+def command_times(command):
+    """End time, reference time (robot clock seconds) and point times of a mobility command,
+    and the velocity limit of its MobilityParams, as the official classes decode them."""
+    mobility = command.synchronized_command.mobility_command
+    kind = mobility.WhichOneof("command")
+    out = {"kind": kind or command.WhichOneof("command")}
+    if kind in ("se2_velocity_request", "se2_trajectory_request"):
+        request = getattr(mobility, kind)
+        out["end_time"] = seconds(request.end_time)
+    if kind == "se2_trajectory_request":
+        trajectory = mobility.se2_trajectory_request.trajectory
+        out["reference_time"] = seconds(trajectory.reference_time)
+        out["point_times"] = [p.time_since_reference.ToNanoseconds() * 1e-9 for p in trajectory.points]
+    if mobility.params.type_url:
+        params = spot_command_pb2.MobilityParams()
+        if mobility.params.Unpack(params):
+            limit = params.vel_limit.max_vel
+            out["max_vel"] = [limit.linear.x, limit.linear.y, limit.angular]
+    return out
+
+
 class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
     """Checks the lease and the time sync's clock, then walks by velocity commands."""
 
@@ -537,7 +560,7 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
 
     def RobotCommand(self, request, context):
         received = self.r.now()
-        self.r.record("RobotCommand", context, request)
+        self.r.record("RobotCommand", context, request, **command_times(request.command))
         response = robot_command_pb2.RobotCommandResponse()
         with self.r.lock:
             response.lease_use_result.CopyFrom(self.leases.check(request.lease))
