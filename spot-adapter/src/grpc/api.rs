@@ -4,6 +4,7 @@
 #![allow(
     missing_docs,
     dead_code,
+    clippy::all,
     clippy::pedantic,
     clippy::doc_markdown,
     clippy::large_enum_variant,

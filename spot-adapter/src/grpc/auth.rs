@@ -17,7 +17,7 @@ impl Session {
     pub(crate) async fn authenticate(&self) -> Result<(), SpotError> {
         let credentials = &self.config.credentials;
         self.get_auth_token(api::GetAuthTokenRequest {
-            header: self.header(),
+            header: Some(self.header()),
             username: credentials.username().to_owned(),
             password: credentials.password().to_owned(),
             token: String::new(),
@@ -28,7 +28,7 @@ impl Session {
     /// Trade the token held for a fresh one.
     pub(crate) async fn refresh_token(&self, token: String) -> Result<(), SpotError> {
         self.get_auth_token(api::GetAuthTokenRequest {
-            header: self.header(),
+            header: Some(self.header()),
             username: String::new(),
             password: String::new(),
             token,

@@ -26,7 +26,7 @@ impl Session {
     pub(crate) async fn robot_id(&self) -> Result<RobotIdentity, SpotError> {
         let mut client = RobotIdServiceClient::new(self.channel(ROBOT_ID_AUTHORITY)?);
         let request = api::RobotIdRequest {
-            header: self.header(),
+            header: Some(self.header()),
         };
         let response = self.rpc("GetRobotId", client.get_robot_id(request)).await?;
         check_header("GetRobotId", response.header.as_ref())?;
@@ -43,7 +43,7 @@ impl Session {
     pub(crate) async fn read_directory(&self) -> Result<(), SpotError> {
         let mut client = DirectoryServiceClient::new(self.channel(DIRECTORY_AUTHORITY)?);
         let request = api::ListServiceEntriesRequest {
-            header: self.header(),
+            header: Some(self.header()),
         };
         let response = self
             .rpc("ListServiceEntries", client.list_service_entries(request))

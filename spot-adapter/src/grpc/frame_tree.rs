@@ -136,8 +136,8 @@ impl FrameTree {
 
 /// An `SE3Pose` as a pose: finite numbers and a non-zero quaternion (normalised here), or none.
 pub(crate) fn pose_from_wire(pose: &api::Se3Pose) -> Option<Pose3> {
-    let p = pose.position.clone().unwrap_or_default();
-    let q = pose.rotation.clone().unwrap_or_default();
+    let p = pose.position.unwrap_or_default();
+    let q = pose.rotation.unwrap_or_default();
     let values = [p.x, p.y, p.z, q.w, q.x, q.y, q.z];
     if values.iter().any(|v| !v.is_finite()) {
         return None;

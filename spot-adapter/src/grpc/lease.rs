@@ -69,7 +69,7 @@ impl Session {
     pub(crate) async fn acquire_lease(&self) -> Result<(), SpotError> {
         let mut client = LeaseServiceClient::new(self.service("lease")?);
         let request = api::AcquireLeaseRequest {
-            header: self.header(),
+            header: Some(self.header()),
             resource: BODY_RESOURCE.to_owned(),
         };
         let response = self
@@ -101,7 +101,7 @@ impl Session {
         let lease = self.lease_for_command()?;
         let mut client = LeaseServiceClient::new(self.service("lease")?);
         let request = api::RetainLeaseRequest {
-            header: self.header(),
+            header: Some(self.header()),
             lease: Some(lease),
         };
         let response = self
@@ -116,7 +116,7 @@ impl Session {
         let lease = self.lease_for_command()?;
         let mut client = LeaseServiceClient::new(self.service("lease")?);
         let request = api::ReturnLeaseRequest {
-            header: self.header(),
+            header: Some(self.header()),
             lease: Some(lease),
         };
         let response = self

@@ -16,7 +16,7 @@ impl Session {
     pub(crate) async fn local_grids(&self, names: &[&str]) -> Result<Vec<LocalGrid>, SpotError> {
         let mut client = LocalGridServiceClient::new(self.service(LOCAL_GRID_SERVICE)?);
         let request = api::GetLocalGridsRequest {
-            header: self.header(),
+            header: Some(self.header()),
             local_grid_requests: names
                 .iter()
                 .map(|&n| api::LocalGridRequest {
@@ -131,7 +131,7 @@ pub(crate) fn decode_grid(grid: &api::LocalGrid) -> Result<LocalGrid, SpotError>
     let format = api::local_grid::CellFormat::try_from(grid.cell_format)
         .map_err(|_| bad(format!("cell format {} is unknown", grid.cell_format)))?;
     let width = cell_bytes(format).ok_or_else(|| bad("cell format unknown (0)".into()))?;
-    if grid.data.len() % width != 0 {
+    if !grid.data.len().is_multiple_of(width) {
         return Err(bad(format!(
             "{} bytes is not a whole number of {width}-byte cells",
             grid.data.len()

@@ -31,7 +31,7 @@ impl Session {
         let mut client =
             PointCloudServiceClient::new(self.service(&self.config.point_cloud_service)?);
         let request = api::GetPointCloudRequest {
-            header: self.header(),
+            header: Some(self.header()),
             point_cloud_requests: vec![api::PointCloudRequest {
                 point_cloud_source_name: source_name.clone(),
                 cloud_type: 0,

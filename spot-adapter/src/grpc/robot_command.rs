@@ -189,7 +189,7 @@ impl Session {
     ) -> Result<u32, SpotError> {
         let mut client = RobotCommandServiceClient::new(self.service("robot-command")?);
         let request = api::RobotCommandRequest {
-            header: self.header(),
+            header: Some(self.header()),
             lease: Some(lease),
             command: Some(command),
             clock_identifier,

@@ -11,7 +11,7 @@ impl Session {
     pub(crate) async fn frame_tree(&self) -> Result<FrameTree, SpotError> {
         let mut client = RobotStateServiceClient::new(self.service("robot-state")?);
         let request = api::RobotStateRequest {
-            header: self.header(),
+            header: Some(self.header()),
         };
         let response = self
             .rpc("GetRobotState", client.get_robot_state(request))

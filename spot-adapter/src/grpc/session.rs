@@ -190,12 +190,12 @@ impl Session {
     }
 
     /// A request header as the SDK fills it: this client's name and the time now.
-    pub(crate) fn header(&self) -> Option<api::RequestHeader> {
-        Some(api::RequestHeader {
+    pub(crate) fn header(&self) -> api::RequestHeader {
+        api::RequestHeader {
             request_timestamp: Some(clock::timestamp(clock::local_now())),
             client_name: self.config.client_name.clone(),
             disable_rpc_logging: false,
-        })
+        }
     }
 
     /// Await one call within the call timeout, gRPC failures mapped to [`SpotError`].

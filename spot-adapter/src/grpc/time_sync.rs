@@ -58,11 +58,11 @@ impl Session {
                 .clock
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
-            (sync.previous.clone(), sync.clock_identifier.clone())
+            (sync.previous, sync.clock_identifier.clone())
         };
         let mut client = TimeSyncServiceClient::new(self.service("time-sync")?);
         let request = api::TimeSyncUpdateRequest {
-            header: self.header(),
+            header: Some(self.header()),
             previous_round_trip: previous,
             clock_identifier,
         };

@@ -8,7 +8,8 @@ body moves by the velocity commands it takes, and control lines on stdin inject 
 
 Start-up prints one line `READY <port>` on stdout once the server listens; `<dir>/ca.pem` then
 holds the CA. Control lines (answered `OK <line>`): take-lease, stall-time-sync, malformed-cloud,
-drop (stop serving and exit).
+drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
+<body_T_lidar>` and reads the command that answered with `wait-command <seconds>`.
 """
 
 import argparse
@@ -122,6 +123,10 @@ class Robot:
         self.velocity_end = 0.0  # robot-clock seconds
         self.command_id = 0
         self.last_step = time.time()
+        # Bridge mode: scans and odometry fed on stdin by a simulator, commands handed back.
+        self.bridge_scan = None  # (data bytes, acquisition robot time, odom_T_body, body_T_lidar)
+        self.command_arrived = threading.Condition(self.lock)
+        self.last_command = None  # (kind, vx, vy, wz) of the latest accepted command
 
     def now(self):
         """Robot clock, seconds."""
@@ -167,6 +172,14 @@ class Robot:
         snap = geometry_pb2.FrameTreeSnapshot()
         with self.lock:
             x, y, yaw = self.pose
+            bridged = self.bridge_scan
+        if bridged is not None:
+            # Rooted at odom: the simulator's odometry and LiDAR mounting as given.
+            _, _, odom_t_body, body_t_lidar = bridged
+            add_edge_3d(snap, "body", "odom", odom_t_body)
+            add_edge_3d(snap, "velodyne", "body", body_t_lidar)
+            add_edge(snap, "odom", "", (0.0, 0.0, 0.0), 0.0)
+            return snap
         # body_T_odom = inverse(odom_T_body)
         c, s = math.cos(yaw), math.sin(yaw)
         add_edge(snap, "odom", "body", (-(c * x + s * y), s * x - c * y, 0.0), -yaw)
@@ -192,6 +205,14 @@ def add_edge(snap, child, parent, xyz, yaw):
             edge.parent_tform_child.position.z = xyz
         q = edge.parent_tform_child.rotation
         q.w, q.x, q.y, q.z = math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)
+
+
+def add_edge_3d(snap, child, parent, pose):
+    """`pose` = (x, y, z, qw, qx, qy, qz) of child in parent."""
+    edge = snap.child_to_parent_edge_map[child]
+    edge.parent_frame_name = parent
+    p, q = edge.parent_tform_child.position, edge.parent_tform_child.rotation
+    p.x, p.y, p.z, q.w, q.x, q.y, q.z = pose
 
 
 def unauthenticated(message):
@@ -469,15 +490,23 @@ class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
                 continue
             reply.status = point_cloud_pb2.PointCloudResponse.STATUS_OK
             cloud = reply.point_cloud
-            points = known_points()
             cloud.source.name = "velodyne-point-cloud"
             cloud.source.frame_name_sensor = "velodyne"
-            scan_time = math.floor(self.r.now() * 10.0) / 10.0
-            cloud.source.acquisition_time.CopyFrom(self.r.stamp(scan_time))
-            cloud.source.transforms_snapshot.CopyFrom(self.r.snapshot())
             cloud.encoding = point_cloud_pb2.PointCloud.ENCODING_XYZ_32F
-            cloud.num_points = len(points) + (1 if self.r.malformed_cloud else 0)
-            cloud.data = b"".join(struct.pack("<3f", *p) for p in points)
+            cloud.source.transforms_snapshot.CopyFrom(self.r.snapshot())
+            with self.r.lock:
+                bridged = self.r.bridge_scan
+            if bridged is not None:
+                data, scan_time = bridged[0], bridged[1]
+                count = len(data) // 12
+            else:
+                points = known_points()
+                data = b"".join(struct.pack("<3f", *p) for p in points)
+                scan_time = math.floor(self.r.now() * 10.0) / 10.0
+                count = len(points)
+            cloud.source.acquisition_time.CopyFrom(self.r.stamp(scan_time))
+            cloud.num_points = count + (1 if self.r.malformed_cloud else 0)
+            cloud.data = data
         response.header.CopyFrom(self.r.header(request, received))
         return response
 
@@ -573,6 +602,11 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
         if response.status == robot_command_pb2.RobotCommandResponse.STATUS_OK:
             self.r.command_id += 1
             response.robot_command_id = self.r.command_id
+            with self.r.lock:
+                kind = command_times(request.command)["kind"]
+                vx, vy, wz = self.r.velocity if kind == "se2_velocity_request" else (0.0, 0.0, 0.0)
+                self.r.last_command = (kind, vx, vy, wz)
+                self.r.command_arrived.notify_all()
         response.header.CopyFrom(self.r.header(request, received))
         return response
 
@@ -653,6 +687,24 @@ def main():
             robot.time_sync_stalled = True
         elif line == "malformed-cloud":
             robot.malformed_cloud = True
+        elif line.startswith("scan "):
+            # scan <file of little-endian f32 xyz> <odom_T_body: 7 numbers> <body_T_lidar: 7>
+            words = line.split()
+            with open(words[1], "rb") as f:
+                data = f.read()
+            numbers = [float(w) for w in words[2:16]]
+            with robot.lock:
+                robot.bridge_scan = (data, robot.now(), numbers[:7], numbers[7:])
+                robot.last_command = None
+        elif line.startswith("wait-command "):
+            # The command that answered the last scan (or none within the timeout).
+            deadline = time.time() + float(line.split()[1])
+            with robot.lock:
+                while robot.last_command is None and time.time() < deadline:
+                    robot.command_arrived.wait(timeout=max(0.0, deadline - time.time()))
+                kind, vx, vy, wz = robot.last_command or ("none", 0.0, 0.0, 0.0)
+            print("OK %s %s %r %r %r" % (line, kind, vx, vy, wz), flush=True)
+            continue
         elif line == "drop":
             server.stop(0)
             print("OK drop", flush=True)

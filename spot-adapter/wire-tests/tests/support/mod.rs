@@ -175,6 +175,18 @@ impl FakeSpot {
         }
     }
 
+    /// Send a control line and return what follows `OK <line>` in its answer.
+    pub fn query(&mut self, line: &str) -> String {
+        writeln!(self.stdin, "{line}").unwrap();
+        self.stdin.flush().unwrap();
+        let answer = self.lines.recv_timeout(Duration::from_secs(30)).unwrap();
+        answer
+            .strip_prefix(&format!("OK {line}"))
+            .unwrap_or_else(|| panic!("unexpected answer to {line:?}: {answer:?}"))
+            .trim()
+            .to_owned()
+    }
+
     /// Every request the fake decoded so far, in order.
     pub fn requests(&self) -> Vec<Value> {
         std::fs::read_to_string(self.dir.join("requests.jsonl"))
