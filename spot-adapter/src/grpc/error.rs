@@ -87,7 +87,7 @@ pub enum SpotError {
         status: &'static str,
     },
     /// The last converged time sync is too old to time a command.
-    #[error("time sync is {age:.1} s old, at most {max_age:.1} s is allowed before moving")]
+    #[error("time sync is {age:.2} s old, at most {max_age:.2} s is allowed before moving")]
     TimeSyncStale {
         /// Seconds since the last converged round.
         age: f64,

@@ -680,6 +680,9 @@ def main():
     print("READY %d" % port, flush=True)
     for line in sys.stdin:
         line = line.strip()
+        if not line.startswith(("scan ", "wait-command ")):
+            with robot.lock:  # faults are logged where they happen among the requests
+                robot.log.write(json.dumps({"method": "control", "line": line, "robot_time": robot.now()}) + "\n")
         if line == "take-lease":
             with robot.lock:
                 leases.grant("another-client")

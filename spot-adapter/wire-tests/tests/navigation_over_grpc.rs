@@ -9,13 +9,18 @@ mod support;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
-use slam_core::Pose3;
-use spot_adapter::grpc::SpotClient;
-use spot_adapter::nav::{DriveOutcome, Navigator, NavigatorConfig, drive};
+use nalgebra::Vector2;
+use serde_json::Value;
+use slam_core::{PointCloud, Pose3};
+use spot_adapter::DriveError;
+use spot_adapter::grpc::{SpotClient, SpotError};
+use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_tracker;
-use spot_adapter::robot::{Robot, VelocityCommand};
-use spot_adapter::sim::{CommandedSpot, SimulationConfig};
+use spot_adapter::robot::{Robot, Sample, VelocityCommand};
+use spot_adapter::sim::{Building, CommandedSpot, SimulationConfig};
 
 /// x y z qw qx qy qz of a pose.
 fn words(pose: &Pose3) -> String {
@@ -25,7 +30,7 @@ fn words(pose: &Pose3) -> String {
 }
 
 /// Publish the simulator's sample to the fake (the cloud through a file).
-fn publish(fake: &mut support::FakeSpot, sample: &spot_adapter::robot::Sample, k: usize) {
+fn publish(fake: &mut support::FakeSpot, sample: &Sample, k: usize) {
     let path = fake.dir.join(format!("scan-{}.bin", k % 2));
     let bytes: Vec<u8> = sample
         .cloud
@@ -43,65 +48,122 @@ fn publish(fake: &mut support::FakeSpot, sample: &spot_adapter::robot::Sample, k
     ));
 }
 
-#[test]
-fn the_navigator_walks_the_simulated_spot_to_its_goals_over_grpc() {
-    let (building, map, navigation) = common::building_and_map(3);
-    let corners = building.corridor_loop();
-    let start = corners[0];
-    let along = corners[1] - corners[0];
-    let goal = start + along.normalize() * (0.8 * along.norm()).min(4.0);
-    let mut sim = CommandedSpot::new(building, start, 0.0, &SimulationConfig::default()).unwrap();
-    let world_t_body = sim.body_pose();
+/// Commands the simulator took: the kind the fake decoded and the velocity.
+type Commanded = Vec<(String, VelocityCommand)>;
 
-    let mut fake = fake_spot!("navigation", &["--clock-offset", "4.5"]);
+/// The simulator behind the fake, stepped once per decoded command; `fault` sends a control
+/// line to the fake after the given step (and ends the bridge after a `drop`).
+struct Bridge {
+    fake: Arc<Mutex<support::FakeSpot>>,
+    done: Arc<AtomicBool>,
+    thread: JoinHandle<(CommandedSpot, Commanded)>,
+}
+
+impl Bridge {
+    fn start(
+        fake: support::FakeSpot,
+        mut sim: CommandedSpot,
+        fault: Option<(usize, &'static str)>,
+    ) -> Self {
+        let fake = Arc::new(Mutex::new(fake));
+        let done = Arc::new(AtomicBool::new(false));
+        let (bridge_fake, bridge_done) = (Arc::clone(&fake), Arc::clone(&done));
+        let thread = std::thread::spawn(move || {
+            let mut commanded = Vec::new();
+            let mut k = 0;
+            while !bridge_done.load(Ordering::Relaxed) {
+                let answer = bridge_fake.lock().unwrap().query("wait-command 0.5");
+                let fields: Vec<&str> = answer.split_whitespace().collect();
+                if fields[0] == "none" {
+                    continue;
+                }
+                let number = |i: usize| fields[i].parse::<f64>().unwrap();
+                let command = VelocityCommand {
+                    forward: number(1),
+                    lateral: number(2),
+                    yaw_rate: number(3),
+                };
+                commanded.push((fields[0].to_owned(), command));
+                k += 1;
+                let sample = sim.step(command);
+                publish(&mut bridge_fake.lock().unwrap(), &sample, k);
+                if let Some((at, line)) = fault
+                    && at == k
+                {
+                    bridge_fake.lock().unwrap().control(line);
+                    if line == "drop" {
+                        break;
+                    }
+                }
+            }
+            (sim, commanded)
+        });
+        Self { fake, done, thread }
+    }
+
+    fn finish(self) -> (CommandedSpot, Commanded, Vec<Value>) {
+        self.done.store(true, Ordering::Relaxed);
+        let (sim, commanded) = self.thread.join().unwrap();
+        let requests = self.fake.lock().unwrap().requests();
+        (sim, commanded, requests)
+    }
+}
+
+/// A fake fed by a commanded Spot standing at `start`, the client connected to it, and a
+/// navigator on the map that knows where the robot stands.
+fn setup(
+    building: &Building,
+    map: &PointCloud,
+    navigation: &NavigationMap,
+    start: Vector2<f64>,
+    name: &str,
+    fault: Option<(usize, &'static str)>,
+) -> Option<(SpotClient, Navigator<registration::PointToPlaneIcp>, Bridge)> {
+    let mut sim =
+        CommandedSpot::new(building.clone(), start, 0.0, &SimulationConfig::default()).unwrap();
+    let mut fake = support::start(name, &["--clock-offset", "4.5"])?;
     publish(&mut fake, &sim.sense(), 0);
     let mut config = fake.config();
     config.description = sim.description().clone();
-    let mut spot = SpotClient::connect(config).unwrap();
-
-    // The bridge: one simulator step per command the fake decoded, until told to stop.
-    let fake = Arc::new(Mutex::new(fake));
-    let done = Arc::new(AtomicBool::new(false));
-    let (bridge_fake, bridge_done) = (Arc::clone(&fake), Arc::clone(&done));
-    let bridge = std::thread::spawn(move || {
-        let mut commanded = Vec::new();
-        for k in 1.. {
-            if bridge_done.load(Ordering::Relaxed) {
-                break;
-            }
-            let answer = bridge_fake.lock().unwrap().query("wait-command 0.5");
-            let fields: Vec<&str> = answer.split_whitespace().collect();
-            if fields[0] == "none" {
-                continue;
-            }
-            let number = |i: usize| fields[i].parse::<f64>().unwrap();
-            let command = VelocityCommand {
-                forward: number(1),
-                lateral: number(2),
-                yaw_rate: number(3),
-            };
-            commanded.push((fields[0].to_owned(), command));
-            let sample = sim.step(command);
-            publish(&mut bridge_fake.lock().unwrap(), &sample, k);
-        }
-        (sim, commanded)
-    });
-
-    let mut navigator = Navigator::new(
+    config.lease_retain_interval = Duration::from_millis(200);
+    config.time_sync.resync_interval = Duration::from_millis(200);
+    config.time_sync.max_age = Duration::from_millis(600);
+    let spot = SpotClient::connect(config).unwrap();
+    let navigator = Navigator::new(
         point_to_plane_tracker(),
-        &map,
-        &navigation,
-        world_t_body,
+        map,
+        navigation,
+        sim.body_pose(),
         spot.description(),
         NavigatorConfig::default(),
     )
     .unwrap();
+    Some((spot, navigator, Bridge::start(fake, sim, fault)))
+}
+
+/// A goal 4 m down the corridor from its first corner.
+fn corridor_goal(building: &Building) -> (Vector2<f64>, Vector2<f64>) {
+    let corners = building.corridor_loop();
+    let along = corners[1] - corners[0];
+    (
+        corners[0],
+        corners[0] + along.normalize() * (0.8 * along.norm()).min(4.0),
+    )
+}
+
+#[test]
+fn the_navigator_walks_the_simulated_spot_to_a_goal_and_back_over_grpc() {
+    let (building, map, navigation) = common::building_and_map(3);
+    let (start, goal) = corridor_goal(&building);
+    let Some((mut spot, mut navigator, bridge)) =
+        setup(&building, &map, &navigation, start, "navigation", None)
+    else {
+        return;
+    };
     let there = drive(&mut spot, &mut navigator, goal, 300, |_| {}).unwrap();
     let back = drive(&mut spot, &mut navigator, start, 300, |_| {}).unwrap();
-    done.store(true, Ordering::Relaxed);
-    let (sim, commanded) = bridge.join().unwrap();
     drop(spot);
-
+    let (sim, commanded, requests) = bridge.finish();
     eprintln!(
         "over gRPC: {:?} in {} cycles, {:?} in {} cycles, ended {:.3} m from the start, {} collisions",
         there.outcome,
@@ -134,12 +196,121 @@ fn the_navigator_walks_the_simulated_spot_to_its_goals_over_grpc() {
         .iter()
         .filter(|(kind, _)| kind == "full_body_command")
         .count();
-    assert!(stops >= 1, "a stop after arriving");
-    let fake = fake.lock().unwrap();
-    let decoded = fake.requests_of("RobotCommand");
+    assert_eq!(stops, 2, "a stop after each arrival");
+    let decoded: Vec<&Value> = requests
+        .iter()
+        .filter(|r| r["method"] == "RobotCommand")
+        .collect();
     assert!(
         decoded
             .iter()
             .all(|c| c["request"]["lease"]["sequence"] == serde_json::json!([1]))
     );
+    assert_eq!(requests.last().unwrap()["method"], "ReturnLease");
+}
+
+/// Each fault mid-walk ends the drive with a clear error; no motion command is sent after it,
+/// and the stop goes out whenever the robot can still take one.
+#[test]
+fn faults_mid_walk_stop_the_drive_and_no_motion_follows_them() {
+    let (building, map, navigation) = common::building_and_map(3);
+    let (start, goal) = corridor_goal(&building);
+    for (fault, stop_sent) in [
+        ("malformed-cloud", true),
+        ("stall-time-sync", true),
+        ("take-lease", false),
+        ("drop", false),
+    ] {
+        let Some((mut spot, mut navigator, bridge)) = setup(
+            &building,
+            &map,
+            &navigation,
+            start,
+            fault,
+            Some((10, fault)),
+        ) else {
+            return;
+        };
+        let began = Instant::now();
+        let error = drive(&mut spot, &mut navigator, goal, 300, |_| {}).unwrap_err();
+        let took = began.elapsed();
+        drop(spot);
+        let (_, _, requests) = bridge.finish();
+        let DriveError::Robot(error) = error else {
+            panic!("{fault}: {error:?}")
+        };
+        match fault {
+            "malformed-cloud" => assert!(
+                matches!(error, SpotError::MalformedCloud { .. }),
+                "{error:?}"
+            ),
+            "stall-time-sync" => assert!(
+                matches!(error, SpotError::TimeSyncStale { .. }),
+                "{error:?}"
+            ),
+            "take-lease" => assert!(
+                matches!(
+                    error,
+                    SpotError::LeaseLost {
+                        status: "STATUS_OLDER",
+                        ..
+                    }
+                ),
+                "{error:?}"
+            ),
+            _ => assert!(
+                matches!(
+                    error,
+                    SpotError::Unreachable { .. } | SpotError::Timeout { .. }
+                ),
+                "{error:?}"
+            ),
+        }
+        assert!(took < Duration::from_secs(20), "{fault}: {took:?}");
+        let at = requests
+            .iter()
+            .position(|r| r["method"] == "control" && r["line"] == fault)
+            .unwrap();
+        let after: Vec<&Value> = requests[at..]
+            .iter()
+            .filter(|r| r["method"] == "RobotCommand")
+            .collect();
+        let motion = after
+            .iter()
+            .filter(|c| c["decoded"]["kind"] != "full_body_command")
+            .count();
+        let stops = after.len() - motion;
+        // One cycle may already have been under way when the fault struck, and a stalled time
+        // sync stays usable until it is 0.6 s old; nothing after that.
+        if fault == "stall-time-sync" {
+            let struck = requests[at]["robot_time"].as_f64().unwrap();
+            for c in after
+                .iter()
+                .filter(|c| c["decoded"]["kind"] != "full_body_command")
+            {
+                let sent = c["robot_time"].as_f64().unwrap();
+                assert!(
+                    sent - struck < 0.6 + 0.25,
+                    "{fault}: motion {:.2} s after the stall",
+                    sent - struck
+                );
+            }
+        } else {
+            assert!(
+                motion <= 1,
+                "{fault}: {motion} motion commands after the fault"
+            );
+        }
+        if stop_sent {
+            assert_eq!(stops, 1, "{fault}: the drive's stop reached the robot");
+            assert_eq!(
+                after.last().unwrap()["decoded"]["kind"],
+                "full_body_command",
+                "{fault}"
+            );
+        } else {
+            assert_eq!(stops, 0, "{fault}");
+        }
+        eprintln!("{fault}: {error} after {took:.1?}");
+    }
 }
