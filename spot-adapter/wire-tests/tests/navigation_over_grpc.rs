@@ -2,6 +2,7 @@
 //! serves the simulator's scans and odometry, and the simulated robot moves by the velocity
 //! commands the fake decoded. A bridge thread keeps the two in lockstep: publish a scan, wait
 //! for the command that answers it, step the simulator by it for one LiDAR turn.
+#![allow(clippy::unwrap_used, clippy::panic)]
 
 #[path = "../../tests/common/mod.rs"]
 mod common;

@@ -1,6 +1,8 @@
 //! spot-adapter's gRPC client against a fake Spot on loopback built on the official
 //! `bosdyn-api` 5.2.0 servicers: every assertion on the wire is on what the official classes
 //! decoded (the fake's request log), field by field.
+// Exact float comparisons on purpose: a double crosses the wire bit for bit.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::float_cmp)]
 
 mod support;
 
@@ -516,7 +518,7 @@ fn a_stale_time_sync_stops_motion_but_not_a_stop() {
     config.time_sync.resync_interval = Duration::from_millis(200);
     config.time_sync.max_age = Duration::from_millis(800);
     let mut spot = SpotClient::connect(config).unwrap();
-    std::thread::sleep(Duration::from_millis(1000));
+    std::thread::sleep(Duration::from_secs(1));
     spot.send(&VelocityCommand::new(0.2, 0.0).into())
         .expect("background rounds keep the sync fresh");
     fake.control("stall-time-sync");

@@ -6,7 +6,7 @@
 //! an explicit `SPOT_NAV_SKIP_PYTHON_TESTS=1` turns the tests into a printed skip (never set
 //! in CI).
 
-#![allow(dead_code)]
+#![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -226,7 +226,7 @@ macro_rules! fake_spot {
     };
 }
 
-/// The fake's known cloud (fake_spot.py `known_points`).
+/// The fake's known cloud (`known_points` of `fake_spot.py`).
 pub fn known_points() -> Vec<[f32; 3]> {
     (0..120)
         .map(|i: u32| {
@@ -241,9 +241,9 @@ pub fn known_points() -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// The fake's grid cell value (fake_spot.py `grid_value`).
+/// The fake's grid cell value (`grid_value` of `fake_spot.py`).
 pub fn grid_value(x: u32, y: u32) -> f64 {
-    if (x / 4 + y / 3) % 2 == 0 {
+    if (x / 4 + y / 3).is_multiple_of(2) {
         f64::from((3 * x + 5 * y) % 11)
     } else {
         0.0
