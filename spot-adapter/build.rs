@@ -2,14 +2,11 @@
 //! tonic clients). protox parses the files in pure Rust, so no `protoc` binary is needed.
 //! Without the feature it does nothing.
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    #[cfg(feature = "grpc")]
-    compile_spot_api()?;
-    Ok(())
-}
+#[cfg(not(feature = "grpc"))]
+fn main() {}
 
 #[cfg(feature = "grpc")]
-fn compile_spot_api() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     const FILES: &[&str] = &[
         "bosdyn/api/auth.proto",
         "bosdyn/api/directory.proto",
