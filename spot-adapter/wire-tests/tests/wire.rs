@@ -2,7 +2,12 @@
 //! `bosdyn-api` 5.2.0 servicers: every assertion on the wire is on what the official classes
 //! decoded (the fake's request log), field by field.
 // Exact float comparisons on purpose: a double crosses the wire bit for bit.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::float_cmp)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::float_cmp
+)]
 
 mod support;
 
