@@ -23,6 +23,9 @@ use spot_adapter::pipelines::point_to_plane_tracker;
 use spot_adapter::robot::{Robot, Sample, VelocityCommand};
 use spot_adapter::sim::{Building, CommandedSpot, SimulationConfig};
 
+/// The oldest time sync the client moves with in these tests (short, to test a stale one).
+const MAX_SYNC_AGE: Duration = Duration::from_secs(1);
+
 /// x y z qw qx qy qz of a pose.
 fn words(pose: &Pose3) -> String {
     let t = pose.translation.vector;
@@ -72,6 +75,9 @@ impl Bridge {
         let thread = std::thread::spawn(move || {
             let mut commanded = Vec::new();
             let mut k = 0;
+            let mut last_scan = Instant::now();
+            let period =
+                Duration::from_secs_f64(1.0 / SimulationConfig::default().lidar.rotation_rate);
             while !bridge_done.load(Ordering::Relaxed) {
                 let answer = bridge_fake.lock().unwrap().query("wait-command 0.5");
                 let fields: Vec<&str> = answer.split_whitespace().collect();
@@ -87,6 +93,9 @@ impl Bridge {
                 commanded.push((fields[0].to_owned(), command));
                 k += 1;
                 let sample = sim.step(command);
+                // Scans come at the simulated LiDAR's rate, not as fast as the loop can go.
+                std::thread::sleep(period.saturating_sub(last_scan.elapsed()));
+                last_scan = Instant::now();
                 publish(&mut bridge_fake.lock().unwrap(), &sample, k);
                 if let Some((at, line)) = fault
                     && at == k
@@ -128,7 +137,7 @@ fn setup(
     config.description = sim.description().clone();
     config.lease_retain_interval = Duration::from_millis(200);
     config.time_sync.resync_interval = Duration::from_millis(200);
-    config.time_sync.max_age = Duration::from_millis(600);
+    config.time_sync.max_age = MAX_SYNC_AGE;
     let spot = SpotClient::connect(config).unwrap();
     let navigator = Navigator::new(
         point_to_plane_tracker(),
@@ -282,7 +291,7 @@ fn faults_mid_walk_stop_the_drive_and_no_motion_follows_them() {
             .count();
         let stops = after.len() - motion;
         // One cycle may already have been under way when the fault struck, and a stalled time
-        // sync stays usable until it is 0.6 s old; nothing after that.
+        // sync stays usable until it is `MAX_SYNC_AGE` old; nothing after that.
         if fault == "stall-time-sync" {
             let struck = requests[at]["robot_time"].as_f64().unwrap();
             for c in after
@@ -291,7 +300,7 @@ fn faults_mid_walk_stop_the_drive_and_no_motion_follows_them() {
             {
                 let sent = c["robot_time"].as_f64().unwrap();
                 assert!(
-                    sent - struck < 0.6 + 0.25,
+                    sent - struck < MAX_SYNC_AGE.as_secs_f64() + 0.3,
                     "{fault}: motion {:.2} s after the stall",
                     sent - struck
                 );

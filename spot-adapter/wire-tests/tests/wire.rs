@@ -175,7 +175,8 @@ fn time_sync_recovers_the_robot_clock_offset_and_times_commands_in_robot_time() 
     let fake = fake_spot!("time-sync", &["--clock-offset", "12.5"]);
     let spot = connect(&fake);
     let skew = spot.clock_skew().expect("converged");
-    assert!((skew - 12.5).abs() < 0.02, "skew {skew}");
+    // The estimate is good to half the best round trip: a few milliseconds on loopback.
+    assert!((skew - 12.5).abs() < 0.05, "skew {skew}");
     let rounds = fake.requests_of("TimeSyncUpdate");
     assert!(
         rounds.len() >= 4,
@@ -487,7 +488,7 @@ fn commands_reach_the_robot_with_frames_end_times_limits_and_the_lease() {
         serde_json::json!([1.6, 0.5, 1.0])
     );
     let robot_time = f(&commands[0]["robot_time"]);
-    assert!((f(&commands[0]["decoded"]["end_time"]) - robot_time - 0.6).abs() < 0.1);
+    assert!((f(&commands[0]["decoded"]["end_time"]) - robot_time - 0.6).abs() < 0.25);
 
     let clamped = mobility(&commands[1])["se2_velocity_request"]["velocity"].clone();
     assert_eq!(
@@ -521,13 +522,13 @@ fn a_stale_time_sync_stops_motion_but_not_a_stop() {
     let mut fake = fake_spot!("stale");
     let mut config = fake.config();
     config.time_sync.resync_interval = Duration::from_millis(200);
-    config.time_sync.max_age = Duration::from_millis(800);
+    config.time_sync.max_age = Duration::from_millis(1500);
     let mut spot = SpotClient::connect(config).unwrap();
-    std::thread::sleep(Duration::from_secs(1));
+    std::thread::sleep(Duration::from_secs(2));
     spot.send(&VelocityCommand::new(0.2, 0.0).into())
         .expect("background rounds keep the sync fresh");
     fake.control("stall-time-sync");
-    std::thread::sleep(Duration::from_millis(1200));
+    std::thread::sleep(Duration::from_secs(2));
     let sent = fake.requests_of("RobotCommand").len();
     let error = spot
         .send(&VelocityCommand::new(0.2, 0.0).into())
