@@ -16,6 +16,9 @@ use crate::grpc::point_cloud::SpotCloud;
 use crate::grpc::session::Session;
 use crate::robot::{MobilityCommand, Robot, RobotDescription, Sample};
 
+/// First pause before retrying a failed token renewal.
+const RENEWAL_RETRY: Duration = Duration::from_secs(1);
+
 /// Pause between two asks for a scan newer than the last one.
 const SCAN_POLL: Duration = Duration::from_millis(20);
 
@@ -226,7 +229,7 @@ impl Drop for SpotClient {
 
 /// The lease retain, time-sync and token renewal loops. Their failures are not fatal here:
 /// a lost lease is recorded by the retain and refused at the next command, a stale time sync
-/// is refused at the next motion, a failed renewal is retried on the next tick.
+/// is refused at the next motion, a failed renewal is retried soon.
 fn spawn_background(runtime: &Runtime, session: &Arc<Session>) -> Vec<JoinHandle<()>> {
     let retain = Arc::clone(session);
     let sync = Arc::clone(session);
@@ -247,10 +250,16 @@ fn spawn_background(runtime: &Runtime, session: &Arc<Session>) -> Vec<JoinHandle
             }
         }),
         runtime.spawn(async move {
-            let mut ticks = ticks(renew.config.token_refresh_interval);
+            // As the SDK's token manager: on a failed renewal retry after 1 s, doubling.
+            let period = renew.config.token_refresh_interval;
+            let mut wait = period;
             loop {
-                ticks.tick().await;
-                let _ = renew.refresh_token(renew.current_token()).await;
+                tokio::time::sleep(wait).await;
+                wait = match renew.refresh_token(renew.current_token()).await {
+                    Ok(()) => period,
+                    Err(_) if wait >= period => RENEWAL_RETRY.min(period),
+                    Err(_) => (wait * 2).min(period),
+                };
             }
         }),
     ]
