@@ -136,7 +136,12 @@ fn bad_credentials_are_a_login_error_that_never_shows_the_password() {
         matches!(&error, SpotError::Login { status: "STATUS_INVALID_LOGIN", username } if username == support::USERNAME),
         "{error:?}"
     );
-    let text = format!("{error} {error:?} {logged}");
+    let mut text = format!("{error} {error:?} {logged}");
+    let mut source = std::error::Error::source(&error);
+    while let Some(cause) = source {
+        text = format!("{text} {cause} {cause:?}");
+        source = cause.source();
+    }
     assert!(!text.contains(wrong), "the password leaked: {text}");
     assert!(!format!("{:?}", fake.config()).contains(support::PASSWORD));
 }
