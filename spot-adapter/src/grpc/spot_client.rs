@@ -30,6 +30,9 @@ const SCAN_POLL: Duration = Duration::from_millis(20);
 /// and renews the token every [`SpotConfig::token_refresh_interval`]. Dropping it stops the
 /// background work and returns the lease. Every call waits at most
 /// [`SpotConfig::call_timeout`].
+///
+/// It is a blocking client with a one-thread tokio runtime of its own: call it from ordinary
+/// threads, not from inside another async runtime (tokio refuses to block there).
 pub struct SpotClient {
     session: Arc<Session>,
     runtime: Runtime,
@@ -194,6 +197,16 @@ impl SpotClient {
             cloud: scan.cloud,
             ground_truth: None,
         })
+    }
+}
+
+impl std::fmt::Debug for SpotClient {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SpotClient")
+            .field("host", &self.session.config.host)
+            .field("identity", &self.identity)
+            .field("lease_lost", &self.lease_lost())
+            .finish_non_exhaustive()
     }
 }
 
