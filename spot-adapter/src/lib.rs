@@ -48,6 +48,8 @@
 
 mod error;
 pub mod eval;
+#[cfg(feature = "grpc")]
+pub mod grpc;
 pub mod nav;
 pub mod pipelines;
 pub mod record;

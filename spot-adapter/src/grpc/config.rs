@@ -1,0 +1,170 @@
+//! How to reach a Spot and how the client paces its background work.
+
+use std::fmt;
+use std::time::Duration;
+
+use crate::grpc::error::SpotError;
+use crate::robot::RobotDescription;
+
+/// A user name and password for the robot's auth service. `Debug` shows the user name only;
+/// the password leaves the process in `GetAuthToken` and nowhere else.
+#[derive(Clone)]
+pub struct Credentials {
+    username: String,
+    password: String,
+}
+
+impl Credentials {
+    /// Credentials from a user name and a password (read from an environment variable or a
+    /// prompt, never from a command line).
+    #[must_use]
+    pub fn new(username: impl Into<String>, password: impl Into<String>) -> Self {
+        Self {
+            username: username.into(),
+            password: password.into(),
+        }
+    }
+
+    /// The user name.
+    #[must_use]
+    pub fn username(&self) -> &str {
+        &self.username
+    }
+
+    pub(crate) fn password(&self) -> &str {
+        &self.password
+    }
+}
+
+impl fmt::Debug for Credentials {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Credentials")
+            .field("username", &self.username)
+            .field("password", &"<hidden>")
+            .finish()
+    }
+}
+
+/// How time sync runs: the first rounds before anything moves, then one round now and then in
+/// the background.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct TimeSyncConfig {
+    /// Rounds tried at connection before giving up on convergence: 20.
+    pub max_initial_rounds: usize,
+    /// Pause between the first rounds: 50 ms.
+    pub round_interval: Duration,
+    /// Pause between background rounds: 5 s.
+    pub resync_interval: Duration,
+    /// Oldest converged estimate a motion command may be timed with: 30 s.
+    pub max_age: Duration,
+}
+
+impl Default for TimeSyncConfig {
+    fn default() -> Self {
+        Self {
+            max_initial_rounds: 20,
+            round_interval: Duration::from_millis(50),
+            resync_interval: Duration::from_secs(5),
+            max_age: Duration::from_secs(30),
+        }
+    }
+}
+
+/// Everything [`SpotClient::connect`](crate::grpc::SpotClient::connect) needs.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct SpotConfig {
+    /// The robot's address: a host name or IP (a Spot on its own Wi-Fi: `192.168.80.3`).
+    pub host: String,
+    /// The robot's TLS port: 443.
+    pub port: u16,
+    /// The CA certificate (PEM) the robot's certificate must chain to: for a Spot, Boston
+    /// Dynamics' root CA, given by the user.
+    pub ca_pem: Vec<u8>,
+    /// Who logs in.
+    pub credentials: Credentials,
+    /// The name the robot shows for this client (request headers, lease owner): `spot-nav`.
+    pub client_name: String,
+    /// Longest wait for any one call, connection included: 5 s.
+    pub call_timeout: Duration,
+    /// How often the auth token is renewed (the robot's tokens live much longer): 30 min.
+    pub token_refresh_interval: Duration,
+    /// How often the lease is retained: 2 s, as the SDK's `LeaseKeepAlive`.
+    pub lease_retain_interval: Duration,
+    /// Time sync pacing.
+    pub time_sync: TimeSyncConfig,
+    /// The directory name of the point cloud service: `velodyne-point-cloud`.
+    pub point_cloud_service: String,
+    /// The point cloud source asked for: `velodyne-point-cloud`.
+    pub point_cloud_source: String,
+    /// How long a velocity command holds before the robot stops by itself: 0.6 s, a few LiDAR
+    /// periods, so a driver that falls silent leaves the robot standing.
+    pub velocity_hold: Duration,
+    /// Time past a trajectory's last point before its command ends: 1 s.
+    pub trajectory_slack: Duration,
+    /// Geometry and speed limits (commands are clamped to the limits and the limits are sent
+    /// to the robot as `MobilityParams.vel_limit`).
+    pub description: RobotDescription,
+}
+
+impl SpotConfig {
+    /// A configuration with the defaults above for `host`, its CA and credentials.
+    #[must_use]
+    pub fn new(host: impl Into<String>, ca_pem: Vec<u8>, credentials: Credentials) -> Self {
+        Self {
+            host: host.into(),
+            port: 443,
+            ca_pem,
+            credentials,
+            client_name: "spot-nav".to_owned(),
+            call_timeout: Duration::from_secs(5),
+            token_refresh_interval: Duration::from_secs(30 * 60),
+            lease_retain_interval: Duration::from_secs(2),
+            time_sync: TimeSyncConfig::default(),
+            point_cloud_service: "velodyne-point-cloud".to_owned(),
+            point_cloud_source: "velodyne-point-cloud".to_owned(),
+            velocity_hold: Duration::from_millis(600),
+            trajectory_slack: Duration::from_secs(1),
+            description: RobotDescription::default(),
+        }
+    }
+
+    /// Every setting usable.
+    ///
+    /// # Errors
+    /// [`SpotError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), SpotError> {
+        let bad = |setting: &'static str, problem: &str| {
+            Err(SpotError::InvalidConfig {
+                setting,
+                problem: problem.to_owned(),
+            })
+        };
+        if self.host.is_empty() {
+            return bad("host", "empty");
+        }
+        if self.ca_pem.is_empty() {
+            return bad("ca_pem", "empty: the robot's CA certificate is needed");
+        }
+        for (setting, value) in [
+            ("call_timeout", self.call_timeout),
+            ("token_refresh_interval", self.token_refresh_interval),
+            ("lease_retain_interval", self.lease_retain_interval),
+            ("time_sync.resync_interval", self.time_sync.resync_interval),
+            ("time_sync.max_age", self.time_sync.max_age),
+            ("velocity_hold", self.velocity_hold),
+        ] {
+            if value.is_zero() {
+                return bad(setting, "must be longer than zero");
+            }
+        }
+        if self.time_sync.max_initial_rounds == 0 {
+            return bad("time_sync.max_initial_rounds", "at least one round");
+        }
+        if let Err(error) = self.description.limits.validate() {
+            return bad("description.limits", &error.to_string());
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,161 @@
+//! The error enum of the gRPC client. No variant holds a password or a token: errors are safe
+//! to log.
+
+use thiserror::Error;
+
+/// Why a call to a Spot failed, or why the client refused to make it.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum SpotError {
+    /// A setting of [`SpotConfig`](crate::grpc::SpotConfig) is unusable.
+    #[error("setting {setting}: {problem}")]
+    InvalidConfig {
+        /// The setting, as its field is named.
+        setting: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// The robot's CA certificate or address cannot be used for a TLS channel.
+    #[error("cannot set up a TLS channel to {address} as {authority}")]
+    Channel {
+        /// `host:port` dialled.
+        address: String,
+        /// The authority (TLS name) of the channel.
+        authority: String,
+        /// The cause.
+        #[source]
+        source: tonic::transport::Error,
+    },
+    /// The robot cannot be reached (refused, unroutable, TLS handshake failed, connection lost).
+    #[error("{method}: the robot at {address} cannot be reached")]
+    Unreachable {
+        /// The RPC attempted.
+        method: &'static str,
+        /// `host:port` dialled.
+        address: String,
+        /// gRPC's status, with the transport error as its source.
+        #[source]
+        source: tonic::Status,
+    },
+    /// An RPC did not answer within the call timeout.
+    #[error("{method}: no answer within {seconds} s")]
+    Timeout {
+        /// The RPC attempted.
+        method: &'static str,
+        /// The timeout, seconds.
+        seconds: f64,
+    },
+    /// An RPC failed with a gRPC status other than "unavailable" or "deadline exceeded".
+    #[error("{method}: the robot answered gRPC status {code:?}")]
+    Rpc {
+        /// The RPC attempted.
+        method: &'static str,
+        /// The gRPC status code.
+        code: tonic::Code,
+        /// The status itself.
+        #[source]
+        source: tonic::Status,
+    },
+    /// The robot refused the user name and password, or the token it is asked to refresh.
+    #[error("the robot refused to log in user {username:?}: {status}")]
+    Login {
+        /// The user name (the password is never kept in an error).
+        username: String,
+        /// The refusal, as `GetAuthTokenResponse.Status` names it.
+        status: &'static str,
+    },
+    /// A response header reports an error (or none at all, which the SDK treats as one).
+    #[error("{method}: the robot reported error {code}: {message}")]
+    ResponseHeader {
+        /// The RPC.
+        method: &'static str,
+        /// `CommonError.Code` (0 unset, 2 internal, 3 invalid request).
+        code: i32,
+        /// The robot's message.
+        message: String,
+    },
+    /// The robot's directory lists no service of this name.
+    #[error("the robot's directory has no service {service:?}")]
+    UnknownService {
+        /// The service name looked up.
+        service: String,
+    },
+    /// Time sync has not converged: no command can be timed in robot time.
+    #[error("time sync has not converged (last status {status})")]
+    TimeSyncNotConverged {
+        /// The robot's last `TimeSyncState.Status`.
+        status: &'static str,
+    },
+    /// The last converged time sync is too old to time a command.
+    #[error("time sync is {age:.2} s old, at most {max_age:.2} s is allowed before moving")]
+    TimeSyncStale {
+        /// Seconds since the last converged round.
+        age: f64,
+        /// The configured bound, seconds.
+        max_age: f64,
+    },
+    /// The robot would not grant the lease.
+    #[error("the lease of {resource:?} was refused: {status} (held by {owner:?})")]
+    LeaseRefused {
+        /// The resource asked for (`body`).
+        resource: String,
+        /// `AcquireLeaseResponse.Status` as named on the wire.
+        status: &'static str,
+        /// The client holding it, when the robot says.
+        owner: String,
+    },
+    /// The lease is no longer ours (taken by another client, revoked): no more commands.
+    #[error("the lease is lost: {status} (now held by {owner:?})")]
+    LeaseLost {
+        /// `LeaseUseResult.Status` as named on the wire.
+        status: &'static str,
+        /// The client holding it now, when the robot says.
+        owner: String,
+    },
+    /// The robot refused a command.
+    #[error("the robot refused the command: {status} {message:?}")]
+    CommandRefused {
+        /// `RobotCommandResponse.Status` as named on the wire.
+        status: &'static str,
+        /// The robot's message.
+        message: String,
+    },
+    /// A frame lookup failed.
+    #[error(transparent)]
+    Frame(#[from] crate::grpc::FrameError),
+    /// A point cloud could not be decoded.
+    #[error("point cloud from {source_name:?}: {problem}")]
+    MalformedCloud {
+        /// The point cloud source.
+        source_name: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A local grid could not be decoded.
+    #[error("local grid {grid:?}: {problem}")]
+    MalformedGrid {
+        /// The grid type name.
+        grid: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The robot has no data for a request (an unknown source or grid, data unavailable).
+    #[error("{what:?}: the robot answered {status}")]
+    NoData {
+        /// The point cloud source or local grid asked for.
+        what: String,
+        /// The response status as named on the wire.
+        status: &'static str,
+    },
+    /// The robot delivered no scan newer than the last one within the call timeout.
+    #[error("no new scan from {source_name:?} within {seconds} s")]
+    NoNewScan {
+        /// The point cloud source.
+        source_name: String,
+        /// Seconds waited.
+        seconds: f64,
+    },
+    /// The client's async runtime could not be started.
+    #[error("the client's runtime could not start")]
+    Runtime(#[source] std::io::Error),
+}

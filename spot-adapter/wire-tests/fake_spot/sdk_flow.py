@@ -1,0 +1,71 @@
+"""The official Spot SDK (bosdyn-client) runs spot-nav's flow against the fake Spot.
+
+Authenticates, syncs time, takes the lease, reads the robot state, the point cloud and both local
+grids, sends a velocity and a trajectory command and a stop, returns the lease, and prints one
+JSON line with what it read. Any SDK exception fails the script (exit status 1).
+"""
+
+import argparse
+import json
+import sys
+import time
+
+import bosdyn.client
+from bosdyn.client.frame_helpers import get_a_tform_b
+from bosdyn.client.lease import LeaseClient
+from bosdyn.client.local_grid import LocalGridClient
+from bosdyn.client.point_cloud import PointCloudClient
+from bosdyn.client.robot_command import RobotCommandBuilder, RobotCommandClient
+from bosdyn.client.robot_state import RobotStateClient
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--port", type=int, required=True)
+    parser.add_argument("--ca", required=True)
+    parser.add_argument("--username", default="user")
+    parser.add_argument("--password", default="password")
+    args = parser.parse_args()
+
+    sdk = bosdyn.client.create_standard_sdk("spot-nav-sdk-check")
+    sdk.load_robot_cert(args.ca)
+    robot = sdk.create_robot("127.0.0.1")
+    robot.update_secure_channel_port(args.port)
+    robot.authenticate(args.username, args.password, timeout=10)
+    robot_id = robot.get_id()
+    robot.time_sync.wait_for_sync(timeout_sec=10)
+    skew = robot.time_sync.get_robot_clock_skew()
+    lease_client = robot.ensure_client(LeaseClient.default_service_name)
+    lease = lease_client.acquire()
+    state = robot.ensure_client(RobotStateClient.default_service_name).get_robot_state(timeout=10)
+    snapshot = state.kinematic_state.transforms_snapshot
+    odom_t_body = get_a_tform_b(snapshot, "odom", "body")
+    clouds = robot.ensure_client("velodyne-point-cloud").get_point_cloud_from_sources(
+        ["velodyne-point-cloud"], timeout=10)
+    grids = robot.ensure_client(LocalGridClient.default_service_name).get_local_grids(
+        ["terrain", "no_step"], timeout=10)
+    commands = robot.ensure_client(RobotCommandClient.default_service_name)
+    from bosdyn.client.lease import LeaseKeepAlive, LeaseWallet  # noqa: F401 (the SDK's wallet)
+    robot.lease_wallet.add(lease)
+    end = time.time() + 1.0
+    commands.robot_command(RobotCommandBuilder.synchro_velocity_command(0.3, 0.0, 0.1),
+                           end_time_secs=end, timeout=10)
+    commands.robot_command(RobotCommandBuilder.synchro_se2_trajectory_point_command(
+        1.5, 2.0, 0.2, "odom"), end_time_secs=time.time() + 5.0, timeout=10)
+    commands.robot_command(RobotCommandBuilder.stop_command(), timeout=10)
+    lease_client.return_lease(lease)
+    print(json.dumps({
+        "serial": robot_id.serial_number,
+        "clock_skew": skew.seconds + skew.nanos * 1e-9,
+        "odom_t_body": [odom_t_body.x, odom_t_body.y, odom_t_body.z],
+        "num_points": clouds[0].point_cloud.num_points,
+        "grids": [g.local_grid.local_grid_type_name for g in grids],
+    }), flush=True)
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except Exception as error:  # report the SDK's complaint, not a traceback
+        print("SDK flow failed: %r" % (error,), file=sys.stderr, flush=True)
+        sys.exit(1)
