@@ -319,6 +319,16 @@ pub enum GraphValue {
         /// Id of the node it ends at.
         to: u64,
     },
+    /// The squared error `e^T Omega e` of an edge at the current poses: every number is finite
+    /// but the product overflows (a measurement or pose of 1e200 m), or a solver diverged there.
+    EdgeError {
+        /// Index of the edge.
+        edge: usize,
+        /// Id of the node it starts at.
+        from: u64,
+        /// Id of the node it ends at.
+        to: u64,
+    },
 }
 
 impl std::fmt::Display for GraphValue {
@@ -327,6 +337,9 @@ impl std::fmt::Display for GraphValue {
             Self::NodePose { id } => write!(f, "pose of node {id}"),
             Self::Measurement { edge, from, to } => {
                 write!(f, "measurement of edge {edge} ({from} to {to})")
+            }
+            Self::EdgeError { edge, from, to } => {
+                write!(f, "squared error of edge {edge} ({from} to {to})")
             }
         }
     }
