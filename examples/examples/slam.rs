@@ -105,12 +105,12 @@ where
     };
     match args.registration {
         Registration::PointToPlane => {
-            let mut slam = point_to_plane_slam(config);
+            let mut slam = point_to_plane_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args.out.as_deref())
         }
         Registration::Loam => {
-            let mut slam = loam_slam(config);
+            let mut slam = loam_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args.out.as_deref())
         }
