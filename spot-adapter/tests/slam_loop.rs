@@ -111,6 +111,10 @@ fn an_odometry_jump_is_detected_and_the_lap_stays_accurate() {
     let (e, _) =
         TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
             .unwrap();
+    eprintln!(
+        "with the jump: ATE {:.4} m, loop end-point error {:.4} m, {} fallbacks",
+        e.ate.rmse, e.loop_end_point_error, report.odometry_fallbacks
+    );
     assert!(e.ate.rmse <= 0.05, "ATE {} m", e.ate.rmse);
     assert!(
         e.loop_end_point_error <= 0.05,

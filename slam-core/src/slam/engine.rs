@@ -496,12 +496,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let mut reg_info = None;
         if index > 0 && self.ensure_local_map() {
             let from_odometry = self.register(&source, &predicted);
-            // The extrapolation arbitrates when the odometry step is suspect or its guess did
-            // not register.
+            // The extrapolation arbitrates only a suspect odometry step, so that clean input
+            // runs exactly as without the check.
             let from_prior = match prior {
-                Some((guess, _)) if suspect || from_odometry.is_none() => {
-                    self.register(&source, &guess)
-                }
+                Some((guess, _)) if suspect => self.register(&source, &guess),
                 _ => None,
             };
             let (chosen, fault) = match (from_odometry, from_prior) {

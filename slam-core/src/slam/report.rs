@@ -85,8 +85,8 @@ pub struct SlamReport {
     pub odometry_fallbacks: usize,
     /// Keyframes whose odometry step the registration contradicted: the step ended more than
     /// [`GraphSlamConfig::odometry_fault_distance`](super::GraphSlamConfig) from the
-    /// constant-velocity extrapolation (or its registration failed), and the scan registered
-    /// from the extrapolation fitted better, so that pose was kept.
+    /// constant-velocity extrapolation, and the scan registered from the extrapolation fitted
+    /// better than from the odometry's guess (or only it registered), so that pose was kept.
     pub odometry_faults: usize,
     /// Skipped scans: a non-finite keyframe pose ([`SkipReason::NonFinitePose`]).
     pub skipped_non_finite_pose: usize,
