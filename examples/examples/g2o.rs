@@ -21,7 +21,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
 use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o_with, write_g2o};
-use posegraph::information_repair::InformationRepair;
+use posegraph::information_repair::{InformationRepair, RepairedEdge};
 use posegraph::toro::read_toro;
 use posegraph::{
     ChordalInitialization, ErrorModel, GaussNewton, GncConfig, GraduatedNonConvexity,
@@ -173,11 +173,9 @@ where
     Ok((report, rejected))
 }
 
-fn optimise(args: &Args) -> Result<()> {
+/// The graph of `args.file` (TORO when `is_toro`) and the edges whose information was repaired.
+fn read(args: &Args, is_toro: bool) -> Result<(G2oGraph, Vec<RepairedEdge>)> {
     let file = &args.file;
-    let is_toro = file
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("graph"));
     if is_toro && args.repair_information {
         bail!("--repair-information applies to g2o files, not TORO");
     }
@@ -186,11 +184,33 @@ fn optimise(args: &Args) -> Result<()> {
     } else {
         InformationRepair::Refuse
     };
-    let (mut graph, repaired) = if is_toro {
+    Ok(if is_toro {
         (G2oGraph::Se2(read_toro(file)?), Vec::new())
     } else {
         read_g2o_with(file, repair).with_context(|| format!("reading {}", file.display()))?
-    };
+    })
+}
+
+/// The `repaired` line: how many of `edges` edges' information changed, and the largest change.
+fn print_repairs(repaired: &[RepairedEdge], edges: usize) -> Result<()> {
+    let largest = repaired
+        .iter()
+        .map(|r| r.relative_change)
+        .fold(0.0, f64::max);
+    out!(
+        "repaired    {} of {edges} edges' information (nearest positive definite; largest change {:.1} % of a matrix)",
+        repaired.len(),
+        100.0 * largest
+    )?;
+    Ok(())
+}
+
+fn optimise(args: &Args) -> Result<()> {
+    let file = &args.file;
+    let is_toro = file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("graph"));
+    let (mut graph, repaired) = read(args, is_toro)?;
     let (nodes, edges) = match &graph {
         G2oGraph::Se2(g) => (g.node_count(), g.edge_count()),
         G2oGraph::Se3(g) => (g.node_count(), g.edge_count()),
@@ -241,15 +261,7 @@ fn optimise(args: &Args) -> Result<()> {
         }
     )?;
     if args.repair_information {
-        let largest = repaired
-            .iter()
-            .map(|r| r.relative_change)
-            .fold(0.0, f64::max);
-        out!(
-            "repaired    {} of {edges} edges' information (nearest positive definite; largest change {:.1} % of a matrix)",
-            repaired.len(),
-            100.0 * largest
-        )?;
+        print_repairs(&repaired, edges)?;
     }
     let method = match args.robust {
         Robust::None => value_name(&args.optimizer),

@@ -69,8 +69,8 @@ pub trait RepairableInformation: Copy + Sized {
     fn nearest_positive_definite(&self, ratio: f64) -> Option<(Self, f64)>;
     /// Frobenius norm.
     fn norm(&self) -> f64;
-    /// `self - other`.
-    fn minus(&self, other: &Self) -> Self;
+    /// Frobenius norm of `self - other`.
+    fn distance(&self, other: &Self) -> f64;
 }
 
 /// `V diag(max(lambda, floor)) V^T` for the eigen-decomposition `(values, vectors)`, with the
@@ -106,8 +106,8 @@ macro_rules! repairable {
             fn norm(&self) -> f64 {
                 nalgebra::Matrix::norm(self)
             }
-            fn minus(&self, other: &Self) -> Self {
-                self - other
+            fn distance(&self, other: &Self) -> f64 {
+                nalgebra::Matrix::norm(&(self - other))
             }
         }
     };
@@ -148,7 +148,7 @@ impl InformationRepair {
             line,
             edge,
             smallest_eigenvalue,
-            relative_change: fixed.minus(&info).norm() / info.norm().max(f64::MIN_POSITIVE),
+            relative_change: fixed.distance(&info) / info.norm().max(f64::MIN_POSITIVE),
         });
         Ok(fixed)
     }

@@ -361,6 +361,20 @@ impl VoxelHashMap {
         out.first().copied()
     }
 
+    /// Every stored point outside the rings `0..ring` around cell `base`: those whose key is none
+    /// of theirs, so offsets modulo 2^21 (a cell 2^21 cells away shares a key).
+    fn entries_outside(&self, base: [i32; 3], ring: i32) -> impl Iterator<Item = &Entry> + '_ {
+        self.cells.values().flatten().filter(move |e| {
+            let w = widen(e.p);
+            let o = [
+                key_offset(cell_of(w.x, self.inv_cell), base[0]),
+                key_offset(cell_of(w.y, self.inv_cell), base[1]),
+                key_offset(cell_of(w.z, self.inv_cell), base[2]),
+            ];
+            !o.iter().all(|v| v.abs() < ring)
+        })
+    }
+
     /// The search behind [`VoxelHashMap::nearest_k`], into a caller's buffer.
     #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
     pub(crate) fn search(
@@ -457,18 +471,7 @@ impl VoxelHashMap {
             // (2r + 1)^3 - (2r - 1)^3 cells, written so that it cannot overflow for r <= 2^20.
             let shell = 24 * i64::from(ring) * i64::from(ring) + 2;
             if usize::try_from(shell).unwrap_or(usize::MAX) > self.cells.len() {
-                for e in self.cells.values().flatten() {
-                    let w = widen(e.p);
-                    // Points of the rings searched already: those whose key is one of theirs,
-                    // so offsets modulo 2^21 (a cell 2^21 cells away shares a key).
-                    let o = [
-                        key_offset(cell_of(w.x, self.inv_cell), base[0]),
-                        key_offset(cell_of(w.y, self.inv_cell), base[1]),
-                        key_offset(cell_of(w.z, self.inv_cell), base[2]),
-                    ];
-                    if o.iter().all(|v| v.abs() < ring) {
-                        continue;
-                    }
+                for e in self.entries_outside(base, ring) {
                     offer(&mut best, e);
                 }
                 break;

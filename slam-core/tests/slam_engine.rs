@@ -739,11 +739,11 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
     let truth = loop_poses();
     let config = no_loop_config();
     let mut slam = brute_engine(config).unwrap();
-    for k in 0..6 {
-        let cloud = scan(&world, &truth[k]);
+    for (k, gt) in truth.iter().take(6).enumerate() {
+        let cloud = scan(&world, gt);
         slam.process(&ScanInput {
             stamp: k as f64 * 0.2,
-            odom_t_body: truth[k],
+            odom_t_body: *gt,
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
         });
@@ -754,7 +754,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
             .map(|i| Point3::new(500.0 + 0.1 * i as f32, 0.0, 0.0))
             .collect(),
     );
-    let mut input = |k: usize, odom: Pose3| ScanInput {
+    let input = |k: usize, odom: Pose3| ScanInput {
         stamp: k as f64 * 0.2,
         odom_t_body: odom,
         body_t_lidar: Pose3::identity(),

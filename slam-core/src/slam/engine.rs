@@ -391,11 +391,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         &mut self,
         id: u64,
         pose: Pose3,
-        edge: Option<(Pose3, Matrix6<f64>)>,
+        edge: Option<&(Pose3, Matrix6<f64>)>,
     ) -> Result<(), OptimizeError> {
         if !pose3_is_finite(&pose)
             || edge.is_some_and(|(step, info)| {
-                !pose3_is_finite(&step) || !Pose3::information_is_valid(&info)
+                !pose3_is_finite(step) || !Pose3::information_is_valid(info)
             })
         {
             return Err(OptimizeError::NonFinite {
@@ -404,7 +404,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         self.graph.add_node(id, pose)?;
         match (edge, id.checked_sub(1)) {
-            (Some((step, info)), Some(prev)) => {
+            (Some(&(step, info)), Some(prev)) => {
                 self.graph.add_edge(prev, id, step, info, None)?;
             }
             _ => self.graph.fix(id)?,
@@ -429,9 +429,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// odometry, whichever scored higher.
     fn contradicts(&self, prior: &Alignment, odometry: &Alignment) -> bool {
         let apart = (prior.pose.translation.vector - odometry.pose.translation.vector).norm();
-        apart > self.config.odometry_fault_distance
-            && (prior.inlier_ratio > odometry.inlier_ratio
-                || (prior.inlier_ratio == odometry.inlier_ratio && prior.rmse < odometry.rmse))
+        let better = match prior.inlier_ratio.total_cmp(&odometry.inlier_ratio) {
+            std::cmp::Ordering::Greater => true,
+            std::cmp::Ordering::Equal => prior.rmse < odometry.rmse,
+            std::cmp::Ordering::Less => false,
+        };
+        apart > self.config.odometry_fault_distance && better
     }
 
     /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted
@@ -450,6 +453,40 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         });
         let pose = velocity.map_or(x1, |v| x1 * se3_exp(&(v * dt)));
         Some((pose, velocity))
+    }
+
+    /// The pose of a new keyframe (`source`) and its registration's information: registered
+    /// from the odometry's `predicted` pose, and from `prior` too when given (a suspect odometry
+    /// step), the better fit kept when they disagree; `predicted` when neither registers.
+    /// Counts fallbacks and odometry faults.
+    fn register_keyframe(
+        &mut self,
+        source: &R::Source,
+        predicted: Pose3,
+        prior: Option<Pose3>,
+    ) -> (Pose3, Option<Matrix6<f64>>) {
+        let from_odometry = self.register(source, &predicted);
+        let from_prior = prior.and_then(|guess| self.register(source, &guess));
+        let (chosen, fault) = match (from_odometry, from_prior) {
+            (Some(o), Some(p)) => {
+                if self.contradicts(&p, &o) {
+                    (Some(p), true)
+                } else {
+                    (Some(o), false)
+                }
+            }
+            (None, Some(p)) => (Some(p), true),
+            (o, None) => (o, false),
+        };
+        if fault {
+            self.report.odometry_faults += 1;
+        }
+        if let Some(a) = chosen {
+            (a.pose, Some(a.information))
+        } else {
+            self.report.odometry_fallbacks += 1;
+            (predicted, None)
+        }
     }
 
     fn add_keyframe(
@@ -491,39 +528,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .unwrap_or(cloud);
 
         let index = self.keyframes.len();
-        let mut pose = predicted;
-        let mut registered = false;
-        let mut reg_info = None;
-        if index > 0 && self.ensure_local_map() {
-            let from_odometry = self.register(&source, &predicted);
-            // The extrapolation arbitrates only a suspect odometry step, so that clean input
-            // runs exactly as without the check.
-            let from_prior = match prior {
-                Some((guess, _)) if suspect => self.register(&source, &guess),
-                _ => None,
-            };
-            let (chosen, fault) = match (from_odometry, from_prior) {
-                (Some(o), Some(p)) => {
-                    if self.contradicts(&p, &o) {
-                        (Some(p), true)
-                    } else {
-                        (Some(o), false)
-                    }
-                }
-                (None, Some(p)) => (Some(p), true),
-                (o, None) => (o, false),
-            };
-            if let Some(a) = chosen {
-                pose = a.pose;
-                registered = true;
-                reg_info = Some(a.information);
-            } else {
-                self.report.odometry_fallbacks += 1;
-            }
-            if fault {
-                self.report.odometry_faults += 1;
-            }
-        }
+        // The extrapolation arbitrates only a suspect odometry step, so that clean input runs
+        // exactly as without the check.
+        let (pose, reg_info) = if index > 0 && self.ensure_local_map() {
+            let arbiter = prior.filter(|_| suspect).map(|(guess, _)| guess);
+            self.register_keyframe(&source, predicted, arbiter)
+        } else {
+            (predicted, None)
+        };
 
         let id = index as u64;
         let edge = if index == 0 {
@@ -534,7 +546,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 Self::information(self.config.odometry_information, reg_info.as_ref(), &pose);
             Some((step, info))
         };
-        if self.insert_node(id, pose, edge).is_err() {
+        if self.insert_node(id, pose, edge.as_ref()).is_err() {
             return self.skip(SkipReason::NonFinitePose, started);
         }
         self.keyframes.push(Keyframe {
@@ -575,7 +587,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if self.config.inline_loop_closure {
             self.loop_closure_step();
         }
-        ScanOutcome::Keyframe { id, registered }
+        ScanOutcome::Keyframe {
+            id,
+            registered: reg_info.is_some(),
+        }
     }
 
     /// Try the oldest queued loop candidate: coarse alignment of the new keyframe to the
