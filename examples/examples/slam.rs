@@ -133,12 +133,14 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             + report.skipped_too_few_points
             + report.skipped_preparation
             + report.skipped_awaiting_velocity
+            + report.skipped_non_finite_pose
     )?;
     out!(
-        "loops       {} closed of {} tried; {} odometry fallbacks",
+        "loops       {} closed of {} tried; {} odometry fallbacks, {} odometry faults",
         report.loops_closed,
         report.loops_attempted,
-        report.odometry_fallbacks
+        report.odometry_fallbacks,
+        report.odometry_faults
     )?;
     let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);
     let p99 = report.scan_ms_quantile(0.99);
