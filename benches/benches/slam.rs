@@ -130,14 +130,21 @@ fn main() {
             let mut laps = Vec::new();
             for _ in 0..repeats {
                 let Ok(input) = simulate() else { break };
-                laps.push(match setup.as_str() {
-                    "p2plane" => lap(point_to_plane_slam(slam_config()), input),
-                    "loam" => lap(loam_slam(slam_config()), input),
+                let done = match setup.as_str() {
+                    "p2plane" => point_to_plane_slam(slam_config()).map(|s| lap(s, input)),
+                    "loam" => loam_slam(slam_config()).map(|s| lap(s, input)),
                     other => {
                         eprintln!("slam bench: unknown setup {other:?} (p2plane, loam)");
                         break;
                     }
-                });
+                };
+                match done {
+                    Ok(l) => laps.push(l),
+                    Err(e) => {
+                        eprintln!("slam bench: {e}");
+                        break;
+                    }
+                }
             }
             match row(&laps, &sim) {
                 Ok(row) => println!("| {seed} | {setup} | {row}"),

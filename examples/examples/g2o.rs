@@ -2,14 +2,16 @@
 //! final cost in both conventions (log-map `sum e^T Omega e`, and g2o's own chi2) and milliseconds.
 //!
 //! `cargo run --release --example g2o -- FILE [--optimizer gn|lm] [--init file|chordal]
-//! [--error logmap|g2o] [--robust none|gnc] [--out OUT.g2o]`
+//! [--error logmap|g2o] [--robust none|gnc] [--repair-information] [--out OUT.g2o]`
 //!
 //! `--robust gnc` optimises with graduated non-convexity (truncated least squares; odometry, the
 //! edges between consecutive ids, as known inliers; its inner solver is always LM) and prints how
 //! many edges it weighted out; `--out` then writes the graph without them.
 //! The first node is fixed when the file fixes none. `--init chordal` replaces the file's initial
 //! guess by the chordal initialisation before optimising (its time is included). `--error g2o`
-//! minimises g2o's error convention instead of the log map (GTSAM's). Exits with status 1 when the
+//! minimises g2o's error convention instead of the log map (GTSAM's). Information matrices that are
+//! not positive definite are refused unless `--repair-information` replaces each by the nearest
+//! positive-definite matrix (eigenvalues clipped to 1e-6 of the largest) and counts them. Exits with status 1 when the
 //! optimiser stopped at its iteration cap (the figures are printed, and `--out` written, first).
 
 use std::path::PathBuf;
@@ -18,7 +20,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
-use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o, write_g2o};
+use posegraph::g2o::{G2oGraph, g2o_chi2, read_g2o_with, write_g2o};
+use posegraph::information_repair::{InformationRepair, RepairedEdge};
 use posegraph::toro::read_toro;
 use posegraph::{
     ChordalInitialization, ErrorModel, GaussNewton, GncConfig, GraduatedNonConvexity,
@@ -59,6 +62,11 @@ struct Args {
     /// Write the optimised graph here (g2o; with `--robust gnc` without the edges weighted out).
     #[arg(long, value_name = "OUT.g2o")]
     out: Option<PathBuf>,
+    /// Replace information matrices that are not positive definite by the nearest
+    /// positive-definite matrix (eigenvalues clipped to 1e-6 of the largest) instead of refusing
+    /// the file, and print how many edges changed (g2o files only).
+    #[arg(long)]
+    repair_information: bool,
 }
 
 /// `--optimizer`.
@@ -165,16 +173,44 @@ where
     Ok((report, rejected))
 }
 
+/// The graph of `args.file` (TORO when `is_toro`) and the edges whose information was repaired.
+fn read(args: &Args, is_toro: bool) -> Result<(G2oGraph, Vec<RepairedEdge>)> {
+    let file = &args.file;
+    if is_toro && args.repair_information {
+        bail!("--repair-information applies to g2o files, not TORO");
+    }
+    let repair = if args.repair_information {
+        InformationRepair::nearest_positive_definite()
+    } else {
+        InformationRepair::Refuse
+    };
+    Ok(if is_toro {
+        (G2oGraph::Se2(read_toro(file)?), Vec::new())
+    } else {
+        read_g2o_with(file, repair).with_context(|| format!("reading {}", file.display()))?
+    })
+}
+
+/// The `repaired` line: how many of `edges` edges' information changed, and the largest change.
+fn print_repairs(repaired: &[RepairedEdge], edges: usize) -> Result<()> {
+    let largest = repaired
+        .iter()
+        .map(|r| r.relative_change)
+        .fold(0.0, f64::max);
+    out!(
+        "repaired    {} of {edges} edges' information (nearest positive definite; largest change {:.1} % of a matrix)",
+        repaired.len(),
+        100.0 * largest
+    )?;
+    Ok(())
+}
+
 fn optimise(args: &Args) -> Result<()> {
     let file = &args.file;
     let is_toro = file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("graph"));
-    let mut graph = if is_toro {
-        G2oGraph::Se2(read_toro(file)?)
-    } else {
-        read_g2o(file).with_context(|| format!("reading {}", file.display()))?
-    };
+    let (mut graph, repaired) = read(args, is_toro)?;
     let (nodes, edges) = match &graph {
         G2oGraph::Se2(g) => (g.node_count(), g.edge_count()),
         G2oGraph::Se3(g) => (g.node_count(), g.edge_count()),
@@ -224,6 +260,9 @@ fn optimise(args: &Args) -> Result<()> {
             "SE(2)"
         }
     )?;
+    if args.repair_information {
+        print_repairs(&repaired, edges)?;
+    }
     let method = match args.robust {
         Robust::None => value_name(&args.optimizer),
         Robust::Gnc => value_name(&args.robust),

@@ -395,8 +395,8 @@ fn mission(args: &Args) -> Result<()> {
         building.rooms().len()
     )?;
     let mapped = match args.registration {
-        Registration::PointToPlane => map_building(point_to_plane_slam(slam_config()), sim)?,
-        Registration::Loam => map_building(loam_slam(slam_config()), sim)?,
+        Registration::PointToPlane => map_building(point_to_plane_slam(slam_config())?, sim)?,
+        Registration::Loam => map_building(loam_slam(slam_config())?, sim)?,
     };
 
     let start = lap_end.translation.vector.xy();

@@ -105,12 +105,12 @@ where
     };
     match args.registration {
         Registration::PointToPlane => {
-            let mut slam = point_to_plane_slam(config);
+            let mut slam = point_to_plane_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args.out.as_deref())
         }
         Registration::Loam => {
-            let mut slam = loam_slam(config);
+            let mut slam = loam_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args.out.as_deref())
         }
@@ -133,12 +133,14 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             + report.skipped_too_few_points
             + report.skipped_preparation
             + report.skipped_awaiting_velocity
+            + report.skipped_non_finite_pose
     )?;
     out!(
-        "loops       {} closed of {} tried; {} odometry fallbacks",
+        "loops       {} closed of {} tried; {} odometry fallbacks, {} odometry faults",
         report.loops_closed,
         report.loops_attempted,
-        report.odometry_fallbacks
+        report.odometry_fallbacks,
+        report.odometry_faults
     )?;
     let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);
     let p99 = report.scan_ms_quantile(0.99);

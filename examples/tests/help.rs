@@ -21,6 +21,7 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--error",
             "--robust",
             "--out",
+            "--repair-information",
             "gn",
             "lm",
             "chordal",

@@ -36,6 +36,18 @@ pub enum GraphFileError {
         /// 1-based line number.
         line: usize,
     },
+    /// An edge's information matrix is not positive definite (and was not repaired).
+    #[error(
+        "line {line}: the information matrix of edge {edge} is not positive definite; read with \
+         InformationRepair::NearestPositiveDefinite (the g2o example's --repair-information) to \
+         replace it by the nearest positive-definite matrix"
+    )]
+    InformationNotPositiveDefinite {
+        /// 1-based line number.
+        line: usize,
+        /// Index the edge would have had.
+        edge: usize,
+    },
     /// The graph rejected an element (duplicate node, unknown node, bad information).
     #[error("line {line}: {source}")]
     Graph {

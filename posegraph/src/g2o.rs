@@ -10,6 +10,7 @@ use nalgebra::{Matrix3, Matrix6, Translation3, Vector2};
 use slam_core::{GraphPose, Pose2, Pose3, PoseGraph, quaternion_from_xyzw, quaternion_to_xyzw};
 
 use crate::error::{GraphFileError, UnknownTag};
+use crate::information_repair::{InformationRepair, RepairedEdge};
 
 /// A graph read from a g2o file: 2D or 3D.
 #[derive(Clone, Debug)]
@@ -55,15 +56,29 @@ fn id(word: &str, line: usize) -> Result<u64, GraphFileError> {
         .map_err(|_| line_err(line, format!("{word:?} is not a vertex id")))
 }
 
-/// Parse g2o text.
+/// Parse g2o text; information matrices that are not positive definite are refused.
 ///
 /// # Errors
 /// [`GraphFileError::Line`] for malformed lines, [`GraphFileError::Graph`] for duplicate or
-/// unknown vertices and non-positive-definite information, [`GraphFileError::MixedDimensions`],
-/// and [`GraphFileError::UnknownTags`] when the file uses tags this reader does not implement.
+/// unknown vertices, [`GraphFileError::InformationNotPositiveDefinite`],
+/// [`GraphFileError::MixedDimensions`], and [`GraphFileError::UnknownTags`] when the file uses
+/// tags this reader does not implement.
+pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
+    parse_g2o_with(text, InformationRepair::Refuse).map(|(graph, _)| graph)
+}
+
+/// Parse g2o text, with `repair` deciding what happens to information matrices that are not
+/// positive definite; returns the graph and the edges repaired.
+///
+/// # Errors
+/// As [`parse_g2o`].
 // One pass over the lines with one arm per tag; the arms are short and read best side by side.
 #[allow(clippy::too_many_lines)]
-pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
+pub fn parse_g2o_with(
+    text: &str,
+    repair: InformationRepair,
+) -> Result<(G2oGraph, Vec<RepairedEdge>), GraphFileError> {
+    let mut repaired = Vec::new();
     let mut g2: Option<PoseGraph<Pose2>> = None;
     let mut g3: Option<PoseGraph<Pose3>> = None;
     let mut fixes: Vec<(usize, u64)> = Vec::new();
@@ -115,6 +130,8 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
                         idx += 1;
                     }
                 }
+                let edge = g3.as_ref().map_or(0, PoseGraph::edge_count);
+                let info = repair.apply(info, line, edge, &mut repaired)?;
                 g3.get_or_insert_with(PoseGraph::new)
                     .add_edge(a, b, z, info, None)
                     .map_err(graph_err)?;
@@ -143,6 +160,8 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
                 let v = numbers(&rest[2..], line, 3 + 6, tag)?;
                 let z = Pose2::new(Vector2::new(v[0], v[1]), v[2]);
                 let info = Matrix3::new(v[3], v[4], v[5], v[4], v[6], v[7], v[5], v[7], v[8]);
+                let edge = g2.as_ref().map_or(0, PoseGraph::edge_count);
+                let info = repair.apply(info, line, edge, &mut repaired)?;
                 g2.get_or_insert_with(PoseGraph::new)
                     .add_edge(a, b, z, info, None)
                     .map_err(graph_err)?;
@@ -181,7 +200,7 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
         };
         r.map_err(|source| GraphFileError::Graph { line, source })?;
     }
-    Ok(out)
+    Ok((out, repaired))
 }
 
 /// Read a g2o file.
@@ -189,12 +208,23 @@ pub fn parse_g2o(text: &str) -> Result<G2oGraph, GraphFileError> {
 /// # Errors
 /// [`GraphFileError::Io`], or as [`parse_g2o`].
 pub fn read_g2o(path: impl AsRef<Path>) -> Result<G2oGraph, GraphFileError> {
+    read_g2o_with(path, InformationRepair::Refuse).map(|(graph, _)| graph)
+}
+
+/// Read a g2o file with `repair` (see [`parse_g2o_with`]).
+///
+/// # Errors
+/// [`GraphFileError::Io`], or as [`parse_g2o`].
+pub fn read_g2o_with(
+    path: impl AsRef<Path>,
+    repair: InformationRepair,
+) -> Result<(G2oGraph, Vec<RepairedEdge>), GraphFileError> {
     let path = path.as_ref();
     let text = std::fs::read_to_string(path).map_err(|source| GraphFileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_g2o(&text)
+    parse_g2o_with(&text, repair)
 }
 
 /// g2o text of an SE(3) graph (full precision: it reads back exactly).

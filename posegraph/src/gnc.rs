@@ -16,7 +16,7 @@ use crate::gnc_loss::{GncLoss, chi2_quantile};
 use crate::linearize::Linearize;
 use crate::loop_support::supported;
 use crate::solver::sealed::Caches;
-use crate::solver::{Cache, SolverConfig, SolverPose, chi2, optimize};
+use crate::solver::{Cache, SolverConfig, SolverPose, check_finite, chi2, optimize};
 
 /// Which edges graduated non-convexity takes as inliers without testing them (weight 1 always):
 /// odometry, whose errors are small and which keeps the graph connected.
@@ -326,6 +326,7 @@ pub(crate) fn graduate<P: Linearize<D> + SolverPose, const D: usize>(
     config: &GncConfig,
 ) -> Result<GncReport, OptimizeError> {
     graph.check_gauge()?;
+    check_finite(graph, config.solver.error_model)?;
     let m = graph.edge_count();
     let known: Vec<bool> = (0..m)
         .map(|k| config.known_inliers.contains(graph, k))

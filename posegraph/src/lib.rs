@@ -49,6 +49,7 @@ pub mod g2o;
 mod gauss_newton;
 mod gnc;
 mod gnc_loss;
+pub mod information_repair;
 mod levenberg_marquardt;
 mod linearize;
 mod loop_support;

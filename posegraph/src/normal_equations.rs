@@ -23,8 +23,11 @@ struct EdgeSlots {
 
 /// The pattern and symbolic factorisation for one graph structure.
 pub(crate) struct NormalEquations<const D: usize> {
-    /// (nodes, edges, fixed flags hash) the pattern was built for.
-    key: (usize, usize, u64),
+    /// The structure the pattern was built for: each node's fixed flag and each edge's endpoint
+    /// indices. Compared whole, so a second graph of the same size with other edges gets its own
+    /// pattern instead of filling this one's slots.
+    fixed: Vec<bool>,
+    ends: Vec<(usize, usize)>,
     /// Variable of each node (`None` for fixed nodes).
     var_of_node: Vec<Option<usize>>,
     n_vars: usize,
@@ -40,20 +43,21 @@ pub(crate) struct NormalEquations<const D: usize> {
     pub(crate) gradient: Vec<f64>,
 }
 
-fn structure_key<P: GraphPose>(graph: &PoseGraph<P>) -> (usize, usize, u64) {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for (i, n) in graph.nodes().iter().enumerate() {
-        if n.fixed {
-            h = (h ^ i as u64).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    (graph.node_count(), graph.edge_count(), h)
-}
-
 impl<const D: usize> NormalEquations<D> {
     /// Whether this pattern still fits `graph`.
     pub(crate) fn fits<P: GraphPose>(&self, graph: &PoseGraph<P>) -> bool {
-        self.key == structure_key(graph)
+        self.fixed.len() == graph.node_count()
+            && self.ends.len() == graph.edge_count()
+            && self
+                .fixed
+                .iter()
+                .zip(graph.nodes())
+                .all(|(&f, n)| f == n.fixed)
+            && self
+                .ends
+                .iter()
+                .zip(graph.edges())
+                .all(|(&(a, b), e)| a == e.from && b == e.to)
     }
 
     /// Build the pattern and the symbolic factorisation for `graph`, with `D` unknowns per free
@@ -127,7 +131,8 @@ impl<const D: usize> NormalEquations<D> {
         // Up to D right-hand sides (the chordal relaxation solves for D columns at once).
         let cholesky = SparseCholesky::try_new::<D>(symbolic_pattern.as_ref(), blocks.as_ref(), D)?;
         Ok(Self {
-            key: structure_key(graph),
+            fixed: graph.nodes().iter().map(|n| n.fixed).collect(),
+            ends: graph.edges().iter().map(|e| (e.from, e.to)).collect(),
             var_of_node,
             n_vars,
             col_ptr,

@@ -3,8 +3,8 @@
 
 use nalgebra::SVector;
 use slam_core::{
-    Edge, FactorizationFailure, OptimizationReport, OptimizeError, Pose2, Pose3, PoseGraph,
-    RobustKernel, StopReason,
+    Edge, FactorizationFailure, GraphValue, OptimizationReport, OptimizeError, Pose2, Pose3,
+    PoseGraph, RobustKernel, StopReason,
 };
 
 use crate::error::{InvalidConfig, check};
@@ -100,6 +100,45 @@ pub(crate) fn chi2<P: Linearize<D>, const D: usize>(
 ) -> f64 {
     let err = P::error(model, &e.measurement, &poses[e.from], &poses[e.to]);
     (err.transpose() * P::info(&e.information) * err)[0]
+}
+
+/// The first value that makes the cost of `graph` at `poses` non-finite: a node's pose (set
+/// through [`PoseGraph::set_pose`], which does not check), else an edge whose squared error
+/// overflows although its numbers are finite (a 1e200 m measurement).
+pub(crate) fn non_finite_value<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    poses: &[P],
+    model: ErrorModel,
+) -> Option<GraphValue> {
+    let nodes = graph.nodes();
+    if let Some(i) = poses.iter().position(|p| !p.is_finite()) {
+        return Some(GraphValue::NodePose { id: nodes[i].id });
+    }
+    graph
+        .edges()
+        .iter()
+        .position(|e| !chi2(e, poses, model).is_finite())
+        .map(|k| {
+            let e = &graph.edges()[k];
+            GraphValue::EdgeError {
+                edge: k,
+                from: nodes[e.from].id,
+                to: nodes[e.to].id,
+            }
+        })
+}
+
+/// [`OptimizeError::NonFinite`] unless every pose and every edge's squared error of `graph` is
+/// finite: a solver started there would end `Ok` with a NaN or infinite cost.
+pub(crate) fn check_finite<P: Linearize<D>, const D: usize>(
+    graph: &PoseGraph<P>,
+    model: ErrorModel,
+) -> Result<(), OptimizeError> {
+    let poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
+    match non_finite_value(graph, &poses, model) {
+        Some(what) => Err(OptimizeError::NonFinite { what }),
+        None => Ok(()),
+    }
 }
 
 /// The IRLS surrogate of a graph with robust kernels, `sum w_k s_k(poses)` with each kernel's
@@ -323,6 +362,7 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
 ) -> Result<OptimizationReport, OptimizeError> {
     graph.check_gauge()?;
     let model = config.error_model;
+    check_finite(graph, model)?;
     let mut poses: Vec<P> = graph.nodes().iter().map(|n| n.pose).collect();
     let initial_cost = cost_with(graph, &poses, model, weights, 1.0);
     let kernelled = weights.is_none() && graph.edges().iter().any(|e| e.kernel.is_some());
@@ -405,6 +445,13 @@ pub(crate) fn optimize<P: Linearize<D>, const D: usize>(
             });
         }
         let new_cost = cost_with(graph, &trial, model, weights, gm_scale);
+        if !levenberg
+            && !new_cost.is_finite()
+            && let Some(what) = non_finite_value(graph, &trial, model)
+        {
+            // Gauss-Newton takes every step: one that overflows is a divergence, not a result.
+            return Err(OptimizeError::NonFinite { what });
+        }
         // NaN costs count as worse.
         let improved = new_cost < cost;
         if levenberg && !improved {

@@ -146,13 +146,19 @@ fn malformed_files_and_bad_graphs_are_errors() {
     ));
     // Information that is not positive definite.
     let bad = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 -1 0 0 1 0 1\n";
-    assert!(matches!(
-        parse_g2o(bad),
-        Err(GraphFileError::Graph {
-            line: 3,
-            source: OptimizeError::InformationNotPositiveDefinite { .. }
-        })
-    ));
+    let refused = parse_g2o(bad).unwrap_err();
+    assert!(
+        matches!(
+            refused,
+            GraphFileError::InformationNotPositiveDefinite { line: 3, edge: 0 }
+        ),
+        "{refused}"
+    );
+    // The error names the option that repairs it.
+    assert!(
+        refused.to_string().contains("--repair-information"),
+        "{refused}"
+    );
     // No fixed node, and a node connected to nothing.
     let G2oGraph::Se2(mut g) = parse_g2o("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 5 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n").unwrap() else { panic!() };
     assert!(matches!(

@@ -52,8 +52,29 @@ pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> 
         .collect()
 }
 
+/// How many directions `points` spread along (0 to 3): the eigenvalues of their covariance
+/// whose standard deviation exceeds both 1e-6 of the largest one and what f32 storage can
+/// resolve at their distance from the origin (plus 1e-6 m).
+#[allow(clippy::cast_precision_loss)]
+fn spread_dimensions(points: &[Point3<f64>]) -> usize {
+    if points.is_empty() {
+        return 0;
+    }
+    let n = points.len() as f64;
+    let mean = points.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n;
+    let cov = points.iter().fold(Matrix3::zeros(), |m, p| {
+        let d = p.coords - mean;
+        m + d * d.transpose()
+    }) / n;
+    let sigma = symmetric_eigen3(&cov).values.map(|v| v.max(0.0).sqrt());
+    let floor = 1e-6 + f64::from(f32::EPSILON) * mean.amax();
+    let tolerance = floor.max(1e-6 * sigma.max());
+    sigma.iter().filter(|&&s| s > tolerance).count()
+}
+
 impl PreparedTarget {
     /// Build the tree (and normals from `normal_neighbours` nearest points when asked).
+    /// Coincident or collinear points are refused ([`Degeneracy::DegenerateTarget`]).
     pub(crate) fn new(
         points: Vec<Point3<f64>>,
         normal_neighbours: Option<usize>,
@@ -64,6 +85,12 @@ impl PreparedTarget {
                 what: "target",
                 points: points.len(),
                 required: min_points,
+            });
+        }
+        let dimensions = spread_dimensions(&points);
+        if dimensions < 2 {
+            return Err(RegistrationError::Degenerate {
+                cause: Degeneracy::DegenerateTarget { dimensions },
             });
         }
         #[allow(clippy::cast_possible_truncation)]

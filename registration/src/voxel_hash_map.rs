@@ -92,14 +92,36 @@ fn pack(c: [i32; 3]) -> u64 {
     axis(c[0]) | (axis(c[1]) << 21) | (axis(c[2]) << 42)
 }
 
-/// Integer cell of `v` at `inv` cells per metre; saturating, so absurd coordinates stay finite.
+/// Integer cell of `v` at `inv` cells per metre; saturating at the ends of `i32`, so absurd
+/// coordinates stay finite (and fall in the end cells, which the distance test sorts out).
 #[allow(clippy::cast_possible_truncation)]
 fn cell_of(v: f64, inv: f64) -> i32 {
     // Truncate, then step down for negatives: `f64::floor` is a library call on baseline x86-64.
     let x = v * inv;
     let t = x as i32;
-    if f64::from(t) > x { t - 1 } else { t }
+    if f64::from(t) > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
 }
+
+/// The cell `o` cells from `base` on each axis. Wrapping: keys keep 21 bits per axis anyway
+/// ([`pack`]), and wrapping in `i32` is wrapping modulo 2^21 too, so a cell next to the last one
+/// is the one a wrapped key names.
+fn offset(base: [i32; 3], o: [i32; 3]) -> [i32; 3] {
+    std::array::from_fn(|a| base[a].wrapping_add(o[a]))
+}
+
+/// `cell - base` modulo 2^21, in `[-2^20, 2^20)`: the offset between the cells' keys.
+fn key_offset(cell: i32, base: i32) -> i32 {
+    cell.wrapping_sub(base).wrapping_shl(11) >> 11
+}
+
+/// Rings searched at most: beyond 2^20 cells the 21-bit keys wrap round, and a map has far fewer
+/// cells than such a ring would visit, so the search reads every cell before (see
+/// [`VoxelHashMap::nearest_k`]).
+const MAX_RING: i32 = 1 << 20;
 
 /// The `k` best (smallest squared distance) candidates seen so far, sorted ascending.
 struct Best<'a> {
@@ -210,14 +232,15 @@ impl VoxelHashMap {
 
     /// Adds `p` for `owner`. With thinning, a voxel keeps the point of the oldest owner that
     /// saw it (the first point within one owner) and remembers the newest other owner's point
-    /// as a stand-in for when the oldest is removed. Non-finite points are skipped; returns
-    /// whether `p` was kept (searchable or as a stand-in).
+    /// as a stand-in for when the oldest is removed. Non-finite points, and points beyond the
+    /// cells (or thinning voxels) an `i32` numbers (2^31 cells from the origin: 859,000 km at
+    /// 0.4 m), are skipped; returns whether `p` was kept (searchable or as a stand-in).
     pub fn insert(&mut self, owner: u32, p: &Point3<f64>) -> bool {
-        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-            return false;
-        }
         #[allow(clippy::cast_possible_truncation)]
         let q = [p.x as f32, p.y as f32, p.z as f32];
+        if !self.numbered(q) {
+            return false;
+        }
         let key = self.cell_key(q);
         let entry = Entry { p: q, owner };
         if self.thin > 0.0 {
@@ -300,8 +323,19 @@ impl VoxelHashMap {
         before - self.len
     }
 
+    /// Whether every coordinate of `q` is finite and lies inside the cells and thinning voxels an
+    /// `i32` numbers, where a cell's points lie within its bounds (the search's pruning relies on
+    /// it; beyond, cell indices saturate).
+    fn numbered(&self, q: [f32; 3]) -> bool {
+        let inv = self.inv_cell.max(self.inv_thin);
+        let limit = f64::from(i32::MAX) - 1.0;
+        q.iter()
+            .all(|&v| v.is_finite() && (f64::from(v) * inv).abs() < limit)
+    }
+
     /// The `k` points nearest `q` within `max_distance`, nearest first, as (squared distance,
-    /// point) in `out` (cleared first; fewer than `k` when fewer lie within reach).
+    /// point) in `out` (cleared first; fewer than `k` when fewer lie within reach). A query
+    /// beyond the numbered cells (see [`VoxelHashMap::insert`]) reads every point.
     #[allow(clippy::cast_possible_truncation)]
     pub fn nearest_k(
         &self,
@@ -327,6 +361,20 @@ impl VoxelHashMap {
         out.first().copied()
     }
 
+    /// Every stored point outside the rings `0..ring` around cell `base`: those whose key is none
+    /// of theirs, so offsets modulo 2^21 (a cell 2^21 cells away shares a key).
+    fn entries_outside(&self, base: [i32; 3], ring: i32) -> impl Iterator<Item = &Entry> + '_ {
+        self.cells.values().flatten().filter(move |e| {
+            let w = widen(e.p);
+            let o = [
+                key_offset(cell_of(w.x, self.inv_cell), base[0]),
+                key_offset(cell_of(w.y, self.inv_cell), base[1]),
+                key_offset(cell_of(w.z, self.inv_cell), base[2]),
+            ];
+            !o.iter().all(|v| v.abs() < ring)
+        })
+    }
+
     /// The search behind [`VoxelHashMap::nearest_k`], into a caller's buffer.
     #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
     pub(crate) fn search(
@@ -346,15 +394,6 @@ impl VoxelHashMap {
             return;
         }
         let qf = [q.x as f32, q.y as f32, q.z as f32];
-        let w = widen(qf);
-        let base = [
-            cell_of(w.x, self.inv_cell),
-            cell_of(w.y, self.inv_cell),
-            cell_of(w.z, self.inv_cell),
-        ];
-        // The query's offset inside its cell, in metres from the low and the high face.
-        let lo: [f64; 3] = std::array::from_fn(|a| w[a] - f64::from(base[a]) * self.cell);
-        let hi: [f64; 3] = std::array::from_fn(|a| self.cell - lo[a]);
         let max_d2 = (max_distance * max_distance) as f32;
         let mut best = Best { k, items };
         let offer = |best: &mut Best<'_>, e: &Entry| {
@@ -370,6 +409,22 @@ impl VoxelHashMap {
                 best.offer(d2, e.p);
             }
         };
+        if !self.numbered(qf) {
+            // Beyond the numbered cells the cell geometry does not hold: compare every point.
+            for e in self.cells.values().flatten() {
+                offer(&mut best, e);
+            }
+            return;
+        }
+        let w = widen(qf);
+        let base = [
+            cell_of(w.x, self.inv_cell),
+            cell_of(w.y, self.inv_cell),
+            cell_of(w.z, self.inv_cell),
+        ];
+        // The query's offset inside its cell, in metres from the low and the high face.
+        let lo: [f64; 3] = std::array::from_fn(|a| w[a] - f64::from(base[a]) * self.cell);
+        let hi: [f64; 3] = std::array::from_fn(|a| self.cell - lo[a]);
         let scan = |best: &mut Best<'_>, key: u64| {
             if let Some(entries) = self.cells.get(&key) {
                 for e in entries {
@@ -399,12 +454,12 @@ impl VoxelHashMap {
             if (gx * gx + gy * gy + gz * gz) as f32 > best.bound(max_d2) {
                 continue;
             }
-            scan(
-                &mut best,
-                pack([base[0] + o[0], base[1] + o[1], base[2] + o[2]]),
-            );
+            scan(&mut best, pack(offset(base, o)));
         }
-        let reach = (max_distance * self.inv_cell).ceil() as i32 + 1;
+        // Saturating: an infinite `max_distance` reaches every cell.
+        let reach = ((max_distance * self.inv_cell).ceil() as i32)
+            .saturating_add(1)
+            .min(MAX_RING);
         for ring in 2..=reach {
             // Every cell outside the rings searched so far is at least this far.
             let outside = f64::from(ring - 1) * self.cell + nearest_face;
@@ -413,19 +468,10 @@ impl VoxelHashMap {
             }
             // A far reach over a sparse map: reading every occupied cell once is cheaper than
             // enumerating the remaining rings.
-            let shell = (2 * i64::from(ring) + 1).pow(3) - (2 * i64::from(ring) - 1).pow(3);
+            // (2r + 1)^3 - (2r - 1)^3 cells, written so that it cannot overflow for r <= 2^20.
+            let shell = 24 * i64::from(ring) * i64::from(ring) + 2;
             if usize::try_from(shell).unwrap_or(usize::MAX) > self.cells.len() {
-                for e in self.cells.values().flatten() {
-                    let w = widen(e.p);
-                    let o = [
-                        cell_of(w.x, self.inv_cell) - base[0],
-                        cell_of(w.y, self.inv_cell) - base[1],
-                        cell_of(w.z, self.inv_cell) - base[2],
-                    ];
-                    // Points of the rings searched already.
-                    if o.iter().all(|v| v.abs() < ring) {
-                        continue;
-                    }
+                for e in self.entries_outside(base, ring) {
                     offer(&mut best, e);
                 }
                 break;
@@ -441,7 +487,7 @@ impl VoxelHashMap {
                         if d2 as f32 > best.bound(max_d2) {
                             continue;
                         }
-                        scan(&mut best, pack([base[0] + dx, base[1] + dy, base[2] + dz]));
+                        scan(&mut best, pack(offset(base, [dx, dy, dz])));
                     }
                 }
             }
@@ -503,4 +549,24 @@ fn touch(touched: &mut Touched, key: u64) {
 
 fn widen(p: [f32; 3]) -> Point3<f64> {
     Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{cell_of, offset, pack};
+
+    #[test]
+    fn cells_saturate_and_offsets_wrap_as_the_keys_do() {
+        // `t - 1` at i32::MIN wrapped to i32::MAX in release builds (and panicked in debug).
+        assert_eq!(cell_of(-3e9, 1.0), i32::MIN);
+        assert_eq!(cell_of(f64::NEG_INFINITY, 1.0), i32::MIN);
+        assert_eq!(cell_of(3e9, 1.0), i32::MAX);
+        assert_eq!(cell_of(-2.5, 1.0), -3);
+        // The cell after the last one is the first one modulo 2^21, as its packed key says.
+        let last = [i32::MAX, 0, i32::MIN];
+        assert_eq!(
+            pack(offset(last, [1, 0, -1])),
+            pack([i32::MIN, 0, i32::MAX])
+        );
+    }
 }

@@ -227,3 +227,50 @@ fn bad_input_is_refused_or_skipped() {
     map.nearest_k(&Point3::origin(), 3, -1.0, &mut out);
     assert!(out.is_empty());
 }
+
+/// Points beyond the cells `i32` can number are refused like non-finite ones; queries there read
+/// every point; cells 2^21 apart share a key (the first ring of a query near the origin reads
+/// the cells next to 2^31, which the full reading then read again: a far point came back twice);
+/// an infinite reach (its ring count overflowed and the search stopped after the first ring):
+/// the brute-force answer every time.
+#[test]
+fn extreme_coordinates_and_an_infinite_reach_equal_brute_force() {
+    let mut map = VoxelHashMap::new(1.0, 0.0).unwrap();
+    let mut kept = Vec::new();
+    for i in 0..40 {
+        let t = f64::from(i);
+        for (p, numbered) in [
+            (Point3::new(3.0 * t.sin(), 3.0 * t.cos(), 0.1 * t), true),
+            (Point3::new(-3e9 - 1e7 * t, 0.0, 0.0), false),
+            (Point3::new(3e9 + 1e7 * t, 5.0, 0.0), false),
+            // Near cell 2^31 - 1, whose key is that of cell -1.
+            (Point3::new(2_147_470_000.0 + 256.0 * t, 0.0, 0.0), true),
+            // Cells 2^21 apart: one key.
+            (Point3::new(2_097_152.0 + 0.3 * t, 0.5, 0.5), true),
+        ] {
+            assert_eq!(map.insert(0, &p), numbered, "{p}");
+            if numbered {
+                kept.push(p);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for q in [
+        Point3::origin(),
+        Point3::new(0.3, 0.5, 0.5),
+        Point3::new(-3.2e9, 0.0, 0.0),
+        Point3::new(3.1e9, 5.0, 0.0),
+        Point3::new(2_147_480_000.0, 0.0, 0.0),
+    ] {
+        for (k, r) in [
+            (1, f64::INFINITY),
+            (5, f64::INFINITY),
+            (200, f64::INFINITY),
+            (3, 10.0),
+        ] {
+            map.nearest_k(&q, k, r, &mut out);
+            let got: Vec<f32> = out.iter().map(|(d2, _)| *d2 as f32).collect();
+            assert_eq!(got, brute(&kept, &q, k, r), "q {q} k {k} r {r}");
+        }
+    }
+}

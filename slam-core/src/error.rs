@@ -196,6 +196,14 @@ pub enum Degeneracy {
         /// The axis (0 = x, 1 = y, 2 = z).
         axis: usize,
     },
+    /// The target's points span fewer than two dimensions: all at one place (`dimensions` 0)
+    /// or on one line (1). No pose is determined (a line leaves the rotation about it free), and
+    /// nearest-neighbour searches over thousands of equidistant points would take seconds.
+    #[error("the target's points span {dimensions} dimension(s): coincident or collinear")]
+    DegenerateTarget {
+        /// Directions with a spread: 0 or 1.
+        dimensions: usize,
+    },
 }
 
 /// Errors of [`fit_rigid_transform`](crate::geometry::fit_rigid_transform) and
@@ -319,6 +327,16 @@ pub enum GraphValue {
         /// Id of the node it ends at.
         to: u64,
     },
+    /// The squared error `e^T Omega e` of an edge at the current poses: every number is finite
+    /// but the product overflows (a measurement or pose of 1e200 m), or a solver diverged there.
+    EdgeError {
+        /// Index of the edge.
+        edge: usize,
+        /// Id of the node it starts at.
+        from: u64,
+        /// Id of the node it ends at.
+        to: u64,
+    },
 }
 
 impl std::fmt::Display for GraphValue {
@@ -327,6 +345,9 @@ impl std::fmt::Display for GraphValue {
             Self::NodePose { id } => write!(f, "pose of node {id}"),
             Self::Measurement { edge, from, to } => {
                 write!(f, "measurement of edge {edge} ({from} to {to})")
+            }
+            Self::EdgeError { edge, from, to } => {
+                write!(f, "squared error of edge {edge} ({from} to {to})")
             }
         }
     }
@@ -412,4 +433,18 @@ pub enum CloudError {
         /// The size given.
         size: f32,
     },
+}
+
+/// A setting of a [`GraphSlamConfig`](crate::GraphSlamConfig) is out of its range (a zero sigma
+/// would give an infinite information matrix, and every edge weighed by it would be refused).
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[error("{setting} = {value}: must be {expected}")]
+pub struct InvalidSlamConfig {
+    /// The setting, as `GraphSlamConfig::field` (`...::translation_sigma` for a field of an
+    /// [`EdgeInformation`](crate::EdgeInformation)).
+    pub setting: &'static str,
+    /// The value given (counts converted).
+    pub value: f64,
+    /// The valid range, in words.
+    pub expected: &'static str,
 }

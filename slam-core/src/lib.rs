@@ -46,7 +46,7 @@ mod voxel;
 pub use cloud::{Aabb, PointCloud};
 pub use error::{
     CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
-    OptimizeError, PlanError, RegistrationError, RigidFitError,
+    InvalidSlamConfig, OptimizeError, PlanError, RegistrationError, RigidFitError,
 };
 pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};

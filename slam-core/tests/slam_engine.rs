@@ -320,13 +320,14 @@ fn loop_closure_removes_odometry_drift() {
         },
         ..GraphSlamConfig::default()
     };
-    let mut slam = GraphSlam::new(
+    let mut slam = GraphSlam::try_new(
         config,
         BruteIcp { max_distance: 0.5 },
         BruteIcp { max_distance: 1.0 },
         BruteIcp { max_distance: 0.5 },
         DenseGaussNewton,
-    );
+    )
+    .unwrap();
     let body_t_lidar = Pose3::identity();
     let mut keyframes = 0;
     for (k, (gt, od)) in truth.iter().zip(&odom).enumerate() {
@@ -539,20 +540,22 @@ fn local_map_slid_in_place_equals_rebuilt() {
         loop_search_radius: 1e-6,
         ..GraphSlamConfig::default()
     };
-    let mut rebuilt = GraphSlam::new(
+    let mut rebuilt = GraphSlam::try_new(
         config.clone(),
         BruteIcp { max_distance: 0.5 },
         BruteIcp { max_distance: 1.0 },
         BruteIcp { max_distance: 0.5 },
         DenseGaussNewton,
-    );
-    let mut in_place = GraphSlam::new(
+    )
+    .unwrap();
+    let mut in_place = GraphSlam::try_new(
         config,
         InPlaceIcp(BruteIcp { max_distance: 0.5 }),
         BruteIcp { max_distance: 1.0 },
         InPlaceIcp(BruteIcp { max_distance: 0.5 }),
         DenseGaussNewton,
-    );
+    )
+    .unwrap();
     // The first third of the loop, odometry 3 % long.
     let n = truth.len() / 3;
     let mut odom = truth[0];
@@ -577,4 +580,203 @@ fn local_map_slid_in_place_equals_rebuilt() {
     assert!(in_place.keyframe_count() > 12, "the window slid");
     assert_eq!(rebuilt.report().odometry_fallbacks, 0);
     assert_eq!(rebuilt.scan_trajectory(), in_place.scan_trajectory());
+}
+
+/// The engine with the test backends.
+fn brute_engine(
+    config: GraphSlamConfig,
+) -> Result<GraphSlam<BruteIcp, BruteIcp, DenseGaussNewton>, slam_core::InvalidSlamConfig> {
+    GraphSlam::try_new(
+        config,
+        BruteIcp { max_distance: 0.5 },
+        BruteIcp { max_distance: 1.0 },
+        BruteIcp { max_distance: 0.5 },
+        DenseGaussNewton,
+    )
+}
+
+/// Settings for runs without loop closure (the test ICP on the hall).
+fn no_loop_config() -> GraphSlamConfig {
+    GraphSlamConfig {
+        keyframe_distance: 0.45,
+        local_map_keyframes: 10,
+        min_scan_points: 50,
+        loop_search_radius: 1e-6,
+        ..GraphSlamConfig::default()
+    }
+}
+
+/// The first half of the loop with exact odometry except for a `jump` (metres along x, in the
+/// odometry frame) from scan `at` on, through `config`: the end error of the scan trajectory
+/// against the truth and the report.
+fn lap_with_odometry_jump(
+    config: GraphSlamConfig,
+    jump: f64,
+    at: usize,
+) -> (f64, slam_core::SlamReport) {
+    let world = hall();
+    let truth = loop_poses();
+    let n = truth.len() / 2;
+    let mut slam = brute_engine(config).unwrap();
+    for (k, gt) in truth.iter().take(n).enumerate() {
+        let odom = if k >= at {
+            Pose3::translation(jump, 0.0, 0.0) * gt
+        } else {
+            *gt
+        };
+        let cloud = scan(&world, gt);
+        slam.process(&ScanInput {
+            stamp: k as f64 * 0.2,
+            odom_t_body: odom,
+            body_t_lidar: Pose3::identity(),
+            cloud: &cloud,
+        });
+    }
+    let end = slam.current_lidar_pose().unwrap();
+    let err = (end.translation.vector - truth[n - 1].translation.vector).norm();
+    (err, slam.report().clone())
+}
+
+#[test]
+fn an_odometry_jump_is_detected_and_not_trusted() {
+    let config = no_loop_config();
+    // Ground truth is the oracle: a 10 m jump of the odometry frame at scan 40 (the odometry
+    // alone ends 10 m off; trusted, the keyframe after the jump landed there too).
+    let (err, report) = lap_with_odometry_jump(config.clone(), 10.0, 40);
+    assert_eq!(report.odometry_faults, 1, "{report:?}");
+    // Without the jump nothing is flagged; the end error is the crude test ICP's own.
+    let (clean, clean_report) = lap_with_odometry_jump(config, 0.0, 40);
+    eprintln!("end error {err} m with the jump, {clean} m without");
+    assert_eq!(clean_report.odometry_faults, 0, "{clean_report:?}");
+    assert!(clean < 0.3, "end error {clean} m");
+    assert!(
+        err < clean + 0.05,
+        "end error {err} m with the jump detected, {clean} m without"
+    );
+}
+
+#[test]
+fn bad_settings_are_refused_by_name() {
+    let build = |config: GraphSlamConfig| brute_engine(config).err().map(|e| (e.setting, e.value));
+    assert_eq!(build(GraphSlamConfig::default()), None);
+    let zero_sigma = GraphSlamConfig {
+        loop_information: EdgeInformation::Fixed {
+            translation_sigma: 0.0,
+            rotation_sigma: 0.01,
+        },
+        ..GraphSlamConfig::default()
+    };
+    assert_eq!(
+        build(zero_sigma),
+        Some(("GraphSlamConfig::loop_information::translation_sigma", 0.0))
+    );
+    let tiny_sigma = GraphSlamConfig {
+        odometry_information: EdgeInformation::Fixed {
+            translation_sigma: 0.01,
+            rotation_sigma: 1e-200,
+        },
+        ..GraphSlamConfig::default()
+    };
+    assert_eq!(
+        build(tiny_sigma),
+        Some((
+            "GraphSlamConfig::odometry_information::rotation_sigma",
+            1e-200
+        ))
+    );
+    let cases: [(GraphSlamConfig, &str); 6] = [
+        (
+            GraphSlamConfig {
+                keyframe_distance: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::keyframe_distance",
+        ),
+        (
+            GraphSlamConfig {
+                local_map_keyframes: 0,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::local_map_keyframes",
+        ),
+        (
+            GraphSlamConfig {
+                odometry_fault_distance: 0.0,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::odometry_fault_distance",
+        ),
+        (
+            GraphSlamConfig {
+                loop_kernel: Some(slam_core::RobustKernel::Cauchy { c: -1.0 }),
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_kernel",
+        ),
+        (
+            GraphSlamConfig {
+                loop_information: EdgeInformation::FromRegistration { scale: 0.0 },
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_information::scale",
+        ),
+        (
+            GraphSlamConfig {
+                map_voxel_size: -0.05,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::map_voxel_size",
+        ),
+    ];
+    for (config, setting) in cases {
+        assert_eq!(build(config).map(|(s, _)| s), Some(setting));
+    }
+}
+
+#[test]
+fn an_overflowing_keyframe_pose_is_reported_as_such() {
+    let world = hall();
+    let truth = loop_poses();
+    let config = no_loop_config();
+    let mut slam = brute_engine(config).unwrap();
+    for (k, gt) in truth.iter().take(6).enumerate() {
+        let cloud = scan(&world, gt);
+        slam.process(&ScanInput {
+            stamp: k as f64 * 0.2,
+            odom_t_body: *gt,
+            body_t_lidar: Pose3::identity(),
+            cloud: &cloud,
+        });
+    }
+    // Points 500 m away match nothing, so no registration can stand in for the odometry.
+    let far: PointCloud = PointCloud::from_points(
+        (0..100)
+            .map(|i| Point3::new(500.0 + 0.1 * i as f32, 0.0, 0.0))
+            .collect(),
+    );
+    let input = |k: usize, odom: Pose3| ScanInput {
+        stamp: k as f64 * 0.2,
+        odom_t_body: odom,
+        body_t_lidar: Pose3::identity(),
+        cloud: &far,
+    };
+    // Finite odometry: a keyframe at about 1.8e308 m (kept, unregistered)...
+    assert!(matches!(
+        slam.process(&input(6, Pose3::translation(f64::MAX, 0.0, 0.0))),
+        ScanOutcome::Keyframe {
+            registered: false,
+            ..
+        }
+    ));
+    // ... then a step from it that overflows to infinity.
+    assert_eq!(
+        slam.process(&input(7, Pose3::translation(-f64::MAX, 0.0, 0.0))),
+        ScanOutcome::Skipped(slam_core::SkipReason::NonFinitePose)
+    );
+    let report = slam.report();
+    assert_eq!(report.skipped_non_finite_pose, 1, "{report:?}");
+    assert_eq!(report.skipped_non_finite_odometry, 0, "{report:?}");
+    // The graph is untouched by the refusal: one node per keyframe, a chain of edges.
+    assert_eq!(slam.graph().node_count(), slam.keyframe_count());
+    assert_eq!(slam.graph().edge_count(), slam.keyframe_count() - 1);
 }

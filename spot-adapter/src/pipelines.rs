@@ -7,7 +7,7 @@ use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
     ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
 };
-use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator, PlaceRecognizer};
+use slam_core::{GraphSlam, GraphSlamConfig, InvalidSlamConfig, MapRegistrator, PlaceRecognizer};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
 pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, LevenbergMarquardt>;
@@ -32,7 +32,7 @@ fn assemble<R: MapRegistrator>(
     config: GraphSlamConfig,
     odometry: R,
     refine: R,
-) -> GraphSlam<R, PointToPointIcp, LevenbergMarquardt> {
+) -> Result<GraphSlam<R, PointToPointIcp, LevenbergMarquardt>, InvalidSlamConfig> {
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
@@ -42,7 +42,7 @@ fn assemble<R: MapRegistrator>(
             ..IcpConfig::default()
         },
     };
-    GraphSlam::new(
+    GraphSlam::try_new(
         config,
         odometry,
         loop_check,
@@ -69,8 +69,10 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
 /// Point-to-plane odometry ([`point_to_plane_tracker`]) against the local map, and
 /// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m), with `config` (usually
 /// [`slam_config`]).
-#[must_use]
-pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
+///
+/// # Errors
+/// [`InvalidSlamConfig`] naming the first bad setting of `config`.
+pub fn point_to_plane_slam(config: GraphSlamConfig) -> Result<PointToPlaneSlam, InvalidSlamConfig> {
     let odometry = point_to_plane_tracker();
     let refine = PointToPlaneIcp {
         config: IcpConfig {
@@ -85,8 +87,10 @@ pub fn point_to_plane_slam(config: GraphSlamConfig) -> PointToPlaneSlam {
 /// LOAM odometry against a local map of edge and planar features (5 cm and 10 cm voxels,
 /// Tukey 5 cm, as the thesis), and LOAM loop refinement with Tukey 10 cm, with `config` (usually
 /// [`slam_config`]).
-#[must_use]
-pub fn loam_slam(config: GraphSlamConfig) -> LoamSlam {
+///
+/// # Errors
+/// [`InvalidSlamConfig`] naming the first bad setting of `config`.
+pub fn loam_slam(config: GraphSlamConfig) -> Result<LoamSlam, InvalidSlamConfig> {
     let odometry = LoamRegistrator {
         config: LoamConfig::local_map_odometry(),
     };

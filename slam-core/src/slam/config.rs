@@ -1,5 +1,6 @@
 //! Settings of the Graph-SLAM engine, with the thesis' values as defaults.
 
+use crate::error::InvalidSlamConfig;
 use crate::robust_kernel::RobustKernel;
 
 /// How an edge's information matrix is chosen.
@@ -34,6 +35,13 @@ pub struct GraphSlamConfig {
     /// A registration result that moves the predicted pose by more than this (metres) is
     /// rejected and the odometry prediction kept instead (a diverged alignment).
     pub max_odometry_correction: f64,
+    /// An odometry step that ends further than this (metres) from the constant-velocity
+    /// extrapolation of the last two scans is suspect (a jump, a reset): the keyframe is then
+    /// registered from both guesses and the better fit kept; when the extrapolation's wins the
+    /// odometry step is counted as a fault ([`SlamReport::odometry_faults`](super::SlamReport)).
+    /// Default 0.5 m: a walking robot's step between scans differs from the last one by
+    /// centimetres.
+    pub odometry_fault_distance: f64,
     /// Loop candidates lie within this distance of the new keyframe (thesis: 0.5 m).
     pub loop_search_radius: f64,
     /// The loop target is made of the candidate and this many keyframes on each side (thesis: 20).
@@ -75,6 +83,7 @@ impl Default for GraphSlamConfig {
             keyframe_rotation: 10f64.to_radians(),
             local_map_keyframes: 40,
             max_odometry_correction: 0.5,
+            odometry_fault_distance: 0.5,
             loop_search_radius: 0.5,
             loop_neighbours: 20,
             loop_max_mean_squared_error: 0.01,
@@ -91,5 +100,143 @@ impl Default for GraphSlamConfig {
             deskew: true,
             inline_loop_closure: true,
         }
+    }
+}
+
+/// [`InvalidSlamConfig`] for `setting` unless `ok`.
+fn check(
+    ok: bool,
+    setting: &'static str,
+    value: f64,
+    expected: &'static str,
+) -> Result<(), InvalidSlamConfig> {
+    if ok {
+        Ok(())
+    } else {
+        Err(InvalidSlamConfig {
+            setting,
+            value,
+            expected,
+        })
+    }
+}
+
+impl EdgeInformation {
+    /// Checks the sigmas (finite, positive, and with a finite `1 / sigma^2`) or the scale
+    /// (finite and positive); `field` names the configuration field it sits in.
+    fn validate(&self, field: Fields) -> Result<(), InvalidSlamConfig> {
+        match *self {
+            Self::Fixed {
+                translation_sigma,
+                rotation_sigma,
+            } => {
+                for (setting, sigma) in [
+                    (field.translation_sigma, translation_sigma),
+                    (field.rotation_sigma, rotation_sigma),
+                ] {
+                    check(
+                        sigma.is_finite() && sigma > 0.0 && (1.0 / (sigma * sigma)).is_finite(),
+                        setting,
+                        sigma,
+                        "finite and positive (with a finite 1 / sigma^2)",
+                    )?;
+                }
+                Ok(())
+            }
+            Self::FromRegistration { scale } => check(
+                scale.is_finite() && scale > 0.0,
+                field.scale,
+                scale,
+                "finite and positive",
+            ),
+        }
+    }
+}
+
+/// The setting names of one [`EdgeInformation`] field.
+#[derive(Clone, Copy)]
+struct Fields {
+    translation_sigma: &'static str,
+    rotation_sigma: &'static str,
+    scale: &'static str,
+}
+
+impl GraphSlamConfig {
+    /// Checks every setting: distances, angles and thresholds finite and not negative (those
+    /// that divide or bound a search positive), at least one local-map keyframe, a valid loop
+    /// kernel, positive sigmas and scales, a positive map voxel.
+    /// [`GraphSlam::try_new`](super::GraphSlam::try_new) calls it.
+    ///
+    /// # Errors
+    /// [`InvalidSlamConfig`] naming the first bad setting.
+    #[allow(clippy::cast_precision_loss)]
+    pub fn validate(&self) -> Result<(), InvalidSlamConfig> {
+        for (setting, v) in [
+            ("GraphSlamConfig::keyframe_distance", self.keyframe_distance),
+            ("GraphSlamConfig::keyframe_rotation", self.keyframe_rotation),
+            (
+                "GraphSlamConfig::loop_search_radius",
+                self.loop_search_radius,
+            ),
+            (
+                "GraphSlamConfig::loop_max_mean_squared_error",
+                self.loop_max_mean_squared_error,
+            ),
+            (
+                "GraphSlamConfig::loop_max_refine_shift",
+                self.loop_max_refine_shift,
+            ),
+        ] {
+            check(
+                v.is_finite() && v >= 0.0,
+                setting,
+                v,
+                "finite and not negative",
+            )?;
+        }
+        for (setting, v) in [
+            (
+                "GraphSlamConfig::max_odometry_correction",
+                self.max_odometry_correction,
+            ),
+            (
+                "GraphSlamConfig::odometry_fault_distance",
+                self.odometry_fault_distance,
+            ),
+            (
+                "GraphSlamConfig::map_voxel_size",
+                f64::from(self.map_voxel_size),
+            ),
+        ] {
+            check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
+        }
+        check(
+            self.local_map_keyframes >= 1,
+            "GraphSlamConfig::local_map_keyframes",
+            self.local_map_keyframes as f64,
+            "at least 1",
+        )?;
+        if let Some(kernel) = self.loop_kernel {
+            let parameter = match kernel {
+                RobustKernel::Huber { delta } => delta,
+                RobustKernel::Cauchy { c } | RobustKernel::GemanMcClure { c } => c,
+            };
+            check(
+                kernel.is_valid(),
+                "GraphSlamConfig::loop_kernel",
+                parameter,
+                "a kernel parameter finite and positive",
+            )?;
+        }
+        self.odometry_information.validate(Fields {
+            translation_sigma: "GraphSlamConfig::odometry_information::translation_sigma",
+            rotation_sigma: "GraphSlamConfig::odometry_information::rotation_sigma",
+            scale: "GraphSlamConfig::odometry_information::scale",
+        })?;
+        self.loop_information.validate(Fields {
+            translation_sigma: "GraphSlamConfig::loop_information::translation_sigma",
+            rotation_sigma: "GraphSlamConfig::loop_information::rotation_sigma",
+            scale: "GraphSlamConfig::loop_information::scale",
+        })
     }
 }

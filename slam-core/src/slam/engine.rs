@@ -9,13 +9,13 @@ use super::deskew::deskew;
 use super::node_index::NodeIndex;
 use super::report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
 use crate::cloud::PointCloud;
-use crate::error::CloudError;
-use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_log};
+use crate::error::{CloudError, InvalidSlamConfig, OptimizeError};
+use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_exp, se3_log};
 use crate::io::StampedPose;
-use crate::pose_graph::PoseGraph;
+use crate::pose_graph::{GraphPose, PoseGraph};
 use crate::traits::optimizer::Optimizer;
 use crate::traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
-use crate::traits::registrator::MapRegistrator;
+use crate::traits::registrator::{Alignment, MapRegistrator};
 
 /// One LiDAR scan with the robot's odometry at the same instant (the `spot-adapter` sample).
 #[derive(Clone, Copy, Debug)]
@@ -109,14 +109,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// An engine with its backends: `odometry` registers scans against the local map,
     /// `loop_coarse` checks loop candidates, `loop_refine` refines accepted loops (the same
     /// backend as odometry with a looser outlier threshold, thesis: 0.10 m).
-    pub fn new(
+    ///
+    /// # Errors
+    /// [`InvalidSlamConfig`] naming the first bad setting of `config`
+    /// ([`GraphSlamConfig::validate`]).
+    pub fn try_new(
         config: GraphSlamConfig,
         odometry: R,
         loop_coarse: C,
         loop_refine: R,
         optimizer: O,
-    ) -> Self {
-        Self {
+    ) -> Result<Self, InvalidSlamConfig> {
+        config.validate()?;
+        Ok(Self {
             config,
             odometry,
             loop_coarse,
@@ -133,7 +138,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             last_odometry: None,
             places: None,
             report: SlamReport::default(),
-        }
+        })
     }
 
     /// The engine seeking loops by appearance too: each keyframe's scan goes to `places`, and a
@@ -232,6 +237,13 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         all.voxel_downsample(voxel_size)
     }
 
+    fn record_scan_time(&mut self, started: Instant) {
+        SlamReport::record(
+            &mut self.report.scan_ms,
+            started.elapsed().as_secs_f64() * 1e3,
+        );
+    }
+
     fn skip(&mut self, reason: SkipReason, started: Instant) -> ScanOutcome {
         match reason {
             SkipReason::OutOfOrderStamp => self.report.skipped_out_of_order += 1,
@@ -239,10 +251,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             SkipReason::TooFewPoints => self.report.skipped_too_few_points += 1,
             SkipReason::PreparationFailed => self.report.skipped_preparation += 1,
             SkipReason::AwaitingVelocity => self.report.skipped_awaiting_velocity += 1,
+            SkipReason::NonFinitePose => self.report.skipped_non_finite_pose += 1,
         }
-        self.report
-            .scan_ms
-            .push(started.elapsed().as_secs_f64() * 1e3);
+        self.record_scan_time(started);
         ScanOutcome::Skipped(reason)
     }
 
@@ -296,9 +307,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 keyframe: last,
                 keyframe_t_lidar: delta,
             });
-            self.report
-                .scan_ms
-                .push(started.elapsed().as_secs_f64() * 1e3);
+            self.record_scan_time(started);
             return ScanOutcome::Tracked;
         }
         self.add_keyframe(scan, velocity, odom_t_lidar, predicted, started)
@@ -316,7 +325,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 let ad = se3_adjoint(pose);
                 let m = ad.transpose() * info * ad * scale;
                 let sym = (m + m.transpose()) * 0.5;
-                if sym.cholesky().is_some() {
+                if Pose3::information_is_valid(&sym) {
                     return sym;
                 }
                 fixed_information(0.05, 1f64.to_radians())
@@ -394,6 +403,111 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
     }
 
+    /// Add node `id` at `pose` with its odometry edge `(step, information)` from the previous
+    /// node, or fixed as the gauge without one. Checked first with the graph's own predicates,
+    /// so that a refusal leaves the graph unchanged.
+    fn insert_node(
+        &mut self,
+        id: u64,
+        pose: Pose3,
+        edge: Option<&(Pose3, Matrix6<f64>)>,
+    ) -> Result<(), OptimizeError> {
+        if !pose3_is_finite(&pose)
+            || edge.is_some_and(|(step, info)| {
+                !pose3_is_finite(step) || !Pose3::information_is_valid(info)
+            })
+        {
+            return Err(OptimizeError::NonFinite {
+                what: crate::error::GraphValue::NodePose { id },
+            });
+        }
+        self.graph.add_node(id, pose)?;
+        match (edge, id.checked_sub(1)) {
+            (Some(&(step, info)), Some(prev)) => {
+                self.graph.add_edge(prev, id, step, info, None)?;
+            }
+            _ => self.graph.fix(id)?,
+        }
+        Ok(())
+    }
+
+    /// `source` aligned to the local map from `guess`: the result if it converged to a finite
+    /// pose within [`GraphSlamConfig::max_odometry_correction`] of the guess.
+    fn register(&self, source: &R::Source, guess: &Pose3) -> Option<Alignment> {
+        let map = self.local_map.as_ref()?;
+        let a = self.odometry.align(source, &map.target, guess).ok()?;
+        let shift = (a.pose.translation.vector - guess.translation.vector).norm();
+        (a.converged && pose3_is_finite(&a.pose) && shift <= self.config.max_odometry_correction)
+            .then_some(a)
+    }
+
+    /// Whether the registration from the motion prior (`prior`) contradicts the one from the
+    /// odometry's guess (`odometry`) and fits better: they ended further apart than
+    /// [`GraphSlamConfig::odometry_fault_distance`] and `prior` has the larger inlier ratio (the
+    /// lower RMS error on a tie). Two registrations that end together do not contradict the
+    /// odometry, whichever scored higher.
+    fn contradicts(&self, prior: &Alignment, odometry: &Alignment) -> bool {
+        let apart = (prior.pose.translation.vector - odometry.pose.translation.vector).norm();
+        let better = match prior.inlier_ratio.total_cmp(&odometry.inlier_ratio) {
+            std::cmp::Ordering::Greater => true,
+            std::cmp::Ordering::Equal => prior.rmse < odometry.rmse,
+            std::cmp::Ordering::Less => false,
+        };
+        apart > self.config.odometry_fault_distance && better
+    }
+
+    /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted
+    /// scans, with that velocity (LiDAR-frame twist per second); the last scan's pose held, and
+    /// no velocity, when there is only one or the scans are more than a second apart. `None`
+    /// before the first scan.
+    fn motion_prior(&self, stamp: f64) -> Option<(Pose3, Option<Vector6<f64>>)> {
+        let at = |s: &ScanPose| self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar;
+        let (last, earlier) = self.scan_poses.split_last()?;
+        let x1 = at(last);
+        let dt = stamp - last.stamp;
+        let velocity = earlier.last().and_then(|prev| {
+            let dt0 = last.stamp - prev.stamp;
+            (dt0 > 0.0 && dt0 <= 1.0 && dt > 0.0 && dt <= 1.0)
+                .then(|| se3_log(&(at(prev).inverse() * x1)) / dt0)
+        });
+        let pose = velocity.map_or(x1, |v| x1 * se3_exp(&(v * dt)));
+        Some((pose, velocity))
+    }
+
+    /// The pose of a new keyframe (`source`) and its registration's information: registered
+    /// from the odometry's `predicted` pose, and from `prior` too when given (a suspect odometry
+    /// step), the better fit kept when they disagree; `predicted` when neither registers.
+    /// Counts fallbacks and odometry faults.
+    fn register_keyframe(
+        &mut self,
+        source: &R::Source,
+        predicted: Pose3,
+        prior: Option<Pose3>,
+    ) -> (Pose3, Option<Matrix6<f64>>) {
+        let from_odometry = self.register(source, &predicted);
+        let from_prior = prior.and_then(|guess| self.register(source, &guess));
+        let (chosen, fault) = match (from_odometry, from_prior) {
+            (Some(o), Some(p)) => {
+                if self.contradicts(&p, &o) {
+                    (Some(p), true)
+                } else {
+                    (Some(o), false)
+                }
+            }
+            (None, Some(p)) => (Some(p), true),
+            (o, None) => (o, false),
+        };
+        if fault {
+            self.report.odometry_faults += 1;
+        }
+        if let Some(a) = chosen {
+            (a.pose, Some(a.information))
+        } else {
+            self.report.odometry_fallbacks += 1;
+            (predicted, None)
+        }
+    }
+
     fn add_keyframe(
         &mut self,
         scan: &ScanInput<'_>,
@@ -402,6 +516,18 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         predicted: Pose3,
         started: Instant,
     ) -> ScanOutcome {
+        let prior = self.motion_prior(scan.stamp);
+        let suspect = prior.is_some_and(|(p, _)| {
+            (p.inverse() * predicted).translation.vector.norm()
+                > self.config.odometry_fault_distance
+        });
+        // A suspect odometry step would deskew with its jump as the velocity: take the
+        // extrapolation's instead.
+        let velocity = if suspect {
+            velocity.and(prior.and_then(|(_, v)| v))
+        } else {
+            velocity
+        };
         let mut cloud = velocity
             .and_then(|v| deskew(scan.cloud, &v))
             .unwrap_or_else(|| scan.cloud.clone());
@@ -435,43 +561,26 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .voxel_downsample(self.config.map_voxel_size)
             .unwrap_or(cloud);
 
-        let mut pose = predicted;
-        let mut registered = false;
-        let mut reg_info = None;
-        if index > 0 && self.ensure_local_map() {
-            if let Some(map) = &self.local_map
-                && let Ok(a) = self.odometry.align(&source, &map.target, &predicted)
-            {
-                let shift = (a.pose.translation.vector - predicted.translation.vector).norm();
-                if a.converged
-                    && pose3_is_finite(&a.pose)
-                    && shift <= self.config.max_odometry_correction
-                {
-                    pose = a.pose;
-                    registered = true;
-                    reg_info = Some(a.information);
-                }
-            }
-            if !registered {
-                self.report.odometry_fallbacks += 1;
-            }
-        }
+        // The extrapolation arbitrates only a suspect odometry step, so that clean input runs
+        // exactly as without the check.
+        let (pose, reg_info) = if index > 0 && self.ensure_local_map() {
+            let arbiter = prior.filter(|_| suspect).map(|(guess, _)| guess);
+            self.register_keyframe(&source, predicted, arbiter)
+        } else {
+            (predicted, None)
+        };
 
         let id = index as u64;
-        if self.graph.add_node(id, pose).is_err() {
-            return self.skip(SkipReason::NonFiniteOdometry, started);
-        }
-        if index == 0 {
-            // The first node is the gauge.
-            let _ = self.graph.fix(id);
+        let edge = if index == 0 {
+            None
         } else {
-            let prev = self.keyframe_pose(index - 1);
+            let step = self.keyframe_pose(index - 1).inverse() * pose;
             let info =
                 Self::information(self.config.odometry_information, reg_info.as_ref(), &pose);
-            // Both nodes exist and the information is positive definite, so this cannot fail.
-            let _ = self
-                .graph
-                .add_edge(id - 1, id, prev.inverse() * pose, info, None);
+            Some((step, info))
+        };
+        if self.insert_node(id, pose, edge.as_ref()).is_err() {
+            return self.skip(SkipReason::NonFinitePose, started);
         }
         self.keyframes.push(Keyframe {
             stamp: scan.stamp,
@@ -491,13 +600,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
 
         self.queue_loop_candidate(index, &pose, look_alike);
         self.node_index.insert(index, &pose);
-        self.report
-            .scan_ms
-            .push(started.elapsed().as_secs_f64() * 1e3);
+        self.record_scan_time(started);
         if self.config.inline_loop_closure {
             self.loop_closure_step();
         }
-        ScanOutcome::Keyframe { id, registered }
+        ScanOutcome::Keyframe {
+            id,
+            registered: reg_info.is_some(),
+        }
     }
 
     /// Queue a loop candidate for keyframe `index` at `pose`: the oldest keyframe near it outside
@@ -544,9 +654,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let candidate = self.pending_loops.remove(0);
         self.report.loops_attempted += 1;
         let outcome = self.try_loop(&candidate);
-        self.report
-            .loop_ms
-            .push(started.elapsed().as_secs_f64() * 1e3);
+        SlamReport::record(
+            &mut self.report.loop_ms,
+            started.elapsed().as_secs_f64() * 1e3,
+        );
         outcome
     }
 

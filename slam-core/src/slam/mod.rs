@@ -4,7 +4,9 @@
 //! (`X_t = X_k * (odom_T_lidar_k^-1 * odom_T_lidar_t)`, thesis eq. 4.1-4.2), and once the LiDAR
 //! has moved [`GraphSlamConfig::keyframe_distance`] from the last keyframe, register the scan
 //! against a local map of the last [`GraphSlamConfig::local_map_keyframes`] keyframes and add a
-//! node. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
+//! node. An odometry step far from the constant-velocity extrapolation of the last two scans
+//! ([`GraphSlamConfig::odometry_fault_distance`]) is registered from both guesses and the better
+//! fit kept; [`SlamReport::odometry_faults`] counts the steps it overruled. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
 //! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
 //! optimises the graph. Keyframe scans with a per-point `time` channel are deskewed first, with
 //! the velocity the odometry showed since the previous scan.

@@ -17,6 +17,9 @@ pub enum SkipReason {
     /// velocity, and an unskewed first keyframe would anchor the map (and every loop closure
     /// back to it) on a distorted scan.
     AwaitingVelocity,
+    /// The keyframe's pose, or its step from the previous keyframe, is not finite although
+    /// every input number is (odometry so large that composing it overflows).
+    NonFinitePose,
 }
 
 /// What happened to one scan.
@@ -80,6 +83,13 @@ pub struct SlamReport {
     pub dropped_points: usize,
     /// Keyframes where the registration was rejected and odometry kept.
     pub odometry_fallbacks: usize,
+    /// Keyframes whose odometry step the registration contradicted: the step ended more than
+    /// [`GraphSlamConfig::odometry_fault_distance`](super::GraphSlamConfig) from the
+    /// constant-velocity extrapolation, and the scan registered from the extrapolation fitted
+    /// better than from the odometry's guess (or only it registered), so that pose was kept.
+    pub odometry_faults: usize,
+    /// Skipped scans: a non-finite keyframe pose ([`SkipReason::NonFinitePose`]).
+    pub skipped_non_finite_pose: usize,
     /// Loop candidates tried.
     pub loops_attempted: usize,
     /// Loops accepted.
@@ -92,13 +102,28 @@ pub struct SlamReport {
     pub place_refusals: usize,
     /// Optimiser runs that returned an error (the graph was kept as it was).
     pub optimizer_failures: usize,
-    /// Milliseconds of each `process` call (odometry path), in order.
+    /// Milliseconds of each `process` call (odometry path), in order: the most recent ones, at
+    /// most [`SlamReport::TIMES_KEPT`] (the oldest half is dropped when full, so a long run's
+    /// memory stays bounded).
     pub scan_ms: Vec<f64>,
-    /// Milliseconds of each loop-closure step that had a candidate.
+    /// Milliseconds of each loop-closure step that had a candidate (bounded as `scan_ms`).
     pub loop_ms: Vec<f64>,
 }
 
 impl SlamReport {
+    /// Most timings kept in [`SlamReport::scan_ms`] and [`SlamReport::loop_ms`]: 65,536 (3.6 h of
+    /// scans at 5 Hz). The statistics below are over the kept ones.
+    pub const TIMES_KEPT: usize = 1 << 16;
+
+    /// Append `ms` to `times`, first dropping the oldest half when [`SlamReport::TIMES_KEPT`]
+    /// are kept (amortised O(1)).
+    pub(crate) fn record(times: &mut Vec<f64>, ms: f64) {
+        if times.len() >= Self::TIMES_KEPT {
+            times.drain(..Self::TIMES_KEPT / 2);
+        }
+        times.push(ms);
+    }
+
     /// Mean of [`SlamReport::scan_ms`].
     #[must_use]
     pub fn mean_scan_ms(&self) -> f64 {
@@ -130,5 +155,26 @@ impl SlamReport {
             .get(rank.min(sorted.len().saturating_sub(1)))
             .copied()
             .unwrap_or(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SlamReport;
+
+    #[test]
+    fn timings_stay_bounded_and_keep_the_latest() {
+        let mut times = Vec::new();
+        let n = 3 * SlamReport::TIMES_KEPT + 17;
+        for i in 0..n {
+            #[allow(clippy::cast_precision_loss)]
+            SlamReport::record(&mut times, i as f64);
+            assert!(times.len() <= SlamReport::TIMES_KEPT);
+        }
+        // The kept ones are the latest, in order.
+        #[allow(clippy::cast_precision_loss)]
+        let expected: Vec<f64> = (n - times.len()..n).map(|i| i as f64).collect();
+        assert_eq!(times, expected);
+        assert!(times.len() >= SlamReport::TIMES_KEPT / 2);
     }
 }
