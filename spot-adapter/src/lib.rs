@@ -55,4 +55,4 @@ pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 
-pub use error::{AdapterError, DriveError};
+pub use error::{AdapterError, DriveError, MessageError};
