@@ -76,7 +76,12 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
     (
         "slam",
         &[
-            "RECORDING_DIR",
+            "PATH",
+            "--cloud-topic",
+            "--odom-topic",
+            "--odom-frame",
+            "--base-frame",
+            "--lidar-frame",
             "--seed",
             "--registration",
             "--skewed",
