@@ -6,7 +6,8 @@
 //! ODOMETRY.tum                   optional (given by argument): odom_T_body, TUM format
 //! ```
 //!
-//! Stamps come from the file names when every name is a number, else from the odometry file
+//! Stamps come from the file names when every name is a number (and the scans are then taken
+//! in stamp order), else from the odometry file
 //! (one line per scan), else 10 Hz from 0. With the names as stamps, the odometry is
 //! interpolated at each scan's stamp; otherwise its lines are taken in order. The LiDAR mounting
 //! is given by argument (identity by default). Without odometry every `odom_T_body` is the
@@ -90,17 +91,24 @@ impl CloudFolder {
         if scans.is_empty() {
             return Err(bad(&dir, "no .pcd or .ply file".into()));
         }
-        let named: Option<Vec<f64>> = scans
-            .iter()
-            .map(|p| {
-                p.file_stem()?
-                    .to_str()?
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|t| t.is_finite())
-            })
-            .collect();
-        let named = named.filter(|t| t.windows(2).all(|w| w[1] > w[0]));
+        let stamp_of = |p: &PathBuf| {
+            p.file_stem()?
+                .to_str()?
+                .parse::<f64>()
+                .ok()
+                .filter(|t| t.is_finite())
+        };
+        // Names that are stamps sort by their value ("100.pcd" before "100.1.pcd").
+        let named: Option<Vec<f64>> = scans.iter().map(stamp_of).collect();
+        let named = named.and_then(|_| {
+            scans.sort_by(|a, b| {
+                stamp_of(a)
+                    .partial_cmp(&stamp_of(b))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
+            let t: Vec<f64> = scans.iter().filter_map(stamp_of).collect();
+            t.windows(2).all(|w| w[1] > w[0]).then_some(t)
+        });
         let tum = match &config.odometry {
             Some(path) => Some((path, read_tum(path)?)),
             None => None,

@@ -541,3 +541,140 @@ impl PointCloud2Decoder {
         Ok(best)
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)]
+mod tests {
+    use super::*;
+    use crate::record::ros_messages::Header;
+
+    fn field(name: &str, offset: u32, datatype: u8) -> PointField {
+        PointField {
+            name: name.into(),
+            offset,
+            datatype,
+            count: 1,
+        }
+    }
+
+    /// `n` points of x y z f32 and a time (f32 seconds) at offset 12, 16 bytes each.
+    fn cloud(data: &[u8], stamp: f64) -> PointCloud2<'_> {
+        PointCloud2 {
+            header: Header {
+                stamp,
+                frame_id: "lidar".into(),
+            },
+            height: 1,
+            width: (data.len() / 16) as u32,
+            fields: vec![
+                field("x", 0, 7),
+                field("y", 4, 7),
+                field("z", 8, 7),
+                field("time", 12, 7),
+            ],
+            is_bigendian: false,
+            point_step: 16,
+            row_step: data.len() as u32,
+            data,
+        }
+    }
+
+    fn points(times: &[f32]) -> Vec<u8> {
+        let mut data = Vec::new();
+        for (i, t) in times.iter().enumerate() {
+            for v in [1.0 + i as f32, 2.0, 3.0, *t] {
+                data.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        data
+    }
+
+    #[test]
+    fn shapes_that_disagree_are_errors() {
+        let data = points(&[0.0, 0.05]);
+        let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+        let mut c = cloud(&data, 100.0);
+        c.row_step = 16;
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::CloudShape { .. })
+        ));
+        let mut c = cloud(&data[..24], 100.0);
+        c.width = 2;
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::CloudShape { .. })
+        ));
+        let mut c = cloud(&data, 100.0);
+        c.fields[3].offset = 14;
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::FieldOutsidePoint { .. })
+        ));
+        let mut c = cloud(&data, 100.0);
+        c.fields[0].datatype = 9;
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::UnsupportedDatatype { .. })
+        ));
+        let mut c = cloud(&data, 100.0);
+        c.fields[1].datatype = 5;
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::UnsupportedDatatype { role, .. }) if role.contains("coordinate")
+        ));
+        let mut c = cloud(&data, 100.0);
+        c.fields[3].name = "ring".into();
+        assert!(matches!(
+            decoder.decode(&c),
+            Err(MessageError::UnsupportedDatatype { role, .. }) if role.contains("ring")
+        ));
+    }
+
+    #[test]
+    fn time_units_are_decided_once_and_checked_after() {
+        let data = points(&[0.0, 0.05, 0.099]);
+        let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+        let got = decoder.decode(&cloud(&data, 1.7e9)).unwrap();
+        assert_eq!(decoder.time_unit(), Some(TimeUnit::SecondsRelative));
+        assert_eq!(got.cloud.time(), Some(&[0.0, 0.05, 0.099][..]));
+        // A later cloud spanning 2 s no longer fits the unit decided.
+        let data = points(&[0.0, 2.0]);
+        assert!(matches!(
+            decoder.decode(&cloud(&data, 1.7e9 + 0.1)),
+            Err(MessageError::TimeUnit { .. })
+        ));
+        // Near a zero stamp, absolute and relative seconds both fit and disagree.
+        let data = points(&[0.06, 0.1]);
+        let mut fresh = PointCloud2Decoder::new(PointCloud2Config::default());
+        let err = fresh.decode(&cloud(&data, 0.05)).unwrap_err();
+        assert!(
+            matches!(&err, MessageError::TimeUnit { problem, .. } if problem.contains("both")),
+            "{err}"
+        );
+        // Equal times decide nothing.
+        let data = points(&[0.0, 0.0]);
+        let mut fresh = PointCloud2Decoder::new(PointCloud2Config::default());
+        fresh.decode(&cloud(&data, 5.0)).unwrap();
+        assert_eq!(fresh.time_unit(), None);
+    }
+
+    #[test]
+    fn no_returns_and_non_finite_points_are_dropped_with_their_channels() {
+        let mut data = points(&[0.0, 0.01, 0.02, 0.03]);
+        // Point 1 at the origin, point 2 NaN.
+        data[16..28].copy_from_slice(&[0; 12]);
+        data[32..36].copy_from_slice(&f32::NAN.to_le_bytes());
+        let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+        let got = decoder.decode(&cloud(&data, 10.0)).unwrap();
+        assert_eq!(
+            got.dropped,
+            DroppedPoints {
+                non_finite: 1,
+                no_return: 1
+            }
+        );
+        assert_eq!(got.cloud.time(), Some(&[0.0, 0.03][..]));
+        assert_eq!(got.cloud.points()[1].x, 4.0);
+    }
+}
