@@ -72,6 +72,7 @@ pub struct FieldSlot {
 
 impl FieldSlot {
     /// The value in `point` (at least `offset + size` bytes, checked when the layout was made).
+    #[inline]
     fn read(&self, point: &[u8], big_endian: bool) -> f64 {
         self.scalar.read(&point[self.offset..], !big_endian)
     }
@@ -92,6 +93,7 @@ pub enum TimeFields {
 }
 
 impl TimeFields {
+    #[inline]
     fn read(&self, point: &[u8], big_endian: bool) -> f64 {
         match self {
             Self::Single(f) => f.read(point, big_endian),
@@ -307,6 +309,29 @@ impl fmt::Display for CloudLayout {
     }
 }
 
+fn shape_error(msg: &PointCloud2<'_>) -> MessageError {
+    MessageError::CloudShape {
+        width: msg.width,
+        height: msg.height,
+        point_step: msg.point_step,
+        row_step: msg.row_step,
+        data_len: msg.data.len(),
+    }
+}
+
+/// The bytes of points in one row, once `width`, `height`, `point_step`, `row_step` and the
+/// data's length are checked to agree.
+fn checked_row_bytes(msg: &PointCloud2<'_>) -> Result<u64, MessageError> {
+    let row_points = u64::from(msg.width) * u64::from(msg.point_step);
+    if msg.point_step == 0
+        || u64::from(msg.row_step) < row_points
+        || u64::from(msg.row_step) * u64::from(msg.height) != msg.data.len() as u64
+    {
+        return Err(shape_error(msg));
+    }
+    Ok(row_points)
+}
+
 /// Settings of [`PointCloud2Decoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointCloud2Config {
@@ -371,85 +396,102 @@ impl PointCloud2Decoder {
     /// decided.
     pub fn decode(&mut self, msg: &PointCloud2<'_>) -> Result<DecodedCloud, MessageError> {
         let layout = CloudLayout::of(msg)?;
-        let shape = || MessageError::CloudShape {
-            width: msg.width,
-            height: msg.height,
-            point_step: msg.point_step,
-            row_step: msg.row_step,
-            data_len: msg.data.len(),
-        };
-        let row_points = u64::from(msg.width) * u64::from(msg.point_step);
-        if msg.point_step == 0
-            || u64::from(msg.row_step) < row_points
-            || u64::from(msg.row_step) * u64::from(msg.height) != msg.data.len() as u64
-        {
-            return Err(shape());
-        }
+        let row_points = checked_row_bytes(msg)?;
         let (step, row_step) = (layout.point_step, msg.row_step as usize);
-        let points_of = || {
-            (0..msg.height as usize).flat_map(move |row| {
-                let start = row * row_step;
-                msg.data[start..start + row_points as usize].chunks_exact(step)
-            })
-        };
         let n = msg.width as usize * msg.height as usize;
         let be = layout.big_endian;
-        let offset_of = match &layout.time {
-            Some(time) => {
-                let unit = self.time_unit_of(
-                    time,
-                    msg.header.stamp,
-                    points_of().map(|p| time.read(p, be)),
-                )?;
-                Some((time, unit))
-            }
-            None => None,
-        };
         let mut dropped = DroppedPoints::default();
         let mut points = Vec::with_capacity(n);
         let mut ring = layout.ring.as_ref().map(|_| Vec::with_capacity(n));
         let mut intensity = layout.intensity.as_ref().map(|_| Vec::with_capacity(n));
-        let mut time = offset_of.map(|_| Vec::with_capacity(n));
+        // Raw times of the kept points, and the range over all points (for the unit).
+        let mut raw_time = layout.time.as_ref().map(|_| Vec::with_capacity(n));
+        let (mut t_min, mut t_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut bad_time = false;
         let [x, y, z] = &layout.xyz;
-        for p in points_of() {
-            let point = Point3::new(
-                x.read(p, be) as f32,
-                y.read(p, be) as f32,
-                z.read(p, be) as f32,
-            );
-            match self.config.returns.classify(&point) {
-                PointKind::Return => {}
-                PointKind::NonFinite => {
-                    dropped.non_finite += 1;
-                    continue;
+        // The common layout (little-endian float32 coordinates) read without dispatch.
+        let plain = !be && layout.xyz.iter().all(|f| f.scalar == Scalar::F32);
+        let f32_at = |p: &[u8], o: usize| {
+            let mut a = [0u8; 4];
+            a.copy_from_slice(&p[o..o + 4]);
+            f32::from_le_bytes(a)
+        };
+        for row in 0..msg.height as usize {
+            let start = row * row_step;
+            for p in msg.data[start..start + row_points as usize].chunks_exact(step) {
+                let t = layout.time.as_ref().map(|f| {
+                    let t = f.read(p, be);
+                    bad_time |= !t.is_finite();
+                    t_min = t_min.min(t);
+                    t_max = t_max.max(t);
+                    t
+                });
+                let point = if plain {
+                    Point3::new(
+                        f32_at(p, x.offset),
+                        f32_at(p, y.offset),
+                        f32_at(p, z.offset),
+                    )
+                } else {
+                    Point3::new(
+                        x.read(p, be) as f32,
+                        y.read(p, be) as f32,
+                        z.read(p, be) as f32,
+                    )
+                };
+                match self.config.returns.classify(&point) {
+                    PointKind::Return => {}
+                    PointKind::NonFinite => {
+                        dropped.non_finite += 1;
+                        continue;
+                    }
+                    PointKind::NoReturn => {
+                        dropped.no_return += 1;
+                        continue;
+                    }
                 }
-                PointKind::NoReturn => {
-                    dropped.no_return += 1;
-                    continue;
+                points.push(point);
+                if let (Some(v), Some(f)) = (&mut ring, &layout.ring) {
+                    v.push(f.read(p, be) as u16);
+                }
+                if let (Some(v), Some(f)) = (&mut intensity, &layout.intensity) {
+                    v.push(f.read(p, be) as f32);
+                }
+                if let (Some(v), Some(t)) = (&mut raw_time, t) {
+                    v.push(t);
                 }
             }
-            points.push(point);
-            if let (Some(v), Some(f)) = (&mut ring, &layout.ring) {
-                v.push(f.read(p, be) as u16);
+        }
+        let time = match (&layout.time, raw_time) {
+            (Some(fields), Some(raw)) => {
+                if bad_time {
+                    t_min = f64::NAN;
+                }
+                let unit = self.time_unit_of(fields, msg.header.stamp, t_min, t_max)?;
+                let stamp = msg.header.stamp;
+                Some(
+                    raw.into_iter()
+                        .map(|v| unit.offset(v, stamp) as f32)
+                        .collect(),
+                )
             }
-            if let (Some(v), Some(f)) = (&mut intensity, &layout.intensity) {
-                v.push(f.read(p, be) as f32);
-            }
-            if let (Some(v), Some((f, unit))) = (&mut time, offset_of) {
-                v.push(unit.offset(f.read(p, be), msg.header.stamp) as f32);
-            }
-        }
-        let mut cloud = PointCloud::from_points(points);
-        // Every channel has one value per kept point, so these cannot fail.
-        if let Some(v) = ring {
-            cloud = cloud.with_ring(v).map_err(|_| shape())?;
-        }
-        if let Some(v) = intensity {
-            cloud = cloud.with_intensity(v).map_err(|_| shape())?;
-        }
-        if let Some(v) = time {
-            cloud = cloud.with_time(v).map_err(|_| shape())?;
-        }
+            _ => None,
+        };
+        // Every channel has one value per kept point.
+        let cloud = PointCloud::from_points(points);
+        let with = |c: Result<PointCloud, _>| c.map_err(|_| shape_error(msg));
+        let cloud = match ring {
+            Some(v) => with(cloud.with_ring(v))?,
+            None => cloud,
+        };
+        let cloud = match intensity {
+            Some(v) => with(cloud.with_intensity(v))?,
+            None => cloud,
+        };
+        let cloud = match time {
+            Some(v) => with(cloud.with_time(v))?,
+            None => cloud,
+        };
         Ok(DecodedCloud {
             cloud,
             dropped,
@@ -457,7 +499,7 @@ impl PointCloud2Decoder {
         })
     }
 
-    /// The unit of `values` (raw times of one cloud stamped `stamp`), deciding it on the first
+    /// The unit of raw times in `[min, max]` (one cloud stamped `stamp`), deciding it on the first
     /// cloud whose times differ.
     // Exactly equal times are the case where nothing can be decided.
     #[allow(clippy::float_cmp)]
@@ -465,13 +507,9 @@ impl PointCloud2Decoder {
         &mut self,
         time: &TimeFields,
         stamp: f64,
-        values: impl Iterator<Item = f64>,
+        min: f64,
+        max: f64,
     ) -> Result<TimeUnit, MessageError> {
-        let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
-        for v in values {
-            min = min.min(v);
-            max = max.max(v);
-        }
         let period = self.config.max_scan_period;
         let error = |problem: String| MessageError::TimeUnit {
             field: time.name(),
