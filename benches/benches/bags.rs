@@ -2,8 +2,9 @@
 //! decode one scan's messages (cloud, odometry, tf) against the engine's time for that scan, and
 //! the peak memory of reading a bag against one twice as long (each read in a child process).
 //!
-//! The bag holds the first scans of a simulated lap (seed 1), written with the `mcap` crate and
-//! a CDR encoder below. `cargo bench -p spot-nav-benches --bench bags`
+//! The bag holds the first scans of a simulated lap (seed 1), written with the `mcap` crate
+//! (zstd chunks, and once uncompressed as `ros2 bag record` writes by default) and a CDR encoder
+//! below. `cargo bench -p spot-nav-benches --bench bags`
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -131,12 +132,18 @@ fn tf_message(stamp: f64, parent: &str, child: &str, pose: &Pose3) -> Vec<u8> {
     w.0
 }
 
-/// A bag of the first `scans` scans of the lap.
-fn write_bag(path: &Path, scans: usize) -> mcap::McapResult<()> {
+/// A bag of the first `scans` scans of the lap, its chunks compressed with `compression`.
+fn write_bag(
+    path: &Path,
+    scans: usize,
+    compression: Option<mcap::Compression>,
+) -> mcap::McapResult<()> {
     let sim =
         SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(1)).unwrap_or_else(|e| fail(&e));
     let body_t_lidar = sim.body_t_lidar();
-    let mut out = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
+    let mut out = mcap::WriteOptions::new()
+        .compression(compression)
+        .create(BufWriter::new(File::create(path)?))?;
     let none = BTreeMap::new();
     let channel = |out: &mut mcap::Writer<_>, topic: &str, ty: &str| -> mcap::McapResult<u16> {
         let schema = out.add_schema(ty, "ros2msg", b"")?;
@@ -211,8 +218,11 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| fail(&e));
     let short: PathBuf = dir.join("short.mcap");
     let long: PathBuf = dir.join("long.mcap");
-    write_bag(&short, SHORT).unwrap_or_else(|e| fail(&e));
-    write_bag(&long, 2 * SHORT).unwrap_or_else(|e| fail(&e));
+    let plain: PathBuf = dir.join("uncompressed.mcap");
+    let zstd = Some(mcap::Compression::Zstd);
+    write_bag(&short, SHORT, zstd).unwrap_or_else(|e| fail(&e));
+    write_bag(&long, 2 * SHORT, zstd).unwrap_or_else(|e| fail(&e));
+    write_bag(&plain, SHORT, None).unwrap_or_else(|e| fail(&e));
 
     let (a, b) = (child_peak(&short), child_peak(&long));
     let mb = |p: &Path| std::fs::metadata(p).map_or(0.0, |m| m.len() as f64 / 1e6);
@@ -251,10 +261,22 @@ fn main() {
     let mut group = c.benchmark_group("bags");
     group.sample_size(10);
     group.throughput(Throughput::Elements(SHORT as u64));
-    group.bench_with_input(BenchmarkId::new("read_mcap", SHORT), &short, |b, path| {
-        let bag = open(path);
-        b.iter(|| bag.samples().unwrap_or_else(|e| fail(&e)).count());
-    });
+    group.bench_with_input(
+        BenchmarkId::new("read_mcap_zstd", SHORT),
+        &short,
+        |b, path| {
+            let bag = open(path);
+            b.iter(|| bag.samples().unwrap_or_else(|e| fail(&e)).count());
+        },
+    );
+    group.bench_with_input(
+        BenchmarkId::new("read_mcap_uncompressed", SHORT),
+        &plain,
+        |b, path| {
+            let bag = open(path);
+            b.iter(|| bag.samples().unwrap_or_else(|e| fail(&e)).count());
+        },
+    );
     group.bench_with_input(BenchmarkId::new("slam", SHORT), &samples, |b, samples| {
         b.iter(|| {
             let mut slam = point_to_plane_slam(slam_config());
