@@ -15,6 +15,10 @@ use crate::error::AdapterError;
 use crate::record::ros_messages::RosMessageType;
 use crate::record::wire::Wire;
 
+/// The largest MCAP record or chunk read (1 GiB): a corrupt length is refused rather than
+/// allocated. A 128-beam cloud is about 10 MB; recorders' chunks are 1 to 100 MB.
+const MAX_RECORD_BYTES: usize = 1 << 30;
+
 /// The bag formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BagFormat {
@@ -85,10 +89,11 @@ impl BagMessages {
                 let file = File::open(path).map_err(|e| AdapterError::io(path, e))?;
                 Ok(Self::Mcap {
                     path: path.to_path_buf(),
-                    reader: Box::new(mcap::io::MessageReader::new(BufReader::with_capacity(
-                        1 << 20,
-                        file,
-                    ))),
+                    reader: Box::new(mcap::io::MessageReader::new_with_options(
+                        BufReader::with_capacity(1 << 20, file),
+                        mcap::sans_io::LinearReaderOptions::default()
+                            .with_record_length_limit(MAX_RECORD_BYTES),
+                    )),
                     topics: HashMap::new(),
                 })
             }
@@ -144,9 +149,10 @@ impl Iterator for BagMessages {
     }
 }
 
-/// Reads the `index_pos` field of a ROS 1 bag's header record, so that a truncated or unindexed
-/// bag is refused before the `rosbag` crate slices its memory map with it.
-fn ros1_index_pos(path: &Path) -> Result<u64, AdapterError> {
+/// Reads the `index_pos` field of a ROS 1 bag's header record and where that record ends, so
+/// that a truncated or unindexed bag is refused before the `rosbag` crate slices its memory map
+/// between the two.
+fn ros1_index_pos(path: &Path) -> Result<(u64, u64), AdapterError> {
     let bad = |message: &str| AdapterError::Recording {
         path: path.to_path_buf(),
         message: message.into(),
@@ -164,6 +170,8 @@ fn ros1_index_pos(path: &Path) -> Result<u64, AdapterError> {
         Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?) as usize)
     };
     let header_len = u32_at(rest, 0).ok_or_else(|| bad("truncated header"))?;
+    let data_len = u32_at(rest, 4 + header_len).ok_or_else(|| bad("truncated header"))?;
+    let header_end = (13 + 4 + header_len + 4 + data_len) as u64;
     let mut fields = rest
         .get(4..4 + header_len)
         .ok_or_else(|| bad("truncated header"))?;
@@ -173,7 +181,7 @@ fn ros1_index_pos(path: &Path) -> Result<u64, AdapterError> {
             .ok_or_else(|| bad("malformed header field"))?;
         if let Some(v) = field.strip_prefix(b"index_pos=") {
             let v: [u8; 8] = v.try_into().map_err(|_| bad("malformed index_pos"))?;
-            return Ok(u64::from_le_bytes(v));
+            return Ok((u64::from_le_bytes(v), header_end));
         }
         fields = &fields[4 + len..];
     }
@@ -194,8 +202,8 @@ impl Ros1Messages {
         let len = std::fs::metadata(path)
             .map_err(|e| AdapterError::io(path, e))?
             .len();
-        let index_pos = ros1_index_pos(path)?;
-        if index_pos == 0 || index_pos > len {
+        let (index_pos, header_end) = ros1_index_pos(path)?;
+        if index_pos < header_end || index_pos > len {
             return Err(AdapterError::Recording {
                 path: path.to_path_buf(),
                 message: format!(
