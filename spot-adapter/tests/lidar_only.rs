@@ -175,3 +175,56 @@ fn kitti_no_return_points_are_removed_and_counted() {
     assert_eq!(s.cloud.len(), 50);
     assert_eq!(samples.dropped_points().no_return, 8);
 }
+
+#[test]
+fn nanosecond_times_in_scan_files_are_read_as_seconds() {
+    let dir = temp_dir("ns-times");
+    let points: Vec<Point3<f32>> = (0..100)
+        .map(|i| Point3::new(2.0 + i as f32 * 0.01, 1.0, 0.5))
+        .collect();
+    // Ouster's convention: nanoseconds since the scan's start, up to 0.099 s.
+    let ns: Vec<f32> = (0..100).map(|i| i as f32 * 1.0e6).collect();
+    let cloud = PointCloud::from_points(points.clone())
+        .with_time(ns)
+        .unwrap();
+    slam_core::io::write_pcd(
+        dir.join("1.0.pcd"),
+        &cloud,
+        slam_core::io::PcdEncoding::Binary,
+    )
+    .unwrap();
+    let seconds: Vec<f32> = (0..100).map(|i| i as f32 * 1.0e-3).collect();
+    let cloud = PointCloud::from_points(points.clone())
+        .with_time(seconds.clone())
+        .unwrap();
+    slam_core::io::write_pcd(
+        dir.join("1.1.pcd"),
+        &cloud,
+        slam_core::io::PcdEncoding::Binary,
+    )
+    .unwrap();
+    let source = open_recording(&dir, &SourceConfig::default()).unwrap();
+    let mut samples = source.samples;
+    let first = samples.next().unwrap().unwrap();
+    for (got, want) in first.cloud.time().unwrap().iter().zip(&seconds) {
+        assert!((got - want).abs() < 1e-8, "{got} s, not {want} s");
+    }
+    // The unit was decided on the first scan: a later one in seconds no longer fits it.
+    let err = samples.next().unwrap().unwrap_err();
+    assert!(err.to_string().contains("1.1.pcd"), "{err}");
+    // Times that fit no unit are an error naming the file.
+    let dir = temp_dir("bad-times");
+    let five: Vec<f32> = (0..100).map(|i| i as f32 * 0.05).collect();
+    let cloud = PointCloud::from_points(points).with_time(five).unwrap();
+    slam_core::io::write_pcd(
+        dir.join("1.0.pcd"),
+        &cloud,
+        slam_core::io::PcdEncoding::Binary,
+    )
+    .unwrap();
+    let mut samples = open_recording(&dir, &SourceConfig::default())
+        .unwrap()
+        .samples;
+    let err = samples.next().unwrap().unwrap_err();
+    assert!(err.to_string().contains("no unit"), "{err}");
+}

@@ -10,7 +10,9 @@
 //! in stamp order), else from the odometry file
 //! (one line per scan), else 10 Hz from 0. With the names as stamps, the odometry is
 //! interpolated at each scan's stamp; otherwise its lines are taken in order. The LiDAR mounting
-//! is given by argument (identity by default). Without odometry every `odom_T_body` is the
+//! is given by argument (identity by default). A per-point time is taken in seconds since the
+//! scan's start, or in nanoseconds (Ouster's PCDs) when that is what fits one scan period.
+//! Without odometry every `odom_T_body` is the
 //! identity: wrap the samples in [`ScanToScanOdometry`](crate::record::ScanToScanOdometry)
 //! for a LiDAR-only run.
 
@@ -23,6 +25,7 @@ use slam_core::io::read_tum;
 use crate::error::AdapterError;
 use crate::record::frame_tree::PoseSeries;
 use crate::record::no_return::{DroppedPoints, ReturnFilter};
+use crate::record::point_cloud2::{PointCloud2Config, PointCloud2Decoder};
 use crate::robot::Sample;
 
 /// Seconds between scans when nothing gives their stamps.
@@ -202,6 +205,7 @@ impl CloudFolder {
             folder: self.clone(),
             next: 0,
             dropped: DroppedPoints::default(),
+            times: PointCloud2Decoder::new(PointCloud2Config::default()),
         }
     }
 }
@@ -212,6 +216,8 @@ pub struct CloudFolderSamples {
     folder: CloudFolder,
     next: usize,
     dropped: DroppedPoints,
+    /// Decides the per-point time unit (seconds or Ouster's nanoseconds) once.
+    times: PointCloud2Decoder,
 }
 
 impl CloudFolderSamples {
@@ -230,21 +236,28 @@ impl Iterator for CloudFolderSamples {
         let path = self.folder.scans.get(i)?;
         self.next += 1;
         let f = &self.folder;
-        Some(
-            slam_core::io::read_cloud(path)
-                .map_err(AdapterError::from)
-                .map(|cloud| {
-                    let (cloud, dropped) = f.returns.apply(cloud);
-                    self.dropped.add(dropped);
-                    Sample {
-                        stamp: f.stamps[i],
-                        odom_t_body: f.odometry.as_ref().map_or_else(Pose3::identity, |o| o[i]),
-                        body_t_lidar: f.body_t_lidar,
-                        cloud,
-                        ground_truth: None,
-                    }
-                }),
-        )
+        let cloud = match slam_core::io::read_cloud(path) {
+            Ok(c) => c,
+            Err(e) => return Some(Err(e.into())),
+        };
+        let cloud = match self.times.times_in_seconds(cloud) {
+            Ok(c) => c,
+            Err(e) => {
+                return Some(Err(AdapterError::Recording {
+                    path: path.clone(),
+                    message: e.to_string(),
+                }));
+            }
+        };
+        let (cloud, dropped) = f.returns.apply(cloud);
+        self.dropped.add(dropped);
+        Some(Ok(Sample {
+            stamp: f.stamps[i],
+            odom_t_body: f.odometry.as_ref().map_or_else(Pose3::identity, |o| o[i]),
+            body_t_lidar: f.body_t_lidar,
+            cloud,
+            ground_truth: None,
+        }))
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {

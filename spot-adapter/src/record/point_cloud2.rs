@@ -499,6 +499,61 @@ impl PointCloud2Decoder {
         })
     }
 
+    /// `cloud`'s time channel (read from a file as it was stored, relative to the scan's start)
+    /// in seconds: kept when it fits seconds, scaled when it fits nanoseconds (Ouster's PCDs),
+    /// by the same rule and with the same memory of the unit as [`PointCloud2Decoder::decode`].
+    ///
+    /// # Errors
+    /// [`MessageError::TimeUnit`] when the times fit neither.
+    pub fn times_in_seconds(&mut self, cloud: PointCloud) -> Result<PointCloud, MessageError> {
+        let Some(time) = cloud.time() else {
+            return Ok(cloud);
+        };
+        let (min, max) = time
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+                (lo.min(f64::from(t)), hi.max(f64::from(t)))
+            });
+        let field = TimeFields::Single(FieldSlot {
+            name: "t".into(),
+            offset: 0,
+            scalar: Scalar::F32,
+        });
+        let min = if time.iter().all(|t| t.is_finite()) {
+            min
+        } else {
+            f64::NAN
+        };
+        match self.time_unit_of(&field, 0.0, min, max)? {
+            TimeUnit::SecondsRelative | TimeUnit::SecondsAbsolute => Ok(cloud),
+            TimeUnit::NanosecondsRelative | TimeUnit::NanosecondsAbsolute => {
+                let (points, ring, intensity, time) = cloud.into_parts();
+                let seconds: Vec<f32> = time
+                    .unwrap_or_default()
+                    .iter()
+                    .map(|&t| (f64::from(t) * 1e-9) as f32)
+                    .collect();
+                let mut out = PointCloud::from_points(points);
+                // The channels keep their lengths, so these cannot fail.
+                let bad = |_| MessageError::TimeUnit {
+                    field: "t".into(),
+                    min,
+                    max,
+                    stamp: 0.0,
+                    period: self.config.max_scan_period,
+                    problem: "the cloud's channels differ in length".into(),
+                };
+                if let Some(r) = ring {
+                    out = out.with_ring(r).map_err(bad)?;
+                }
+                if let Some(i) = intensity {
+                    out = out.with_intensity(i).map_err(bad)?;
+                }
+                out.with_time(seconds).map_err(bad)
+            }
+        }
+    }
+
     /// The unit of raw times in `[min, max]` (one cloud stamped `stamp`), deciding it on the first
     /// cloud whose times differ.
     // Exactly equal times are the case where nothing can be decided.
