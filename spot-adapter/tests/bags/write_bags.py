@@ -9,8 +9,9 @@ writes into OUT_DIR:
   chunks): the recording's clouds on /points (x y z float32, padding, intensity, ring uint16,
   time float32 seconds since the stamp), its odometry on /odom and on /tf (odom -> base_link),
   the LiDAR mounting on /tf_static (base_link -> velodyne), and a constant IMU reading on /imu;
-- `layouts/layouts.mcap`: the first clouds again in other drivers' layouts, one topic each
-  (see LAYOUTS), so a reader can be checked against the recording's own clouds.
+- `layouts/layouts.mcap` and `layouts.bag`: the first clouds again in other drivers' layouts,
+  one topic each (see `layout_messages`), so a reader can be checked against the recording's
+  own clouds.
 
 Only the recording's files are read (index.txt, calibration.txt, odometry.tum, binary PCD).
 """
@@ -273,6 +274,7 @@ def main():
     write_ros2(out / "lap_ros2", lambda m: lap_messages(m, mount, scans), compress=True)
     write_ros1(out / "lap.bag", lambda m: lap_messages(m, mount, scans))
     write_ros2(out / "layouts", lambda m: layout_messages(m, scans), compress=False)
+    write_ros1(out / "layouts.bag", lambda m: layout_messages(m, scans))
 
 
 if __name__ == "__main__":
