@@ -127,15 +127,21 @@ impl Iterator for BagMessages {
                         .schema
                         .as_ref()
                         .map_or_else(String::new, |s| s.name.clone());
+                    // Only ROS payloads are decoded; a protobuf or JSON channel keeps its type
+                    // name (with the encoding) for the listing but is not read.
+                    let wire = match channel.message_encoding.as_str() {
+                        "ros1" => Some(Wire::Ros1),
+                        "cdr" => Some(Wire::Cdr),
+                        _ => None,
+                    };
                     Arc::new(TopicInfo {
                         name: channel.topic.clone(),
-                        message_type: RosMessageType::from_name(&type_name),
-                        type_name,
-                        wire: if channel.message_encoding == "ros1" {
-                            Wire::Ros1
-                        } else {
-                            Wire::Cdr
+                        message_type: wire.and_then(|_| RosMessageType::from_name(&type_name)),
+                        type_name: match wire {
+                            Some(_) => type_name,
+                            None => format!("{type_name} ({})", channel.message_encoding),
                         },
+                        wire: wire.unwrap_or(Wire::Cdr),
                     })
                 });
                 Some(Ok(RawMessage {
