@@ -1,4 +1,4 @@
-//! A ROS 1 or ROS 2 (MCAP) bag as a source of [`Sample`]s: the clouds of one
+//! A ROS 1 or ROS 2 (MCAP) bag as a source of [`Sample`](crate::robot::Sample)s: the clouds of one
 //! `sensor_msgs/PointCloud2` topic, each with `odom_T_body` at its stamp (from a
 //! `nav_msgs/Odometry` topic, or from the `/tf` tree between an odometry frame and the body
 //! frame) and `body_T_lidar` from `/tf_static`.
@@ -8,7 +8,7 @@
 //! that a bad bag fails before any output is written. [`Bag::samples`] then reads it again, a
 //! message at a time: memory holds the few clouds that wait for the odometry after them.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -16,14 +16,13 @@ use slam_core::Pose3;
 
 use crate::error::{AdapterError, MessageError};
 use crate::record::bag_file::{BagFormat, BagMessages, RawMessage, TopicInfo};
-use crate::record::frame_tree::{FrameTree, PoseSeries};
-use crate::record::no_return::DroppedPoints;
+use crate::record::bag_samples::BagSamples;
+use crate::record::frame_tree::FrameTree;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
 use crate::record::ros_messages::{
     Header, ImuReading, Odometry, PointCloud2, RosMessageType, decode_tf_message,
 };
 use crate::record::wire::WireReader;
-use crate::robot::Sample;
 
 /// Where the odometry of a bag comes from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -159,17 +158,22 @@ impl fmt::Display for BagSummary {
 /// A bag opened and checked.
 #[derive(Clone, Debug)]
 pub struct Bag {
-    summary: BagSummary,
+    pub(super) summary: BagSummary,
     /// The fixed transforms.
-    fixed: FrameTree,
+    pub(super) fixed: FrameTree,
     /// The stamps between which odometry is known.
-    span: (f64, f64),
+    pub(super) span: (f64, f64),
     /// The decoder with the time unit decided on the first cloud.
-    decoder: PointCloud2Decoder,
+    pub(super) decoder: PointCloud2Decoder,
 }
 
 /// The error for message `index` of `topic`.
-fn message_error(path: &Path, topic: &str, index: usize, source: MessageError) -> AdapterError {
+pub(super) fn message_error(
+    path: &Path,
+    topic: &str,
+    index: usize,
+    source: MessageError,
+) -> AdapterError {
     AdapterError::Message {
         path: path.to_path_buf(),
         topic: topic.to_owned(),
@@ -186,7 +190,7 @@ fn bad(path: &Path, message: String) -> AdapterError {
 }
 
 /// Whether `topic` is a tf topic, and whether the static one.
-fn tf_kind(topic: &str) -> Option<bool> {
+pub(super) fn tf_kind(topic: &str) -> Option<bool> {
     match topic.trim_start_matches('/') {
         "tf" => Some(false),
         "tf_static" => Some(true),
@@ -195,7 +199,7 @@ fn tf_kind(topic: &str) -> Option<bool> {
 }
 
 /// A decoded message the samples need.
-enum Decoded<'a> {
+pub(super) enum Decoded<'a> {
     Cloud(PointCloud2<'a>),
     Odometry(Odometry),
     Tf(Vec<crate::record::ros_messages::TransformStamped>, bool),
@@ -203,7 +207,7 @@ enum Decoded<'a> {
 }
 
 /// Decode `msg` as what its topic carries; `None` for topics not used.
-fn decode(msg: &RawMessage) -> Result<Option<Decoded<'_>>, MessageError> {
+pub(super) fn decode(msg: &RawMessage) -> Result<Option<Decoded<'_>>, MessageError> {
     let Some(kind) = msg.topic.message_type else {
         return Ok(None);
     };
@@ -220,7 +224,7 @@ fn decode(msg: &RawMessage) -> Result<Option<Decoded<'_>>, MessageError> {
 }
 
 /// The header of a cloud payload only.
-fn cloud_header(msg: &RawMessage) -> Result<Header, MessageError> {
+pub(super) fn cloud_header(msg: &RawMessage) -> Result<Header, MessageError> {
     let mut r = WireReader::new(&msg.data, msg.topic.wire)?;
     Header::decode(&mut r)
 }
@@ -581,221 +585,7 @@ impl Bag {
     /// # Errors
     /// As [`Bag::open`], when the file cannot be opened again.
     pub fn samples(&self) -> Result<BagSamples, AdapterError> {
-        let path = &self.summary.path;
-        Ok(BagSamples {
-            messages: BagMessages::open(path, self.summary.format)?,
-            bag: self.clone(),
-            tree: self.fixed.clone(),
-            odometry: PoseSeries::default(),
-            pending: VecDeque::new(),
-            counters: HashMap::new(),
-            dropped: DroppedPoints::default(),
-            imu: Vec::new(),
-            imu_before_last: Vec::new(),
-            left: self.summary.clouds,
-            done: false,
-        })
-    }
-}
-
-/// A bag's samples, read one message at a time (from [`Bag::samples`]).
-#[derive(Debug)]
-pub struct BagSamples {
-    messages: BagMessages,
-    bag: Bag,
-    tree: FrameTree,
-    odometry: PoseSeries,
-    /// Clouds waiting for the odometry after their stamp.
-    pending: VecDeque<(usize, f64, slam_core::PointCloud)>,
-    counters: HashMap<String, usize>,
-    dropped: DroppedPoints,
-    imu: Vec<ImuReading>,
-    imu_before_last: Vec<ImuReading>,
-    left: usize,
-    done: bool,
-}
-
-/// Whether the odometry at a stamp is known yet.
-enum OdometryAt {
-    Known(Pose3),
-    NotYet,
-}
-
-impl BagSamples {
-    /// Points removed from the clouds delivered so far.
-    #[must_use]
-    pub fn dropped_points(&self) -> DroppedPoints {
-        self.dropped
-    }
-
-    /// The IMU readings read between the previous sample and the last one delivered.
-    #[must_use]
-    pub fn imu_before_last_sample(&self) -> &[ImuReading] {
-        &self.imu_before_last
-    }
-
-    fn odometry_at(&self, stamp: f64) -> Result<OdometryAt, MessageError> {
-        let summary = &self.bag.summary;
-        match &summary.odometry {
-            ResolvedOdometry::None => Ok(OdometryAt::Known(Pose3::identity())),
-            ResolvedOdometry::Topic(_) => match self.odometry.last_stamp() {
-                Some(last) if last >= stamp => {
-                    self.odometry.at(stamp).map(OdometryAt::Known).ok_or(
-                        MessageError::MissingTransform {
-                            parent: "odometry".into(),
-                            child: summary.base_frame.clone(),
-                            stamp,
-                        },
-                    )
-                }
-                _ => Ok(OdometryAt::NotYet),
-            },
-            ResolvedOdometry::Tf { odom_frame } => {
-                match self.tree.known_span(odom_frame, &summary.base_frame) {
-                    Some((_, until)) if until >= stamp => self
-                        .tree
-                        .lookup(odom_frame, &summary.base_frame, stamp)
-                        .map(OdometryAt::Known)
-                        .ok_or_else(|| MessageError::MissingTransform {
-                            parent: odom_frame.clone(),
-                            child: summary.base_frame.clone(),
-                            stamp,
-                        }),
-                    _ => Ok(OdometryAt::NotYet),
-                }
-            }
-        }
-    }
-
-    /// Take in one message.
-    fn take(&mut self, msg: &RawMessage) -> Result<(), AdapterError> {
-        let path = self.bag.summary.path.clone();
-        let name = &msg.topic.name;
-        let counter = self.counters.entry(name.clone()).or_default();
-        let index = *counter;
-        *counter += 1;
-        let at = |e| message_error(&path, name, index, e);
-        let summary = &self.bag.summary;
-        if *name == summary.cloud_topic {
-            let stamp = cloud_header(msg).map_err(at)?.stamp;
-            let (from, until) = self.bag.span;
-            if stamp < from || stamp > until {
-                return Ok(());
-            }
-            let Some(Decoded::Cloud(cloud)) = decode(msg).map_err(at)? else {
-                return Ok(());
-            };
-            let decoded = self.bag.decoder.decode(&cloud).map_err(at)?;
-            self.dropped.add(decoded.dropped);
-            self.pending.push_back((index, stamp, decoded.cloud));
-            return Ok(());
-        }
-        let odometry_topic = matches!(&summary.odometry, ResolvedOdometry::Topic(t) if t == name);
-        let tf = tf_kind(name).is_some();
-        if !(odometry_topic || tf || msg.topic.message_type == Some(RosMessageType::Imu)) {
-            return Ok(());
-        }
-        match decode(msg).map_err(at)? {
-            Some(Decoded::Odometry(o)) if odometry_topic => {
-                self.odometry.push(o.header.stamp, o.pose);
-            }
-            Some(Decoded::Tf(transforms, false)) => {
-                for t in transforms {
-                    self.tree.push_moving(
-                        &t.header.frame_id,
-                        &t.child_frame_id,
-                        t.header.stamp,
-                        t.transform,
-                    );
-                }
-            }
-            Some(Decoded::Imu(reading)) => self.imu.push(reading),
-            _ => {}
-        }
-        Ok(())
-    }
-
-    fn next_sample(&mut self) -> Result<Option<Sample>, AdapterError> {
-        loop {
-            if let Some(&(index, stamp, _)) = self.pending.front() {
-                let known = self.odometry_at(stamp).map_err(|e| {
-                    message_error(
-                        &self.bag.summary.path,
-                        &self.bag.summary.cloud_topic,
-                        index,
-                        e,
-                    )
-                })?;
-                if let OdometryAt::Known(odom_t_body) = known {
-                    let Some((_, _, cloud)) = self.pending.pop_front() else {
-                        continue;
-                    };
-                    // The next cloud's stamp (or this one's) bounds what is still needed.
-                    let keep_from = self.pending.front().map_or(stamp, |p| p.1.min(stamp));
-                    self.odometry.prune_before(keep_from);
-                    self.tree.prune_before(keep_from);
-                    self.imu_before_last = std::mem::take(&mut self.imu);
-                    return Ok(Some(Sample {
-                        stamp,
-                        odom_t_body,
-                        body_t_lidar: self.bag.summary.body_t_lidar,
-                        cloud,
-                        ground_truth: None,
-                    }));
-                }
-            }
-            let Some(msg) = self.messages.next() else {
-                if let Some(&(index, stamp, _)) = self.pending.front() {
-                    let summary = &self.bag.summary;
-                    return Err(message_error(
-                        &summary.path,
-                        &summary.cloud_topic,
-                        index,
-                        MessageError::MissingTransform {
-                            parent: "odometry".into(),
-                            child: summary.base_frame.clone(),
-                            stamp,
-                        },
-                    ));
-                }
-                return Ok(None);
-            };
-            self.take(&msg?)?;
-        }
-    }
-}
-
-impl Iterator for BagSamples {
-    type Item = Result<Sample, AdapterError>;
-
-    fn next(&mut self) -> Option<Self::Item> {
-        if self.done || self.left == 0 {
-            return None;
-        }
-        match self.next_sample() {
-            Ok(Some(sample)) => {
-                self.left -= 1;
-                Some(Ok(sample))
-            }
-            Ok(None) => {
-                self.done = true;
-                None
-            }
-            Err(e) => {
-                self.done = true;
-                Some(Err(e))
-            }
-        }
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        let n = self.len();
-        (n, Some(n))
-    }
-}
-
-impl ExactSizeIterator for BagSamples {
-    fn len(&self) -> usize {
-        if self.done { 0 } else { self.left }
+        let messages = BagMessages::open(&self.summary.path, self.summary.format)?;
+        Ok(BagSamples::new(self.clone(), messages))
     }
 }

@@ -16,6 +16,7 @@
 
 mod bag;
 mod bag_file;
+mod bag_samples;
 mod cloud_folder;
 mod frame_tree;
 mod kitti;
@@ -27,10 +28,9 @@ mod ros_messages;
 mod source;
 mod wire;
 
-pub use bag::{
-    Bag, BagConfig, BagSamples, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary,
-};
+pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
 pub use bag_file::{BagFormat, TopicInfo};
+pub use bag_samples::BagSamples;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
 pub use frame_tree::{FrameTree, PoseSeries};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};

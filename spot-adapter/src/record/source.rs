@@ -9,8 +9,9 @@ use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
 use crate::error::AdapterError;
-use crate::record::bag::{Bag, BagConfig, BagSamples};
+use crate::record::bag::{Bag, BagConfig};
 use crate::record::bag_file::BagFormat;
+use crate::record::bag_samples::BagSamples;
 use crate::record::cloud_folder::{
     CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder,
 };
