@@ -12,6 +12,42 @@
 //! non-finite ones, and counts them ([`ReturnFilter`], [`DroppedPoints`]). A source without
 //! odometry gets it from its scans with [`ScanToScanOdometry`].
 //!
+//! A cloud as a driver publishes it (Ouster's convention: integer nanoseconds under `t`, a
+//! no-return at the origin), decoded:
+//!
+//! ```
+//! use spot_adapter::record::{
+//!     Header, PointCloud2, PointCloud2Config, PointCloud2Decoder, PointField, TimeUnit,
+//! };
+//!
+//! let field = |name: &str, offset, datatype| PointField { name: name.into(), offset, datatype, count: 1 };
+//! let mut data = Vec::new();
+//! for (x, t_ns) in [(2.0f32, 0u32), (0.0, 50_000_000), (3.0, 99_000_000)] {
+//!     for v in [x, 1.0, 0.5] {
+//!         data.extend_from_slice(&v.to_le_bytes()); // x y z float32
+//!     }
+//!     data.extend_from_slice(&t_ns.to_le_bytes()); // t uint32
+//! }
+//! data[16..28].fill(0); // the second point: no return
+//! let msg = PointCloud2 {
+//!     header: Header { stamp: 1.7e9, frame_id: "os_sensor".into() },
+//!     height: 1,
+//!     width: 3,
+//!     fields: vec![field("x", 0, 7), field("y", 4, 7), field("z", 8, 7), field("t", 12, 6)],
+//!     is_bigendian: false,
+//!     point_step: 16,
+//!     row_step: 48,
+//!     data: &data,
+//! };
+//! let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+//! let decoded = decoder.decode(&msg)?;
+//! assert_eq!(decoder.time_unit(), Some(TimeUnit::NanosecondsRelative));
+//! assert_eq!(decoded.cloud.len(), 2);
+//! assert_eq!(decoded.dropped.no_return, 1);
+//! assert_eq!(decoded.cloud.time(), Some(&[0.0, 0.099][..]));
+//! # Ok::<(), spot_adapter::MessageError>(())
+//! ```
+//!
 //! Uses `robot` (the sample type) and `slam-core`'s file formats only.
 
 mod bag;
