@@ -66,7 +66,8 @@ fn python() -> Option<PathBuf> {
     let venv = target_dir().join("rosbags-venv-0.11.9");
     let python = venv.join("bin/python");
     if !python.exists() {
-        // Built beside and renamed into place, so an interrupted install is never taken as done.
+        // Built beside and renamed into place, so an interrupted install is never taken as done
+        // (only its `bin/python` is run, which finds the moved venv by its `pyvenv.cfg`).
         let building = target_dir().join(format!("rosbags-venv-building-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&building);
         run(
