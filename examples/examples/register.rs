@@ -27,6 +27,7 @@ use registration::{
 };
 use slam_core::io::read_cloud;
 use slam_core::{Alignment, PointCloud, Pose3, Registrator, pose3_from_xyz_rpy};
+use spot_adapter::record::ReturnFilter;
 use spot_nav_examples::{Timings, data, out, parse_numbers, value_name};
 
 /// Register two LiDAR scans and print `target_T_source`.
@@ -246,11 +247,28 @@ fn print_times(timed: &Timed) -> Result<()> {
     }
 }
 
+/// The cloud at `path` without its no-return points (exact zeros, inside the housing), which
+/// would pair with each other; says how many there were.
+fn read_returns(path: &Path, which: &str) -> Result<PointCloud> {
+    let cloud = read_cloud(path).with_context(|| path.display().to_string())?;
+    let returns = ReturnFilter::default();
+    let (cloud, d) = returns.apply(cloud);
+    if d.no_return + d.non_finite > 0 {
+        out!(
+            "{which:<11} {} no-return points (zeros or within {} m) and {} non-finite removed",
+            d.no_return,
+            returns.min_range,
+            d.non_finite
+        )?;
+    }
+    Ok(cloud)
+}
+
 fn register(args: &Args) -> Result<()> {
     let job = Job::new(args);
     let repeat = args.repeat.get();
-    let source = read_cloud(&job.source).with_context(|| job.source.display().to_string())?;
-    let target = read_cloud(&job.target).with_context(|| job.target.display().to_string())?;
+    let source = read_returns(&job.source, "source")?;
+    let target = read_returns(&job.target, "target")?;
     let icp = IcpConfig {
         source_voxel: args.voxel,
         target_voxel: args.voxel,

@@ -12,6 +12,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::Parser;
 use slam_core::io::read_cloud;
+use spot_adapter::record::ReturnFilter;
 use spot_nav_examples::{data, out, quantile};
 
 /// Read a LiDAR scan and print its statistics and voxel-downsampled sizes.
@@ -37,8 +38,15 @@ fn scan_stats(args: &Args) -> Result<()> {
     let read_ms = started.elapsed().as_secs_f64() * 1e3;
     out!("file        {}", path.display())?;
     out!("points      {} (read in {read_ms:.1} ms)", cloud.len())?;
-    let dropped = cloud.remove_non_finite();
-    out!("non-finite  {dropped} dropped")?;
+    let (kept, dropped) = ReturnFilter::default().apply(cloud);
+    cloud = kept;
+    out!("non-finite  {} dropped", dropped.non_finite)?;
+    if dropped.no_return > 0 {
+        out!(
+            "no-return   {} dropped (zeros or within 0.1 m)",
+            dropped.no_return
+        )?;
+    }
     out!(
         "channels    ring: {}, intensity: {}, time: {}",
         cloud.ring().is_some(),

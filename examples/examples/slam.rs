@@ -1,38 +1,110 @@
-//! Graph-SLAM on a simulated Spot (or a recording): point-to-plane ICP (or LOAM) odometry against
-//! the local map, loop closure (point-to-point check, point-to-plane or LOAM refinement),
-//! Levenberg-Marquardt. Prints scans, keyframes, loop closures, ATE, drift, loop end-point error
-//! and per-scan times, and writes the map (PLY), the trajectory (TUM) and the pose graph (g2o)
-//! with `--out`.
+//! Graph-SLAM on a simulated Spot or on any recording: a ROS 1 bag (`.bag`), a ROS 2 bag
+//! (`.mcap`, or its folder), a KITTI sequence, a folder of PCD/PLY scans or a spot-nav
+//! recording, detected from PATH. Point-to-plane ICP (or LOAM) odometry against the local map,
+//! loop closure (point-to-point check, point-to-plane or LOAM refinement), Levenberg-Marquardt.
+//! Prints what the recording holds, then scans, keyframes, loop closures, per-scan times and,
+//! with ground truth, ATE, drift and loop end-point error; writes the map (PLY, PCD), the
+//! trajectory (TUM), the pose graph (g2o) and the occupancy grid (PNG, ROS map) with `--out`.
 //!
-//! `cargo run --release --example slam -- [RECORDING_DIR] [--seed N] [--registration p2plane|loam] [--skewed] [--no-deskew] [--out DIR]`
+//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--out DIR]`
 
 use std::convert::Infallible;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Result;
-use clap::Parser;
+use anyhow::{Context, Result};
+use clap::{Parser, ValueEnum};
+use gridmap::{UnknownCells, inflate};
+use nalgebra::{Translation3, Vector2};
 use posegraph::g2o::{G2oGraph, write_g2o};
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
-use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3};
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
-use spot_adapter::record::Recording;
+use slam_core::{
+    GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3, quaternion_from_xyzw,
+};
+use spot_adapter::nav::{NavigationMap, NavigatorConfig};
+use spot_adapter::pipelines::{
+    loam_slam, point_to_plane_slam, scan_to_scan_registrator, slam_config,
+};
+use spot_adapter::record::{
+    BagConfig, OdometrySource, PointCloud2Config, ReturnFilter, SampleSource, ScanToScanConfig,
+    ScanToScanOdometry, SourceConfig, TimeUnit, open_recording,
+};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_nav_examples::{Registration, map_and_evaluate, out};
+use spot_nav_examples::{Registration, map_and_evaluate, out, parse_numbers};
+
+/// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
+const INFLATION: f64 = 0.30;
+
+/// A per-point time unit, as `--time-unit` gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TimeUnitArg {
+    /// Seconds since the cloud's stamp (Velodyne).
+    S,
+    /// Nanoseconds since the cloud's stamp (Ouster, Livox).
+    Ns,
+    /// Seconds on the stamp's clock (Hesai).
+    SAbsolute,
+    /// Nanoseconds on the stamp's clock.
+    NsAbsolute,
+}
 
 /// Graph-SLAM on one simulated lap of a generated building, or on a recording.
 ///
-/// LiDAR odometry against the local map, loop closure, Levenberg-Marquardt. Prints scans,
-/// keyframes, loop closures, per-scan times and, when the ground truth is known, ATE, drift and
-/// loop end-point error. With `--out` it writes the map (`map.ply`, `map.pcd`), the body trajectory
-/// (`trajectory.tum`) and the pose graph (`graph.g2o`). Fails when the engine accepts no scan.
+/// PATH is a ROS 1 bag (.bag), a ROS 2 bag (.mcap, or its folder with metadata.yaml), a KITTI
+/// sequence (velodyne/*.bin, times.txt, calib.txt, poses.txt as ground truth), a folder of PCD
+/// or PLY scans (names that are numbers are stamps), or a spot-nav recording (index.txt). What
+/// it holds is printed first. A recording without odometry runs LiDAR-only (scan-to-scan
+/// odometry with a constant-velocity guess). Prints scans, keyframes, loop closures, per-scan
+/// times and, when the ground truth is known, ATE, drift and loop end-point error. With `--out`
+/// it writes the map (`map.ply`, `map.pcd`), the body trajectory (`trajectory.tum`), the pose
+/// graph (`graph.g2o`) and the occupancy grid (`grid.png`, `map.yaml` + `map.pgm`), all after
+/// the run: a failed run leaves nothing. Fails when the recording cannot be read or the engine
+/// accepts no scan.
 #[derive(Debug, Parser)]
 #[command(name = "slam")]
+#[allow(clippy::struct_excessive_bools)]
 struct Args {
-    /// A recording folder (as the simulate example writes it) to replay instead of simulating.
-    #[arg(value_name = "RECORDING_DIR")]
+    /// A recording to replay instead of simulating (bag, KITTI, PCD/PLY folder, spot-nav).
+    #[arg(value_name = "PATH")]
     recording: Option<PathBuf>,
+    /// Bags: the `sensor_msgs/PointCloud2` topic (default: the only one).
+    #[arg(long, value_name = "TOPIC")]
+    cloud_topic: Option<String>,
+    /// Bags: the `nav_msgs/Odometry` topic (default: the only one, else `/tf` from `odom`).
+    #[arg(long, value_name = "TOPIC", conflicts_with_all = ["odom_frame", "no_odometry"])]
+    odom_topic: Option<String>,
+    /// Bags: take the odometry from /tf, from this frame to the body frame.
+    #[arg(long, value_name = "FRAME", conflicts_with = "no_odometry")]
+    odom_frame: Option<String>,
+    /// Ignore the recording's odometry: LiDAR-only.
+    #[arg(long)]
+    no_odometry: bool,
+    /// Bags: the body frame (default: the odometry's child frame).
+    #[arg(long, value_name = "FRAME")]
+    base_frame: Option<String>,
+    /// Bags: the LiDAR frame (default: the clouds' `frame_id`).
+    #[arg(long, value_name = "FRAME")]
+    lidar_frame: Option<String>,
+    /// Scan folders: the LiDAR pose in the body frame, `tx,ty,tz,qx,qy,qz,qw` (default
+    /// identity).
+    #[arg(long, value_name = "POSE", value_parser = parse_pose, allow_negative_numbers = true)]
+    calibration: Option<Pose3>,
+    /// Scan folders: a TUM file of the body's odometry (default: none, LiDAR-only).
+    #[arg(long, value_name = "FILE")]
+    odometry: Option<PathBuf>,
+    /// Points closer than this to the sensor (metres) are no-returns and removed.
+    #[arg(long, value_name = "M", default_value_t = 0.1)]
+    min_range: f32,
+    /// Bags: the longest sweep (seconds) per-point times may span.
+    #[arg(long, value_name = "S", default_value_t = 0.25)]
+    max_scan_period: f64,
+    /// Bags: the per-point time unit (default: decided from the first cloud).
+    #[arg(long, value_enum, value_name = "UNIT")]
+    time_unit: Option<TimeUnitArg>,
+    /// Height of the LiDAR above the floor (metres), where the grid looks for the floor.
+    #[arg(long, value_name = "H", default_value_t = 0.8)]
+    lidar_height: f64,
     /// Seed of the simulated building, sensor noise and odometry drift (without a recording).
     #[arg(
         long,
@@ -50,13 +122,59 @@ struct Args {
     /// Turn off the engine's deskewing of scans with per-point times.
     #[arg(long)]
     no_deskew: bool,
-    /// Write the map, trajectory and pose graph to this folder.
+    /// Write the map, trajectory, pose graph and grid to this folder.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
 
+/// `tx,ty,tz,qx,qy,qz,qw` as a pose.
+fn parse_pose(text: &str) -> Result<Pose3, String> {
+    let v = parse_numbers::<7>(text)?;
+    let q = quaternion_from_xyzw([v[3], v[4], v[5], v[6]])
+        .ok_or_else(|| "the quaternion is not of unit length".to_owned())?;
+    Ok(Pose3::from_parts(Translation3::new(v[0], v[1], v[2]), q))
+}
+
 fn main() -> ExitCode {
     spot_nav_examples::run(|| slam(&Args::parse()))
+}
+
+/// How to open the recording, from the options.
+fn source_config(args: &Args) -> SourceConfig {
+    let odometry = match (&args.odom_topic, &args.odom_frame, args.no_odometry) {
+        (_, _, true) => OdometrySource::None,
+        (Some(t), _, _) => OdometrySource::Topic(t.clone()),
+        (_, Some(f), _) => OdometrySource::Tf {
+            odom_frame: f.clone(),
+        },
+        _ => OdometrySource::Auto,
+    };
+    SourceConfig {
+        bag: BagConfig {
+            cloud_topic: args.cloud_topic.clone(),
+            odometry,
+            base_frame: args.base_frame.clone(),
+            lidar_frame: args.lidar_frame.clone(),
+            cloud: PointCloud2Config {
+                returns: ReturnFilter {
+                    min_range: args.min_range,
+                },
+                max_scan_period: args.max_scan_period,
+                time_unit: args.time_unit.map(|u| match u {
+                    TimeUnitArg::S => TimeUnit::SecondsRelative,
+                    TimeUnitArg::Ns => TimeUnit::NanosecondsRelative,
+                    TimeUnitArg::SAbsolute => TimeUnit::SecondsAbsolute,
+                    TimeUnitArg::NsAbsolute => TimeUnit::NanosecondsAbsolute,
+                }),
+            },
+        },
+        body_t_lidar: args.calibration,
+        odometry: if args.no_odometry {
+            None
+        } else {
+            args.odometry.clone()
+        },
+    }
 }
 
 fn slam(args: &Args) -> Result<()> {
@@ -64,17 +182,35 @@ fn slam(args: &Args) -> Result<()> {
     if args.no_deskew {
         config.deskew = false;
     }
-    if let Some(dir) = &args.recording {
-        let rec = Recording::open(dir)?;
-        let body_t_lidar = rec.body_t_lidar();
-        let truth = rec.read_ground_truth()?;
+    if let Some(path) = &args.recording {
+        let source = open_recording(path, &source_config(args))?;
+        out!("{}", source.description)?;
+        let mut samples: Box<dyn SampleSource> = if source.has_odometry && !args.no_odometry {
+            source.samples
+        } else {
+            out!(
+                "odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess"
+            )?;
+            Box::new(ScanToScanOdometry::new(
+                scan_to_scan_registrator(),
+                source.samples,
+                ScanToScanConfig::default(),
+            ))
+        };
         backend(
             args,
             config,
-            rec.into_iter(),
-            body_t_lidar,
-            truth.as_deref(),
-        )
+            &mut samples,
+            source.body_t_lidar,
+            source.ground_truth.as_deref(),
+        )?;
+        let dropped = samples.dropped_points();
+        out!(
+            "points      {} no-return and {} non-finite points removed",
+            dropped.no_return,
+            dropped.non_finite
+        )?;
+        Ok(())
     } else {
         let mut sim_config = SimulationConfig::with_seed(args.seed);
         sim_config.motion_distortion = args.skewed;
@@ -107,12 +243,12 @@ where
         Registration::PointToPlane => {
             let mut slam = point_to_plane_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
-            report(&slam, &mapping, args.out.as_deref())
+            report(&slam, &mapping, args)
         }
         Registration::Loam => {
             let mut slam = loam_slam(config)?;
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
-            report(&slam, &mapping, args.out.as_deref())
+            report(&slam, &mapping, args)
         }
     }
 }
@@ -121,7 +257,7 @@ where
 fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
     mapping: &spot_nav_examples::Mapping,
-    out: Option<&std::path::Path>,
+    args: &Args,
 ) -> Result<()> {
     let report = slam.report();
     out!(
@@ -169,14 +305,53 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             ))
         )?;
     }
-    if let Some(dir) = out {
-        std::fs::create_dir_all(dir)?;
-        let map = slam.map(0.05)?;
-        write_ply(dir.join("map.ply"), &map, PlyEncoding::BinaryLittleEndian)?;
-        write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
-        write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
-        write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
-        out!("wrote       {}", dir.display())?;
+    if let Some(dir) = &args.out {
+        write_outputs(slam, mapping, dir, args.lidar_height)?;
+    }
+    Ok(())
+}
+
+/// The map, trajectory, graph and grid in `dir` (made here, after the run).
+fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    mapping: &spot_nav_examples::Mapping,
+    dir: &Path,
+    lidar_height: f64,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let map = slam.map(0.05)?;
+    write_ply(dir.join("map.ply"), &map, PlyEncoding::BinaryLittleEndian)?;
+    write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
+    write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
+    write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
+    let scans: Vec<_> = slam.keyframe_scans().collect();
+    match NavigationMap::from_scans(&scans, lidar_height, &NavigatorConfig::default()) {
+        Ok(navigation) => {
+            let grid = navigation.occupancy();
+            let planning = grid.to_planning_grid(UnknownCells::Free);
+            let inflated = inflate(&planning, INFLATION);
+            let path: Vec<_> = mapping
+                .estimate
+                .iter()
+                .filter_map(|p| {
+                    let t = p.pose.translation.vector;
+                    planning.cell_at(Vector2::new(t.x, t.y))
+                })
+                .collect();
+            gridmap::write_png(dir.join("grid.png"), grid, Some(&inflated), &path, &[])?;
+            gridmap::write_ros_map(grid, dir.join("map.yaml"))?;
+            out!(
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, grid.png, map.yaml + map.pgm",
+                dir.display()
+            )?;
+        }
+        Err(e) => {
+            eprintln!("note: no grid ({e:#}); is --lidar-height {lidar_height} m right?");
+            out!(
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o",
+                dir.display()
+            )?;
+        }
     }
     Ok(())
 }

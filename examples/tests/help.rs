@@ -10,6 +10,9 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+mod common;
+use common::example;
+
 /// Every example with the options its `--help` must name.
 const EXAMPLES: [(&str, &[&str]); 8] = [
     (
@@ -77,7 +80,12 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
     (
         "slam",
         &[
-            "RECORDING_DIR",
+            "PATH",
+            "--cloud-topic",
+            "--odom-topic",
+            "--odom-frame",
+            "--base-frame",
+            "--lidar-frame",
             "--seed",
             "--registration",
             "--skewed",
@@ -86,20 +94,6 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
         ],
     ),
 ];
-
-/// The built example `name`.
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().expect("the test's own path");
-    let profile = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("the test runs from target/<profile>/deps");
-    let path = profile
-        .join("examples")
-        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
-    assert!(path.is_file(), "{} is not built", path.display());
-    path
-}
 
 /// A path from the workspace root.
 fn bundled(relative: &str) -> PathBuf {

@@ -72,6 +72,34 @@ pub enum AdapterError {
         /// What is wrong.
         message: String,
     },
+    /// One message of a bag cannot be used.
+    #[error("{path}: topic {topic}, message {index}: {source}")]
+    Message {
+        /// The bag.
+        path: PathBuf,
+        /// The message's topic.
+        topic: String,
+        /// Its index among the topic's messages (from 0).
+        index: usize,
+        /// What is wrong (boxed: the error enum stays small).
+        source: Box<MessageError>,
+    },
+    /// An MCAP file cannot be read (truncated, corrupt, an unknown compression).
+    #[error("{path}: {source}")]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// The mcap crate's reason (boxed: it is large).
+        source: Box<mcap::McapError>,
+    },
+    /// A ROS 1 bag cannot be read (truncated, corrupt, unindexed).
+    #[error("{path}: {source}")]
+    Ros1Bag {
+        /// The file.
+        path: PathBuf,
+        /// The rosbag crate's reason.
+        source: rosbag::Error,
+    },
     /// A route's start or goal lies inside an obstacle or outside the building.
     #[error("{which} ({x:.2}, {y:.2}) m is not free floor")]
     BlockedEndpoint {
@@ -129,4 +157,126 @@ pub enum DriveError<E: std::error::Error + 'static> {
     /// The navigator failed.
     #[error("the navigator failed")]
     Navigation(#[source] AdapterError),
+}
+
+/// Why one message of a bag (or one cloud) cannot be used.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum MessageError {
+    /// The payload ends before a field it declares.
+    #[error("payload truncated: {needed} bytes needed at offset {offset}, {left} left")]
+    Truncated {
+        /// Byte offset in the payload.
+        offset: usize,
+        /// Bytes the field needs.
+        needed: usize,
+        /// Bytes left.
+        left: usize,
+    },
+    /// A CDR payload whose encapsulation is not plain CDR.
+    #[error("CDR encapsulation {kind:?} is not plain little- or big-endian CDR")]
+    Encapsulation {
+        /// The first two header bytes.
+        kind: [u8; 2],
+    },
+    /// A string is not UTF-8 (or, in CDR, lacks its terminating NUL).
+    #[error("invalid string at offset {offset}")]
+    InvalidString {
+        /// Byte offset of its length.
+        offset: usize,
+    },
+    /// The topic carries another message type than the reader needs there.
+    #[error("message type {found:?} where {expected} is needed")]
+    UnknownType {
+        /// The type the bag names.
+        found: String,
+        /// The type needed.
+        expected: &'static str,
+    },
+    /// A point cloud lacks a coordinate field.
+    #[error("the cloud has no {axis:?} field (fields: {fields})")]
+    MissingCoordinate {
+        /// `x`, `y` or `z`.
+        axis: &'static str,
+        /// The fields it has, comma-separated.
+        fields: String,
+    },
+    /// A point field has a datatype code outside `sensor_msgs/PointField`'s, or one unfit for
+    /// its role (a coordinate that is not a float).
+    #[error("field {field:?}: datatype {datatype} cannot be read as {role}")]
+    UnsupportedDatatype {
+        /// The field's name.
+        field: String,
+        /// Its datatype code.
+        datatype: u8,
+        /// What it was to be read as.
+        role: &'static str,
+    },
+    /// A point field does not fit inside one point.
+    #[error(
+        "field {field:?} (offset {offset}, {size} bytes) does not fit in a point of {point_step} bytes"
+    )]
+    FieldOutsidePoint {
+        /// The field's name.
+        field: String,
+        /// Its offset.
+        offset: u32,
+        /// Its size in bytes.
+        size: usize,
+        /// Bytes per point.
+        point_step: u32,
+    },
+    /// `width`, `height`, `point_step`, `row_step` and the data's length disagree.
+    #[error(
+        "cloud shape: {width} x {height} points of {point_step} bytes, rows of {row_step} bytes, \
+         {data_len} bytes of data"
+    )]
+    CloudShape {
+        /// Points per row.
+        width: u32,
+        /// Rows.
+        height: u32,
+        /// Bytes per point.
+        point_step: u32,
+        /// Bytes per row.
+        row_step: u32,
+        /// Bytes of data.
+        data_len: usize,
+    },
+    /// No unit makes the per-point times fit in one scan period after the header stamp (or more
+    /// than one does).
+    #[error(
+        "per-point time {field:?} in [{min}, {max}] (stamp {stamp} s): {problem} within a scan \
+         period of {period} s"
+    )]
+    TimeUnit {
+        /// The time field (or fields).
+        field: String,
+        /// Smallest raw value.
+        min: f64,
+        /// Largest raw value.
+        max: f64,
+        /// The header stamp (seconds).
+        stamp: f64,
+        /// The longest scan period allowed (seconds).
+        period: f64,
+        /// "no unit fits" or "seconds and nanoseconds both fit", or the unit that stopped fitting.
+        problem: String,
+    },
+    /// A pose with a non-finite value or a quaternion far from unit length.
+    #[error("{what} is not a valid pose (non-finite or non-unit quaternion)")]
+    InvalidPose {
+        /// Which pose.
+        what: &'static str,
+    },
+    /// The frame tree does not join two frames.
+    #[error("no transform from {parent:?} to {child:?} at {stamp} s in the tf messages")]
+    MissingTransform {
+        /// The frame looked up from.
+        parent: String,
+        /// The frame looked up.
+        child: String,
+        /// The time (seconds).
+        stamp: f64,
+    },
 }

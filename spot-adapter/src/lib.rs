@@ -10,8 +10,9 @@
 //!   building with obstacles that can be added later, a VLP-16 model, drifting leg odometry,
 //!   routes, [`SimulatedSpot`](sim::SimulatedSpot) (walks a route) and
 //!   [`CommandedSpot`](sim::CommandedSpot) (a `Robot` driven by commands).
-//! - [`record`]: recordings in: the spot-nav recording format and KITTI folders, streamed one
-//!   scan at a time.
+//! - [`record`]: recordings in, streamed one scan at a time: ROS 1 and ROS 2 (MCAP) bags,
+//!   KITTI sequences, folders of PCD/PLY scans and the spot-nav recording format, each opened
+//!   from its path by [`open_recording`](record::open_recording).
 //! - [`eval`]: accuracy against ground truth: ATE, drift, loop end-point error.
 //! - [`nav`]: the [`Navigator`](nav::Navigator) (localise, plan, command) and
 //!   [`drive`](nav::drive), which runs it on any `Robot`.
@@ -57,4 +58,4 @@ pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 
-pub use error::{AdapterError, DriveError};
+pub use error::{AdapterError, DriveError, MessageError};

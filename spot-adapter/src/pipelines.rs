@@ -66,6 +66,20 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
     }
 }
 
+/// Point-to-plane ICP for scan-to-scan odometry of a source without any
+/// ([`ScanToScanOdometry`](crate::record::ScanToScanOdometry)): from a constant-velocity guess
+/// a few centimetres off, Tukey 20 cm, pairs within 1 m.
+#[must_use]
+pub fn scan_to_scan_registrator() -> PointToPlaneIcp {
+    PointToPlaneIcp {
+        config: IcpConfig {
+            kernel: IcpKernel::Tukey { k: 0.2 },
+            max_correspondence_distance: 1.0,
+            ..IcpConfig::default()
+        },
+    }
+}
+
 /// Point-to-plane odometry ([`point_to_plane_tracker`]) against the local map, and
 /// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m), with `config` (usually
 /// [`slam_config`]).

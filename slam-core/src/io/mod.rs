@@ -33,6 +33,7 @@ pub use kitti::{
 };
 pub use pcd::{PcdEncoding, parse_pcd, read_pcd, write_pcd, write_pcd_to};
 pub use ply::{PlyEncoding, parse_ply, read_ply, write_ply, write_ply_to};
+pub use scalar::Scalar;
 pub use tum::{
     StampedPose, TUM_HEADER, parse_tum, read_tum, write_tum, write_tum_line, write_tum_to,
 };

@@ -2,9 +2,11 @@
 
 use crate::error::FormatError;
 
-/// A scalar type of a binary record field.
+/// A scalar type of a binary record field (PCD, PLY, and the fields of a ROS
+/// `sensor_msgs/PointCloud2`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Scalar {
+#[allow(missing_docs)] // the variants are the Rust primitive types they name
+pub enum Scalar {
     I8,
     U8,
     I16,
@@ -19,7 +21,8 @@ pub(crate) enum Scalar {
 
 impl Scalar {
     /// Size in bytes.
-    pub(crate) fn size(self) -> usize {
+    #[must_use]
+    pub fn size(self) -> usize {
         match self {
             Self::I8 | Self::U8 => 1,
             Self::I16 | Self::U16 => 2,
@@ -29,13 +32,18 @@ impl Scalar {
     }
 
     /// Whether the type is an integer type.
-    pub(crate) fn is_integer(self) -> bool {
+    #[must_use]
+    pub fn is_integer(self) -> bool {
         !matches!(self, Self::F32 | Self::F64)
     }
 
-    /// Decode one value at the start of `b` (at least `size()` bytes) as f64.
+    /// Decode one value at the start of `b` as f64.
+    ///
+    /// # Panics
+    /// If `b` is shorter than [`Scalar::size`].
     #[inline]
-    pub(crate) fn read(self, b: &[u8], little_endian: bool) -> f64 {
+    #[must_use]
+    pub fn read(self, b: &[u8], little_endian: bool) -> f64 {
         macro_rules! get {
             ($t:ty, $n:expr) => {{
                 let mut a = [0u8; $n];

@@ -1,12 +1,86 @@
-//! Recordings in: the spot-nav recording format ([`Recording`], written by
-//! [`RecordingWriter`]) and KITTI-style sequence folders ([`KittiSequence`]), each a source of
-//! [`Sample`](crate::robot::Sample)s read one scan at a time, interchangeable with a simulated
-//! run for the engine.
+//! Recordings in ([`open_recording`] opens any of them from its path), each a source of [`Sample`](crate::robot::Sample)s read one scan at a time,
+//! interchangeable with a simulated run for the engine:
+//!
+//! - the spot-nav recording format ([`Recording`], written by [`RecordingWriter`]);
+//! - KITTI odometry sequences ([`KittiSequence`]);
+//! - folders of PCD or PLY scans with an optional TUM odometry file ([`CloudFolder`]);
+//! - ROS 1 bags and ROS 2 bags in MCAP ([`Bag`]): `sensor_msgs/PointCloud2` in any field
+//!   layout ([`PointCloud2Decoder`]), `nav_msgs/Odometry`, `tf2_msgs/TFMessage`,
+//!   `sensor_msgs/Imu`.
+//!
+//! Every reader removes no-return points (exact zeros, points inside a minimum range) and
+//! non-finite ones, and counts them ([`ReturnFilter`], [`DroppedPoints`]). A source without
+//! odometry gets it from its scans with [`ScanToScanOdometry`].
+//!
+//! A cloud as a driver publishes it (Ouster's convention: integer nanoseconds under `t`, a
+//! no-return at the origin), decoded:
+//!
+//! ```
+//! use spot_adapter::record::{
+//!     Header, PointCloud2, PointCloud2Config, PointCloud2Decoder, PointField, TimeUnit,
+//! };
+//!
+//! let field = |name: &str, offset, datatype| PointField { name: name.into(), offset, datatype, count: 1 };
+//! let mut data = Vec::new();
+//! for (x, t_ns) in [(2.0f32, 0u32), (0.0, 50_000_000), (3.0, 99_000_000)] {
+//!     for v in [x, 1.0, 0.5] {
+//!         data.extend_from_slice(&v.to_le_bytes()); // x y z float32
+//!     }
+//!     data.extend_from_slice(&t_ns.to_le_bytes()); // t uint32
+//! }
+//! data[16..28].fill(0); // the second point: no return
+//! let msg = PointCloud2 {
+//!     header: Header { stamp: 1.7e9, frame_id: "os_sensor".into() },
+//!     height: 1,
+//!     width: 3,
+//!     fields: vec![field("x", 0, 7), field("y", 4, 7), field("z", 8, 7), field("t", 12, 6)],
+//!     is_bigendian: false,
+//!     point_step: 16,
+//!     row_step: 48,
+//!     data: &data,
+//! };
+//! let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+//! let decoded = decoder.decode(&msg)?;
+//! assert_eq!(decoder.time_unit(), Some(TimeUnit::NanosecondsRelative));
+//! assert_eq!(decoded.cloud.len(), 2);
+//! assert_eq!(decoded.dropped.no_return, 1);
+//! assert_eq!(decoded.cloud.time(), Some(&[0.0, 0.099][..]));
+//! # Ok::<(), spot_adapter::MessageError>(())
+//! ```
 //!
 //! Uses `robot` (the sample type) and `slam-core`'s file formats only.
 
+mod bag;
+mod bag_file;
+mod bag_samples;
+mod cloud_folder;
+mod frame_tree;
 mod kitti;
+mod lidar_only;
+mod no_return;
+mod point_cloud2;
 mod recording;
+mod ros_messages;
+mod source;
+mod wire;
 
+pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
+pub use bag_file::{BagFormat, TopicInfo};
+pub use bag_samples::BagSamples;
+pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
+pub use frame_tree::{FrameTree, PoseSeries};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
+pub use lidar_only::{ScanToScanConfig, ScanToScanOdometry};
+pub use no_return::{DroppedPoints, PointKind, ReturnFilter};
+pub use point_cloud2::{
+    CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,
+    TimeUnit,
+};
 pub use recording::{Recording, RecordingSamples, RecordingWriter};
+pub use ros_messages::{
+    Header, ImuReading, Odometry, PointCloud2, PointField, RosMessageType, TransformStamped,
+};
+pub use source::{
+    OpenedSource, RecordingKind, ReturnFiltered, SampleSource, SourceConfig, detect, open_recording,
+};
+pub use wire::Wire;

@@ -1,0 +1,236 @@
+//! A bag's samples read one message at a time: clouds decoded when their message comes, held
+//! until the odometry after their stamp has been read, then given with `odom_T_body`
+//! interpolated at the stamp and the fixed `body_T_lidar`. Moving transforms and odometry older
+//! than the oldest waiting cloud are forgotten, so memory does not grow with the bag.
+
+use std::collections::{HashMap, VecDeque};
+
+use slam_core::{PointCloud, Pose3};
+
+use crate::error::{AdapterError, MessageError};
+use crate::record::bag::{
+    Bag, Decoded, ResolvedOdometry, cloud_header, decode, message_error, tf_kind,
+};
+use crate::record::bag_file::{BagMessages, RawMessage};
+use crate::record::frame_tree::{FrameTree, PoseSeries};
+use crate::record::no_return::DroppedPoints;
+use crate::record::ros_messages::{ImuReading, RosMessageType};
+use crate::robot::Sample;
+
+/// A bag's samples, read one message at a time (from [`Bag::samples`]).
+#[derive(Debug)]
+pub struct BagSamples {
+    messages: BagMessages,
+    bag: Bag,
+    tree: FrameTree,
+    odometry: PoseSeries,
+    /// Clouds waiting for the odometry after their stamp.
+    pending: VecDeque<(usize, f64, PointCloud)>,
+    counters: HashMap<String, usize>,
+    dropped: DroppedPoints,
+    imu: Vec<ImuReading>,
+    imu_before_last: Vec<ImuReading>,
+    left: usize,
+    done: bool,
+}
+
+/// Whether the odometry at a stamp is known yet.
+enum OdometryAt {
+    Known(Pose3),
+    NotYet,
+}
+
+impl BagSamples {
+    pub(super) fn new(bag: Bag, messages: BagMessages) -> Self {
+        Self {
+            messages,
+            tree: bag.fixed.clone(),
+            left: bag.summary.clouds,
+            bag,
+            odometry: PoseSeries::default(),
+            pending: VecDeque::new(),
+            counters: HashMap::new(),
+            dropped: DroppedPoints::default(),
+            imu: Vec::new(),
+            imu_before_last: Vec::new(),
+            done: false,
+        }
+    }
+
+    /// Points removed from the clouds delivered so far.
+    #[must_use]
+    pub fn dropped_points(&self) -> DroppedPoints {
+        self.dropped
+    }
+
+    /// The IMU readings read between the previous sample and the last one delivered.
+    #[must_use]
+    pub fn imu_before_last_sample(&self) -> &[ImuReading] {
+        &self.imu_before_last
+    }
+
+    fn odometry_at(&self, stamp: f64) -> Result<OdometryAt, MessageError> {
+        let summary = &self.bag.summary;
+        match &summary.odometry {
+            ResolvedOdometry::None => Ok(OdometryAt::Known(Pose3::identity())),
+            ResolvedOdometry::Topic(_) => match self.odometry.last_stamp() {
+                Some(last) if last >= stamp => {
+                    self.odometry.at(stamp).map(OdometryAt::Known).ok_or(
+                        MessageError::MissingTransform {
+                            parent: "odometry".into(),
+                            child: summary.base_frame.clone(),
+                            stamp,
+                        },
+                    )
+                }
+                _ => Ok(OdometryAt::NotYet),
+            },
+            ResolvedOdometry::Tf { odom_frame } => {
+                match self.tree.known_span(odom_frame, &summary.base_frame) {
+                    Some((_, until)) if until >= stamp => self
+                        .tree
+                        .lookup(odom_frame, &summary.base_frame, stamp)
+                        .map(OdometryAt::Known)
+                        .ok_or_else(|| MessageError::MissingTransform {
+                            parent: odom_frame.clone(),
+                            child: summary.base_frame.clone(),
+                            stamp,
+                        }),
+                    _ => Ok(OdometryAt::NotYet),
+                }
+            }
+        }
+    }
+
+    /// Take in one message.
+    fn take(&mut self, msg: &RawMessage) -> Result<(), AdapterError> {
+        let path = self.bag.summary.path.clone();
+        let name = &msg.topic.name;
+        let counter = self.counters.entry(name.clone()).or_default();
+        let index = *counter;
+        *counter += 1;
+        let at = |e| message_error(&path, name, index, e);
+        let summary = &self.bag.summary;
+        if *name == summary.cloud_topic {
+            let stamp = cloud_header(msg).map_err(at)?.stamp;
+            let (from, until) = self.bag.span;
+            if stamp < from || stamp > until {
+                return Ok(());
+            }
+            let Some(Decoded::Cloud(cloud)) = decode(msg).map_err(at)? else {
+                return Ok(());
+            };
+            let decoded = self.bag.decoder.decode(&cloud).map_err(at)?;
+            self.dropped.add(decoded.dropped);
+            self.pending.push_back((index, stamp, decoded.cloud));
+            return Ok(());
+        }
+        let odometry_topic = matches!(&summary.odometry, ResolvedOdometry::Topic(t) if t == name);
+        let tf = tf_kind(name).is_some();
+        if !(odometry_topic || tf || msg.topic.message_type == Some(RosMessageType::Imu)) {
+            return Ok(());
+        }
+        match decode(msg).map_err(at)? {
+            Some(Decoded::Odometry(o)) if odometry_topic => {
+                self.odometry.push(o.header.stamp, o.pose);
+            }
+            Some(Decoded::Tf(transforms, false)) => {
+                for t in transforms {
+                    self.tree.push_moving(
+                        &t.header.frame_id,
+                        &t.child_frame_id,
+                        t.header.stamp,
+                        t.transform,
+                    );
+                }
+            }
+            Some(Decoded::Imu(reading)) => self.imu.push(reading),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn next_sample(&mut self) -> Result<Option<Sample>, AdapterError> {
+        loop {
+            if let Some(&(index, stamp, _)) = self.pending.front() {
+                let known = self.odometry_at(stamp).map_err(|e| {
+                    message_error(
+                        &self.bag.summary.path,
+                        &self.bag.summary.cloud_topic,
+                        index,
+                        e,
+                    )
+                })?;
+                if let OdometryAt::Known(odom_t_body) = known {
+                    let Some((_, _, cloud)) = self.pending.pop_front() else {
+                        continue;
+                    };
+                    // The next cloud's stamp (or this one's) bounds what is still needed.
+                    let keep_from = self.pending.front().map_or(stamp, |p| p.1.min(stamp));
+                    self.odometry.prune_before(keep_from);
+                    self.tree.prune_before(keep_from);
+                    self.imu_before_last = std::mem::take(&mut self.imu);
+                    return Ok(Some(Sample {
+                        stamp,
+                        odom_t_body,
+                        body_t_lidar: self.bag.summary.body_t_lidar,
+                        cloud,
+                        ground_truth: None,
+                    }));
+                }
+            }
+            let Some(msg) = self.messages.next() else {
+                if let Some(&(index, stamp, _)) = self.pending.front() {
+                    let summary = &self.bag.summary;
+                    return Err(message_error(
+                        &summary.path,
+                        &summary.cloud_topic,
+                        index,
+                        MessageError::MissingTransform {
+                            parent: "odometry".into(),
+                            child: summary.base_frame.clone(),
+                            stamp,
+                        },
+                    ));
+                }
+                return Ok(None);
+            };
+            self.take(&msg?)?;
+        }
+    }
+}
+
+impl Iterator for BagSamples {
+    type Item = Result<Sample, AdapterError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done || self.left == 0 {
+            return None;
+        }
+        match self.next_sample() {
+            Ok(Some(sample)) => {
+                self.left -= 1;
+                Some(Ok(sample))
+            }
+            Ok(None) => {
+                self.done = true;
+                None
+            }
+            Err(e) => {
+                self.done = true;
+                Some(Err(e))
+            }
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.len();
+        (n, Some(n))
+    }
+}
+
+impl ExactSizeIterator for BagSamples {
+    fn len(&self) -> usize {
+        if self.done { 0 } else { self.left }
+    }
+}
