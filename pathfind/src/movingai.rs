@@ -40,13 +40,22 @@ fn read_text(path: &Path) -> Result<String, PathfindError> {
 /// Parse a `.map` file.
 ///
 /// # Errors
-/// [`PathfindError::Parse`] with the line number for a bad header, a row of the wrong length,
-/// too few rows or an unknown letter.
+/// [`PathfindError::Parse`] with the line number for a bad header, a header whose size the
+/// text after it cannot hold (checked before anything is allocated), a row of the wrong length,
+/// too few rows or an unknown letter; [`PathfindError::Grid`] past [`slam_core::MAX_GRID_CELLS`].
 pub fn parse_map(text: &str) -> Result<MovingAiMap, PathfindError> {
-    let mut lines = text.lines().enumerate();
     let (mut width, mut height) = (None, None);
+    // The text after the line read last, and that line's 1-based number.
+    let mut rest = text;
+    let mut header_lines = 0;
     loop {
-        let (k, line) = lines.next().ok_or_else(|| parse_err(0, "no 'map' line"))?;
+        if rest.is_empty() {
+            return Err(parse_err(0, "no 'map' line"));
+        }
+        let (line, tail) = rest.split_once('\n').unwrap_or((rest, ""));
+        rest = tail;
+        header_lines += 1;
+        let k = header_lines - 1;
         let mut words = line.split_whitespace();
         match (words.next(), words.next()) {
             (Some("type"), Some(_)) | (None, _) => {}
@@ -68,6 +77,21 @@ pub fn parse_map(text: &str) -> Result<MovingAiMap, PathfindError> {
     }
     let width = width.ok_or_else(|| parse_err(0, "no width line"))?;
     let height = height.ok_or_else(|| parse_err(0, "no height line"))?;
+    // One letter per cell must follow: allocate for the map only once the text can hold it.
+    let cells = u64::from(width) * u64::from(height);
+    if cells > rest.len() as u64 {
+        return Err(parse_err(
+            header_lines,
+            format!(
+                "the header states {width}x{height} = {cells} cells but only {} bytes follow",
+                rest.len()
+            ),
+        ));
+    }
+    let mut lines = rest
+        .lines()
+        .enumerate()
+        .map(|(k, line)| (k + header_lines, line));
     let mut grid = BitGrid::new(width, height)?;
     let mut terrain = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {

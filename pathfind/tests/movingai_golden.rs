@@ -89,7 +89,9 @@ fn readers_reject_malformed_files() {
     assert_eq!(m.grid.count_blocked(), 2);
     assert_eq!(m.terrain, b".@.GST");
     for (bad, line) in [
-        ("type octile\nheight 2\nwidth 3\nmap\n.@.\n", 0),
+        // 6 cells stated, 4 bytes after the `map` line: refused at that line, before allocating.
+        ("type octile\nheight 2\nwidth 3\nmap\n.@.\n", 4),
+        ("type octile\nheight 2\nwidth 3\nmap\n.@.\r\r\r\n", 0),
         ("type octile\nheight 2\nwidth 3\nmap\n.@\nGST\n", 5),
         ("type octile\nheight 2\nwidth 3\nmap\n.@.\nGSX\n", 6),
         ("type octile\nheight x\nwidth 3\nmap\n", 2),
