@@ -1,5 +1,6 @@
 //! Moving AI grid benchmark files (Sturtevant 2012): `.map` grids and `.map.scen` scenarios.
 
+use std::fmt::Write as _;
 use std::path::Path;
 
 use slam_core::{BitGrid, Cell};
@@ -129,6 +130,20 @@ pub fn read_map(path: impl AsRef<Path>) -> Result<MovingAiMap, PathfindError> {
     parse_map(&read_text(path.as_ref())?)
 }
 
+/// The `.map` text of `map` (octile type, the terrain letters row by row): reads back to the
+/// same grid and letters.
+#[must_use]
+pub fn map_text(map: &MovingAiMap) -> String {
+    let (w, h) = (map.grid.width(), map.grid.height());
+    let mut s = format!("type octile\nheight {h}\nwidth {w}\nmap\n");
+    s.reserve(map.terrain.len() + h as usize);
+    for row in map.terrain.chunks(w as usize) {
+        s.extend(row.iter().map(|&b| char::from(b)));
+        s.push('\n');
+    }
+    s
+}
+
 /// One benchmark query.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
@@ -207,6 +222,29 @@ pub fn parse_scenarios(text: &str) -> Result<Vec<Scenario>, PathfindError> {
         });
     }
     Ok(out)
+}
+
+/// The `.scen` text of `scenarios` (`version 1`, tab-separated, lengths printed so they read
+/// back exactly). Each read-back tolerance is that of a `version 1` file.
+#[must_use]
+pub fn scenarios_text(scenarios: &[Scenario]) -> String {
+    let mut s = String::from("version 1\n");
+    for q in scenarios {
+        let _ = writeln!(
+            s,
+            "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:?}",
+            q.bucket,
+            q.map,
+            q.map_width,
+            q.map_height,
+            q.start.x,
+            q.start.y,
+            q.goal.x,
+            q.goal.y,
+            q.optimal_length
+        );
+    }
+    s
 }
 
 /// Read a `.scen` file.

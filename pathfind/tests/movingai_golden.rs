@@ -113,3 +113,20 @@ fn readers_reject_malformed_files() {
         Err(pathfind::PathfindError::Parse { line: 2, .. })
     ));
 }
+
+/// The writers read back to the same map and queries (a real map and its scenarios).
+#[test]
+fn written_maps_and_scenarios_read_back() {
+    let map = read_map(data("arena.map")).unwrap();
+    let back = parse_map(&pathfind::movingai::map_text(&map)).unwrap();
+    assert_eq!((back.grid, back.terrain), (map.grid, map.terrain));
+    let scen = read_scenarios(data("arena.map.scen")).unwrap();
+    let back = parse_scenarios(&pathfind::movingai::scenarios_text(&scen)).unwrap();
+    assert_eq!(back.len(), scen.len());
+    for (a, b) in back.iter().zip(&scen) {
+        assert_eq!(
+            (a.bucket, &a.map, a.start, a.goal, a.optimal_length),
+            (b.bucket, &b.map, b.start, b.goal, b.optimal_length)
+        );
+    }
+}
