@@ -401,7 +401,7 @@ fn ros_map_yaml_refuses_nan_thresholds_and_odd_negate() {
     }
     let yaml = RosMapYaml::parse(&format!("{base}negate: 1\nfree_thresh: 0.25\n")).unwrap();
     assert!(yaml.negate);
-    assert_eq!(yaml.free_thresh, 0.25);
+    assert_eq!(yaml.free_thresh.to_bits(), 0.25f64.to_bits());
     assert_eq!(RosMapYaml::parse(&yaml.to_text()).unwrap(), yaml);
 }
 
