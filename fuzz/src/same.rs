@@ -1,6 +1,6 @@
 //! What "reads back the same" means for each kind of data.
 
-use slam_core::{PointCloud, Pose3};
+use slam_core::{PointCloud, Pose2, Pose3};
 
 /// Two f32 values are the same datum: equal bits, or both NaN (a NaN's payload may change
 /// through the readers' f64 conversion and through text).
@@ -39,5 +39,14 @@ pub fn assert_close_pose(a: &Pose3, b: &Pose3, tol: f64, what: &str) {
     let scale = a.translation.vector.norm().max(1.0);
     assert!(dt <= tol * scale, "{what}: translation moved {dt}");
     let dr = a.rotation.angle_to(&b.rotation);
+    assert!(dr <= tol, "{what}: rotation moved {dr} rad");
+}
+
+/// Panic unless two planar poses agree to `tol` (metres, and radians of rotation).
+pub fn assert_close_pose2(a: &Pose2, b: &Pose2, tol: f64, what: &str) {
+    let dt = (a.translation.vector - b.translation.vector).norm();
+    let scale = a.translation.vector.norm().max(1.0);
+    assert!(dt <= tol * scale, "{what}: translation moved {dt}");
+    let dr = a.rotation.angle_to(&b.rotation).abs();
     assert!(dr <= tol, "{what}: rotation moved {dr} rad");
 }
