@@ -80,7 +80,7 @@ impl RosMapYaml {
                 }
             };
             match key.trim() {
-                "image" => image = Some(value.trim_matches(|c| c == '"' || c == '\'').to_string()),
+                "image" => image = Some(unquote(value).to_string()),
                 "resolution" => resolution = Some(num(value)?),
                 "origin" => {
                     let inner = value.trim_start_matches('[').trim_end_matches(']');
@@ -127,11 +127,12 @@ impl RosMapYaml {
     }
 
     /// The YAML text `map_saver` would write for these keys (floats printed so they read back
-    /// exactly).
+    /// exactly; the image name quoted when it must be, e.g. for a leading space). A name with `#`
+    /// or a line break cannot be written (nor read: `#` starts a comment).
     #[must_use]
     pub fn to_text(&self) -> String {
         let mut yaml = String::new();
-        let _ = writeln!(yaml, "image: {}", self.image);
+        let _ = writeln!(yaml, "image: {}", quote_if_needed(&self.image));
         let _ = writeln!(yaml, "mode: trinary");
         let _ = writeln!(yaml, "resolution: {:?}", self.resolution);
         let _ = writeln!(
@@ -195,6 +196,25 @@ impl RosMapYaml {
             grid.set(Cell::new(px, h - 1 - py), state)?;
         }
         Ok(grid)
+    }
+}
+
+/// `value` without one pair of enclosing quotes (`"..."` or `'...'`), else as it is.
+fn unquote(value: &str) -> &str {
+    for q in ['"', '\''] {
+        if let Some(inner) = value.strip_prefix(q).and_then(|rest| rest.strip_suffix(q)) {
+            return inner;
+        }
+    }
+    value
+}
+
+/// `name` as a YAML value that [`unquote`] reads back to `name` after the line is trimmed.
+fn quote_if_needed(name: &str) -> String {
+    if !name.is_empty() && name.trim() == name && unquote(name) == name {
+        name.to_owned()
+    } else {
+        format!("'{name}'")
     }
 }
 

@@ -440,3 +440,21 @@ fn ros_map_image_must_be_a_regular_file() {
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Found by fuzzing (`fuzz/regressions/ros_map`): `image:' arena.pgm` read as " arena.pgm" (a
+/// lone quote stripped) and was written back unquoted, so it read back as "arena.pgm".
+#[test]
+fn ros_map_image_names_read_back_as_written() {
+    for (line, name) in [
+        ("image:' arena.pgm", "' arena.pgm"),
+        ("image: \" arena.pgm\"", " arena.pgm"),
+        ("image: '\"a\"'", "\"a\""),
+        ("image: \"\"", ""),
+        ("image: maps/a:b.pgm", "maps/a:b.pgm"),
+    ] {
+        let yaml =
+            RosMapYaml::parse(&format!("{line}\nresolution: 0.05\norigin: [0, 0, 0]\n")).unwrap();
+        assert_eq!(yaml.image, name, "{line}");
+        assert_eq!(RosMapYaml::parse(&yaml.to_text()).unwrap(), yaml, "{line}");
+    }
+}
