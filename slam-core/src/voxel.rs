@@ -17,6 +17,9 @@ struct Accumulator {
     ring: u16,
 }
 
+/// 2^63, exact in f64: the first voxel coordinate an i64 key cannot hold.
+const TWO_POW_63: f64 = (1u64 << 63) as f64;
+
 /// Integer voxel coordinates of `p`, `Ok(None)` when `p` is not finite, `Err(())` when a finite
 /// coordinate is more than 2^63 voxels from the origin.
 #[inline]
@@ -28,7 +31,7 @@ fn voxel_key(p: &Point3<f32>, inv: f64) -> Result<Option<(i64, i64, i64)>, ()> {
         let x = f64::from(v) * inv;
         // 2^63 is exact in f64; i64 keys reach every finite point a metre-scale voxel can see
         // (i32 keys lost finite points beyond 2 m at 1 nm voxels).
-        if !(-9.223_372_036_854_775_808e18..9.223_372_036_854_775_808e18).contains(&x) {
+        if !(-TWO_POW_63..TWO_POW_63).contains(&x) {
             return Err(());
         }
         // Truncate, then step down for negatives: `f64::floor` is a library call on baseline
