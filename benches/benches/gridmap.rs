@@ -61,6 +61,7 @@ fn grid(c: &mut Criterion) {
             b.iter(|| {
                 let g = builder.build(&cloud, 0.5).unwrap_or_else(|e| panic!("{e}"));
                 inflate(&g.to_planning_grid(UnknownCells::Free), 0.25)
+                    .unwrap_or_else(|e| panic!("{e}"))
             });
         },
     );
@@ -70,7 +71,7 @@ fn grid(c: &mut Criterion) {
     group.throughput(Throughput::Elements(cells));
     let planning = sample.to_planning_grid(UnknownCells::Free);
     group.bench_function(BenchmarkId::new("inflate", format!("{cells}_cells")), |b| {
-        b.iter(|| inflate(&planning, 0.25));
+        b.iter(|| inflate(&planning, 0.25).unwrap_or_else(|e| panic!("{e}")));
     });
     group.finish();
 }

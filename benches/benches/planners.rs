@@ -4,7 +4,8 @@
 //! building the planner) is outside the timed loop. For the full table over every scenario see
 //! `planners_table`.
 //!
-//! `cargo bench -p spot-nav-benches --bench planners`
+//! `cargo bench -p spot-nav-benches --bench planners` (`SPOT_NAV_DATA` names the data folder,
+//! `PLANNERS_MAPS=den520d,AR0011SR` or `all` picks its maps)
 
 // A planner error on a scenario's free endpoints must stop the bench: its figures would be
 // meaningless.
@@ -14,14 +15,11 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_m
 use pathfind::movingai::{Scenario, read_map, read_scenarios};
 use pathfind::{AStar, JumpPointSearch, JumpPointSearchPlus};
 use slam_core::Planner;
-use spot_nav_benches::{data_root_or_notice, pathfinding_peer};
+use spot_nav_benches::{data_root_or_notice, pathfinding_peer, pick_movingai_maps};
 
-const MAPS: [(&str, &str); 4] = [
-    ("dao", "den520d"),
-    ("sc1", "Aftershock"),
-    ("rooms", "32room_000"),
-    ("random", "random512-25-0"),
-];
+/// The maps run unless `PLANNERS_MAPS` names others (any maps of the data folder's `movingai/`,
+/// comma-separated, or `all`).
+const DEFAULT_MAPS: [&str; 4] = ["den520d", "Aftershock", "32room_000", "random512-25-0"];
 
 fn run(planner: &mut impl Planner, scenarios: &[Scenario]) -> f64 {
     scenarios
@@ -39,7 +37,7 @@ fn planners(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("planners");
     group.sample_size(10);
-    for (set, name) in MAPS {
+    for (set, name) in pick_movingai_maps(&root, "PLANNERS_MAPS", &DEFAULT_MAPS) {
         let dir = root.join("movingai");
         let (Ok(map), Ok(all)) = (
             read_map(dir.join(format!("maps/{set}/{name}.map"))),
@@ -52,7 +50,7 @@ fn planners(c: &mut Criterion) {
         let sample: Vec<Scenario> = all.into_iter().step_by(stride).collect();
         let grid = &map.grid;
         group.throughput(Throughput::Elements(sample.len() as u64));
-        group.bench_function(BenchmarkId::new("pathfinding_astar_peer", name), |b| {
+        group.bench_function(BenchmarkId::new("pathfinding_astar_peer", &name), |b| {
             b.iter(|| {
                 sample
                     .iter()
@@ -61,19 +59,19 @@ fn planners(c: &mut Criterion) {
             });
         });
         let mut astar = AStar::new(grid);
-        group.bench_function(BenchmarkId::new("AStar", name), |b| {
+        group.bench_function(BenchmarkId::new("AStar", &name), |b| {
             b.iter(|| run(&mut astar, &sample));
         });
         let mut jps = JumpPointSearch::new(grid);
-        group.bench_function(BenchmarkId::new("JumpPointSearch", name), |b| {
+        group.bench_function(BenchmarkId::new("JumpPointSearch", &name), |b| {
             b.iter(|| run(&mut jps, &sample));
         });
         let mut jps_cells = JumpPointSearch::with_cell_scans(grid);
-        group.bench_function(BenchmarkId::new("JumpPointSearch_cells", name), |b| {
+        group.bench_function(BenchmarkId::new("JumpPointSearch_cells", &name), |b| {
             b.iter(|| run(&mut jps_cells, &sample));
         });
         if let Ok(mut tables) = JumpPointSearchPlus::new(grid) {
-            group.bench_function(BenchmarkId::new("JumpPointSearchPlus", name), |b| {
+            group.bench_function(BenchmarkId::new("JumpPointSearchPlus", &name), |b| {
                 b.iter(|| run(&mut tables, &sample));
             });
         }

@@ -1,7 +1,7 @@
 //! Shared helpers for the benches: where the benchmark data lives, and the peers measured in the
 //! same run.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use slam_core::{BitGrid, Cell};
 
@@ -29,6 +29,49 @@ pub fn data_root_or_notice(what: &str) -> Option<PathBuf> {
     }
 }
 
+/// The Moving AI maps of the data folder `root` (`movingai/maps/SET/NAME.map` with a
+/// `movingai/scenarios/SET/NAME.map.scen`), as `(set, name)` sorted by set and name.
+#[must_use]
+pub fn movingai_maps(root: &Path) -> Vec<(String, String)> {
+    let scenarios = root.join("movingai/scenarios");
+    let mut out = Vec::new();
+    let Ok(sets) = std::fs::read_dir(&scenarios) else {
+        return out;
+    };
+    for set in sets.flatten() {
+        let Ok(files) = std::fs::read_dir(set.path()) else {
+            continue;
+        };
+        let set = set.file_name().to_string_lossy().into_owned();
+        for file in files.flatten() {
+            let file = file.file_name().to_string_lossy().into_owned();
+            if let Some(name) = file.strip_suffix(".map.scen")
+                && root
+                    .join(format!("movingai/maps/{set}/{name}.map"))
+                    .is_file()
+            {
+                out.push((set.clone(), name.to_owned()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The maps a bench runs: those named in the comma-separated variable `var` (any map of the
+/// data folder, or `all`), else `default`'s that the folder has.
+#[must_use]
+pub fn pick_movingai_maps(root: &Path, var: &str, default: &[&str]) -> Vec<(String, String)> {
+    let found = movingai_maps(root);
+    let picked = std::env::var(var).ok();
+    let wanted = |name: &str| match picked.as_deref() {
+        Some("all") => true,
+        Some(list) => list.split(',').any(|m| m == name),
+        None => default.contains(&name),
+    };
+    found.into_iter().filter(|(_, name)| wanted(name)).collect()
+}
+
 /// The peer planner: the `pathfinding` crate's generic `astar`, the common Rust choice, with a
 /// successor closure that follows the same movement rule (8-connected, no corner cutting) and an
 /// octile heuristic. Costs are integers (`pathfinding` needs `Ord`): 1 = 1e-6 cells, so lengths
@@ -46,6 +89,16 @@ pub mod pathfinding_peer {
         let dy = u64::from(a.1.abs_diff(b.1));
         let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
         (hi - lo) * STRAIGHT + lo * DIAGONAL
+    }
+
+    /// How far the peer's length may lie from a scenario's optimum: the file's own tolerance
+    /// plus what the rounded diagonal cost adds (at most one rounding error per diagonal step, and
+    /// a path of length `L` has at most `L / sqrt 2` of them). A `version 1.0` file rounds to two
+    /// decimals, which leaves no room for the rounding error on long paths.
+    #[must_use]
+    pub fn length_tolerance(optimal_length: f64, file_tolerance: f64) -> f64 {
+        let per_diagonal = (DIAGONAL as f64 / STRAIGHT as f64 - std::f64::consts::SQRT_2).abs();
+        file_tolerance + optimal_length / std::f64::consts::SQRT_2 * per_diagonal
     }
 
     /// Shortest path length (in cells) from `start` to `goal`, or `None`.

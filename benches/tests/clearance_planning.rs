@@ -26,7 +26,7 @@ fn corridor_middle_and_door_through_the_planning_layer() {
     }
     let layer = PlanningGrid::new(&map, PlanningGridConfig::default()).unwrap();
     let (start, goal) = (Cell::new(5, 5), Cell::new(114, 5));
-    let closed = inflate(map.occupied(), 0.40);
+    let closed = inflate(map.occupied(), 0.40).unwrap();
     assert_eq!(AStar::new(&closed).plan(start, goal).unwrap(), None);
     let grid = layer.blocked();
     let found = CellCostAStar::new(grid, layer.step_costs())

@@ -85,7 +85,7 @@ fn grid(args: &Args) -> Result<()> {
     let grid = builder.build(&cloud, args.lidar_height)?;
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
-    let inflated = inflate(&grid.to_planning_grid(UnknownCells::Free), radius);
+    let inflated = inflate(&grid.to_planning_grid(UnknownCells::Free), radius)?;
     let inflate_ms = t.elapsed().as_secs_f64() * 1e3;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let pgm = write_ros_map(&grid, out.join("map.yaml"))?;

@@ -329,7 +329,7 @@ fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         Ok(navigation) => {
             let grid = navigation.occupancy();
             let planning = grid.to_planning_grid(UnknownCells::Free);
-            let inflated = inflate(&planning, INFLATION);
+            let inflated = inflate(&planning, INFLATION)?;
             let path: Vec<_> = mapping
                 .estimate
                 .iter()

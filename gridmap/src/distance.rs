@@ -4,6 +4,8 @@
 
 use slam_core::{BitGrid, Cell};
 
+use crate::error::{GridMapError, check};
+
 /// Squared value standing for "no obstacle on this line": above any real squared distance on
 /// grids up to 100,000 cells a side, small enough that `FAR + q^2` keeps its precision.
 const FAR: f64 = 1e12;
@@ -132,8 +134,17 @@ impl DistanceField {
 /// Inflate obstacles by `radius` metres as an exact Euclidean disc: a cell is blocked when its
 /// centre lies within `radius` of a blocked cell's centre. Computed from the distance transform,
 /// so the cost does not grow with the radius.
-#[must_use]
-pub fn inflate(grid: &BitGrid, radius: f64) -> BitGrid {
+///
+/// # Errors
+/// [`GridMapError::InvalidConfig`] unless `radius` is finite and at least zero (a negative
+/// radius is not read as its absolute value, and NaN does not skip the inflation).
+pub fn inflate(grid: &BitGrid, radius: f64) -> Result<BitGrid, GridMapError> {
+    check(
+        radius.is_finite() && radius >= 0.0,
+        "inflate radius",
+        radius,
+        "finite and at least 0 m",
+    )?;
     let r_cells = radius / grid.geometry().resolution;
     let limit = r_cells * r_cells;
     let d2 = squared_distance_cells(grid);
@@ -148,5 +159,5 @@ pub fn inflate(grid: &BitGrid, radius: f64) -> BitGrid {
             }
         }
     }
-    out
+    Ok(out)
 }

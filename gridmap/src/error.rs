@@ -95,6 +95,15 @@ pub enum GridMapError {
         /// What is wrong.
         message: String,
     },
+    /// A map YAML parsed from memory has a line that could not be parsed (from a file, the
+    /// error is [`GridMapError::Yaml`], which names the file).
+    #[error("map YAML line {line}: {message}")]
+    YamlText {
+        /// 1-based line (0 for a key missing from the whole text).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// The image codec failed.
     #[error("image {path}: {source}")]
     Image {

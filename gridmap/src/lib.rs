@@ -45,7 +45,7 @@
 //! let wall: Vec<Point3<f32>> = (0..400).map(|i| Point3::new(i as f32 * 0.01, 2.0, 0.5)).collect();
 //! let builder = OccupancyGridBuilder::new(OccupancyGridConfig::default())?;
 //! let grid = builder.build(&PointCloud::from_points(wall), 0.5)?;
-//! let planning = inflate(&grid.to_planning_grid(UnknownCells::Free), 0.25);
+//! let planning = inflate(&grid.to_planning_grid(UnknownCells::Free), 0.25)?;
 //! let wall_cell = grid.occupied().cell_at([1.0, 2.0].into()).unwrap();
 //! assert!(grid.occupied().is_blocked(wall_cell));
 //! assert!(planning.is_blocked(Cell::new(wall_cell.x, wall_cell.y - 2)), "0.2 m from the wall");
@@ -118,4 +118,4 @@ pub use picture::{colours, render, write_png};
 pub use planning::{
     CellRect, ClearanceCostConfig, PlanningGrid, PlanningGridConfig, clearance_step_costs,
 };
-pub use ros_map::{read_ros_map, write_ros_map};
+pub use ros_map::{RosMapYaml, read_ros_map, ros_map_pgm, ros_map_yaml, write_ros_map};

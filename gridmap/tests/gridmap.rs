@@ -5,8 +5,8 @@ use std::collections::BTreeSet;
 
 use gridmap::{
     CellState, DistanceField, GridMapError, LocalCell, LocalGrid, OccupancyGrid,
-    OccupancyGridBuilder, OccupancyGridConfig, UnknownCells, fuse_local_grid, inflate,
-    read_ros_map, squared_distance_cells, write_png, write_ros_map,
+    OccupancyGridBuilder, OccupancyGridConfig, RosMapYaml, UnknownCells, fuse_local_grid, inflate,
+    read_ros_map, ros_map_pgm, ros_map_yaml, squared_distance_cells, write_png, write_ros_map,
 };
 use nalgebra::{Point3, Vector2};
 use proptest::prelude::*;
@@ -163,7 +163,7 @@ proptest! {
     fn inflation_matches_brute_force_disc(w in 1u32..50, h in 1u32..50, density in 0u32..15, seed in any::<u64>(), radius in 0.0f64..0.6) {
         let res = 0.1;
         let grid = random_grid(w, h, density, seed).with_geometry(GridGeometry::try_new(Vector2::zeros(), res).unwrap());
-        let inflated = inflate(&grid, radius);
+        let inflated = inflate(&grid, radius).unwrap();
         let obstacles: Vec<Cell> = grid.blocked_cells().collect();
         let r = radius / res;
         for y in 0..h {
@@ -362,4 +362,99 @@ fn bad_input_gives_clear_errors() {
         small.build(&far, 0.5),
         Err(GridMapError::TooManyCells { .. })
     ));
+}
+
+#[test]
+fn inflate_refuses_negative_and_nan_radii() {
+    let grid = BitGrid::from_fn(9, 9, |x, y| x == 4 && y == 4).unwrap();
+    for radius in [-1.0, f64::NAN, f64::INFINITY] {
+        assert!(
+            matches!(
+                inflate(&grid, radius),
+                Err(GridMapError::InvalidConfig { .. })
+            ),
+            "{radius}"
+        );
+    }
+    // Zero keeps the obstacles as they are.
+    assert_eq!(inflate(&grid, 0.0).unwrap(), grid);
+}
+
+#[test]
+fn ros_map_yaml_refuses_nan_thresholds_and_odd_negate() {
+    let base = "image: map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n";
+    for (extra, line) in [
+        ("occupied_thresh: nan\n", 4),
+        ("free_thresh: NaN\n", 4),
+        ("free_thresh: 1.5\n", 4),
+        ("negate: nan\n", 4),
+        ("negate: 2\n", 4),
+    ] {
+        let text = format!("{base}{extra}");
+        assert!(
+            matches!(
+                RosMapYaml::parse(&text),
+                Err(GridMapError::YamlText { line: l, .. }) if l == line
+            ),
+            "{extra}"
+        );
+    }
+    let yaml = RosMapYaml::parse(&format!("{base}negate: 1\nfree_thresh: 0.25\n")).unwrap();
+    assert!(yaml.negate);
+    assert_eq!(yaml.free_thresh.to_bits(), 0.25f64.to_bits());
+    assert_eq!(RosMapYaml::parse(&yaml.to_text()).unwrap(), yaml);
+}
+
+#[test]
+fn ros_map_in_memory_matches_the_files() {
+    let geometry = GridGeometry::try_new(Vector2::new(-1.5, 2.25), 0.05).unwrap();
+    let mut grid = OccupancyGrid::new(5, 3, geometry, CellState::Free).unwrap();
+    grid.set(Cell::new(4, 0), CellState::Occupied).unwrap();
+    grid.set(Cell::new(0, 2), CellState::Unknown).unwrap();
+    let yaml = ros_map_yaml(&grid, "m.pgm");
+    let pgm = ros_map_pgm(&grid, std::path::Path::new("m.pgm")).unwrap();
+    let back = RosMapYaml::parse(&yaml.to_text())
+        .unwrap()
+        .grid_from_image(&pgm)
+        .unwrap();
+    assert_eq!(back, grid);
+    assert!(matches!(
+        yaml.grid_from_image(b"P5 not an image"),
+        Err(GridMapError::Image { .. })
+    ));
+}
+
+#[cfg(unix)]
+#[test]
+fn ros_map_image_must_be_a_regular_file() {
+    let dir = temp_dir("ros_dev");
+    let yaml = dir.join("dev.yaml");
+    std::fs::write(
+        &yaml,
+        "image: /dev/zero\nresolution: 0.05\norigin: [0, 0, 0]\n",
+    )
+    .unwrap();
+    assert!(matches!(
+        read_ros_map(&yaml),
+        Err(GridMapError::Io { source, .. }) if source.kind() == std::io::ErrorKind::InvalidInput
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Found by fuzzing (`fuzz/regressions/ros_map`): `image:' arena.pgm` read as " arena.pgm" (a
+/// lone quote stripped) and was written back unquoted, so it read back as "arena.pgm".
+#[test]
+fn ros_map_image_names_read_back_as_written() {
+    for (line, name) in [
+        ("image:' arena.pgm", "' arena.pgm"),
+        ("image: \" arena.pgm\"", " arena.pgm"),
+        ("image: '\"a\"'", "\"a\""),
+        ("image: \"\"", ""),
+        ("image: maps/a:b.pgm", "maps/a:b.pgm"),
+    ] {
+        let yaml =
+            RosMapYaml::parse(&format!("{line}\nresolution: 0.05\norigin: [0, 0, 0]\n")).unwrap();
+        assert_eq!(yaml.image, name, "{line}");
+        assert_eq!(RosMapYaml::parse(&yaml.to_text()).unwrap(), yaml, "{line}");
+    }
 }

@@ -64,7 +64,7 @@ proptest! {
         let cfg = config(blocked, inflation, weight);
         let layer = PlanningGrid::new(&occupancy, cfg.clone()).unwrap();
         let obstacles = occupancy.to_planning_grid(cfg.unknown);
-        prop_assert_eq!(layer.blocked(), &inflate(&obstacles, inflation));
+        prop_assert_eq!(layer.blocked(), &inflate(&obstacles, inflation).unwrap());
         let field = DistanceField::new(&obstacles);
         let reach = if weight > 0.0 { inflation.max(1.0) } else { inflation };
         let costs = clearance_step_costs(&field, &cfg.cost).unwrap();
@@ -154,7 +154,7 @@ fn a_door_of_0_9_m_stays_open_under_the_hard_inflation() {
     let open = open_rows(layer.blocked());
     assert_eq!(open.len(), 2, "{open:?}");
     assert!(open.iter().all(|y| (y - 3.0).abs() < 0.1));
-    assert!(open_rows(&inflate(occupancy.occupied(), 0.40)).is_empty());
+    assert!(open_rows(&inflate(occupancy.occupied(), 0.40).unwrap()).is_empty());
     // In the door, 0.4-0.5 m from the frame: multipliers 1 + 2 ((1 - d) / 0.7)^2.
     for y in open {
         let cell = layer.blocked().cell_at(Vector2::new(8.07, y)).unwrap();

@@ -370,7 +370,8 @@ impl<'g> CellCostAStar<'g> {
                 let m = f64::from(self.costs[(w[1].y * width + w[1].x) as usize]);
                 if diagonal { SQRT_2 * m } else { m }
             })
-            .sum();
+            // From +0.0: `sum()` of no steps is -0.0.
+            .fold(0.0, |a, b| a + b);
         CostedPath {
             path: GridPath {
                 length: path_cost(&cells),

@@ -6,15 +6,20 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum PathfindError {
-    /// JPS+ tables store distances as `i16`.
-    #[error("a {width}x{height} grid is too large for jump tables (at most {max_side} per side)")]
+    /// JPS+ tables store distances as `i16` (a side limit) and take 16 bytes per cell (a total
+    /// limit).
+    #[error(
+        "a {width}x{height} grid is too large for jump tables (at most {max_side} per side and {max_cells} cells)"
+    )]
     GridTooLargeForTables {
         /// Grid width.
         width: u32,
         /// Grid height.
         height: u32,
-        /// The limit.
+        /// The side limit.
         max_side: u32,
+        /// The total limit, [`MAX_JUMP_TABLE_CELLS`](crate::MAX_JUMP_TABLE_CELLS).
+        max_cells: u64,
     },
     /// A per-cell cost array does not have one value per cell.
     #[error("{got} cell costs for a {width}x{height} grid (one per cell expected)")]

@@ -5,7 +5,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::error::PathfindError;
 use crate::jump_search::JumpSearch;
-use crate::jump_tables::{JumpTables, MAX_TABLE_SIDE};
+use crate::jump_tables::{JumpTables, MAX_JUMP_TABLE_CELLS, MAX_TABLE_SIDE};
 
 /// JPS+: the search of [`JumpPointSearch`](crate::JumpPointSearch) with every jump read from
 /// tables built once per grid (the distance to the next jump point or wall from every cell in
@@ -24,13 +24,18 @@ impl<'g> JumpPointSearchPlus<'g> {
     ///
     /// # Errors
     /// [`PathfindError::GridTooLargeForTables`] when a side exceeds 32,767 cells (the tables
-    /// store distances as `i16`).
+    /// store distances as `i16`) or the grid has more than [`MAX_JUMP_TABLE_CELLS`] cells.
     pub fn new(grid: &'g BitGrid) -> Result<Self, PathfindError> {
-        if grid.width() > MAX_TABLE_SIDE || grid.height() > MAX_TABLE_SIDE {
+        let cells = u64::from(grid.width()) * u64::from(grid.height());
+        if grid.width() > MAX_TABLE_SIDE
+            || grid.height() > MAX_TABLE_SIDE
+            || cells > MAX_JUMP_TABLE_CELLS
+        {
             return Err(PathfindError::GridTooLargeForTables {
                 width: grid.width(),
                 height: grid.height(),
                 max_side: MAX_TABLE_SIDE,
+                max_cells: MAX_JUMP_TABLE_CELLS,
             });
         }
         Ok(Self {

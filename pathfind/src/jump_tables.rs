@@ -17,8 +17,12 @@ pub(crate) struct JumpTables {
 /// Largest grid side the `i16` tables can describe.
 pub(crate) const MAX_TABLE_SIDE: u32 = i16::MAX as u32;
 
+/// Most cells a grid may have for JPS+ tables: 2^28 (16,384 x 16,384), 4 GiB of tables.
+pub const MAX_JUMP_TABLE_CELLS: u64 = 1 << 28;
+
 impl JumpTables {
-    /// Build the tables; the caller checks both sides are at most [`MAX_TABLE_SIDE`].
+    /// Build the tables; the caller checks both sides are at most [`MAX_TABLE_SIDE`] and the cells
+    /// at most [`MAX_JUMP_TABLE_CELLS`].
     pub(crate) fn new(grid: &BitGrid) -> Self {
         let (w, h) = (grid.width(), grid.height());
         let mut t = Self {

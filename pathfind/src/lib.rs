@@ -73,5 +73,6 @@ pub use dijkstra::Dijkstra;
 pub use error::PathfindError;
 pub use jps::JumpPointSearch;
 pub use jps_plus::JumpPointSearchPlus;
+pub use jump_tables::MAX_JUMP_TABLE_CELLS;
 pub use line_of_sight::{line_of_sight, supercover_cells};
 pub use path_filter::{FilteredPath, filter_path};

@@ -50,7 +50,11 @@ pub fn can_step(grid: &BitGrid, x: i64, y: i64, dx: i64, dy: i64) -> bool {
 /// Cost of the cell path `cells` (consecutive cells joined by straight or diagonal runs).
 #[must_use]
 pub fn path_cost(cells: &[Cell]) -> f64 {
-    cells.windows(2).map(|w| octile(w[0], w[1])).sum()
+    // A fold from +0.0: `sum()` of no steps is -0.0, which a one-cell path must not report.
+    cells
+        .windows(2)
+        .map(|w| octile(w[0], w[1]))
+        .fold(0.0, |a, b| a + b)
 }
 
 /// Why a path is not valid.

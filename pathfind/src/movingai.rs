@@ -1,5 +1,6 @@
 //! Moving AI grid benchmark files (Sturtevant 2012): `.map` grids and `.map.scen` scenarios.
 
+use std::fmt::Write as _;
 use std::path::Path;
 
 use slam_core::{BitGrid, Cell};
@@ -40,13 +41,22 @@ fn read_text(path: &Path) -> Result<String, PathfindError> {
 /// Parse a `.map` file.
 ///
 /// # Errors
-/// [`PathfindError::Parse`] with the line number for a bad header, a row of the wrong length,
-/// too few rows or an unknown letter.
+/// [`PathfindError::Parse`] with the line number for a bad header, a header whose size the
+/// text after it cannot hold (checked before anything is allocated), a row of the wrong length,
+/// too few rows or an unknown letter; [`PathfindError::Grid`] past [`slam_core::MAX_GRID_CELLS`].
 pub fn parse_map(text: &str) -> Result<MovingAiMap, PathfindError> {
-    let mut lines = text.lines().enumerate();
     let (mut width, mut height) = (None, None);
+    // The text after the line read last, and that line's 1-based number.
+    let mut rest = text;
+    let mut header_lines = 0;
     loop {
-        let (k, line) = lines.next().ok_or_else(|| parse_err(0, "no 'map' line"))?;
+        if rest.is_empty() {
+            return Err(parse_err(0, "no 'map' line"));
+        }
+        let (line, tail) = rest.split_once('\n').unwrap_or((rest, ""));
+        rest = tail;
+        header_lines += 1;
+        let k = header_lines - 1;
         let mut words = line.split_whitespace();
         match (words.next(), words.next()) {
             (Some("type"), Some(_)) | (None, _) => {}
@@ -68,6 +78,21 @@ pub fn parse_map(text: &str) -> Result<MovingAiMap, PathfindError> {
     }
     let width = width.ok_or_else(|| parse_err(0, "no width line"))?;
     let height = height.ok_or_else(|| parse_err(0, "no height line"))?;
+    // One letter per cell must follow: allocate for the map only once the text can hold it.
+    let cells = u64::from(width) * u64::from(height);
+    if cells > rest.len() as u64 {
+        return Err(parse_err(
+            header_lines,
+            format!(
+                "the header states {width}x{height} = {cells} cells but only {} bytes follow",
+                rest.len()
+            ),
+        ));
+    }
+    let mut lines = rest
+        .lines()
+        .enumerate()
+        .map(|(k, line)| (k + header_lines, line));
     let mut grid = BitGrid::new(width, height)?;
     let mut terrain = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {
@@ -103,6 +128,20 @@ pub fn parse_map(text: &str) -> Result<MovingAiMap, PathfindError> {
 /// [`PathfindError::Io`] or as [`parse_map`].
 pub fn read_map(path: impl AsRef<Path>) -> Result<MovingAiMap, PathfindError> {
     parse_map(&read_text(path.as_ref())?)
+}
+
+/// The `.map` text of `map` (octile type, the terrain letters row by row): reads back to the
+/// same grid and letters.
+#[must_use]
+pub fn map_text(map: &MovingAiMap) -> String {
+    let (w, h) = (map.grid.width(), map.grid.height());
+    let mut s = format!("type octile\nheight {h}\nwidth {w}\nmap\n");
+    s.reserve(map.terrain.len() + h as usize);
+    for row in map.terrain.chunks(w as usize) {
+        s.extend(row.iter().map(|&b| char::from(b)));
+        s.push('\n');
+    }
+    s
 }
 
 /// One benchmark query.
@@ -183,6 +222,29 @@ pub fn parse_scenarios(text: &str) -> Result<Vec<Scenario>, PathfindError> {
         });
     }
     Ok(out)
+}
+
+/// The `.scen` text of `scenarios` (`version 1`, tab-separated, lengths printed so they read
+/// back exactly). Each read-back tolerance is that of a `version 1` file.
+#[must_use]
+pub fn scenarios_text(scenarios: &[Scenario]) -> String {
+    let mut s = String::from("version 1\n");
+    for q in scenarios {
+        let _ = writeln!(
+            s,
+            "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{:?}",
+            q.bucket,
+            q.map,
+            q.map_width,
+            q.map_height,
+            q.start.x,
+            q.start.y,
+            q.goal.x,
+            q.goal.y,
+            q.optimal_length
+        );
+    }
+    s
 }
 
 /// Read a `.scen` file.

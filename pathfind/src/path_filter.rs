@@ -45,7 +45,8 @@ pub fn filter_path(grid: &BitGrid, path: &GridPath) -> FilteredPath {
             let dy = f64::from(w[1].y) - f64::from(w[0].y);
             dx.hypot(dy)
         })
-        .sum();
+        // From +0.0: `sum()` of no steps is -0.0.
+        .fold(0.0, |a, b| a + b);
     let turns_after = waypoints.len().saturating_sub(2);
     FilteredPath {
         waypoints,

@@ -89,7 +89,9 @@ fn readers_reject_malformed_files() {
     assert_eq!(m.grid.count_blocked(), 2);
     assert_eq!(m.terrain, b".@.GST");
     for (bad, line) in [
-        ("type octile\nheight 2\nwidth 3\nmap\n.@.\n", 0),
+        // 6 cells stated, 4 bytes after the `map` line: refused at that line, before allocating.
+        ("type octile\nheight 2\nwidth 3\nmap\n.@.\n", 4),
+        ("type octile\nheight 2\nwidth 3\nmap\n.@.\r\r\r\n", 0),
         ("type octile\nheight 2\nwidth 3\nmap\n.@\nGST\n", 5),
         ("type octile\nheight 2\nwidth 3\nmap\n.@.\nGSX\n", 6),
         ("type octile\nheight x\nwidth 3\nmap\n", 2),
@@ -110,4 +112,21 @@ fn readers_reject_malformed_files() {
         parse_scenarios("version 1\n0 m 3 2 0 0 2 0\n"),
         Err(pathfind::PathfindError::Parse { line: 2, .. })
     ));
+}
+
+/// The writers read back to the same map and queries (a real map and its scenarios).
+#[test]
+fn written_maps_and_scenarios_read_back() {
+    let map = read_map(data("arena.map")).unwrap();
+    let back = parse_map(&pathfind::movingai::map_text(&map)).unwrap();
+    assert_eq!((back.grid, back.terrain), (map.grid, map.terrain));
+    let scen = read_scenarios(data("arena.map.scen")).unwrap();
+    let back = parse_scenarios(&pathfind::movingai::scenarios_text(&scen)).unwrap();
+    assert_eq!(back.len(), scen.len());
+    for (a, b) in back.iter().zip(&scen) {
+        assert_eq!(
+            (a.bucket, &a.map, a.start, a.goal, a.optimal_length),
+            (b.bucket, &b.map, b.start, b.goal, b.optimal_length)
+        );
+    }
 }

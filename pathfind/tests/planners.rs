@@ -190,3 +190,48 @@ proptest! {
         }
     }
 }
+
+/// A path from a cell to itself has length +0.0 (a sum of no steps started at -0.0 before), in
+/// every planner, in the filter and in the costed search.
+#[test]
+fn start_equal_to_goal_has_length_plus_zero() {
+    let grid = BitGrid::from_fn(6, 4, |x, y| x == 3 && y < 3).unwrap();
+    let c = Cell::new(1, 2);
+    let mut planners: Vec<Box<dyn Planner>> = vec![
+        Box::new(Dijkstra::new(&grid)),
+        Box::new(AStar::new(&grid)),
+        Box::new(JumpPointSearch::new(&grid)),
+        Box::new(JumpPointSearchPlus::new(&grid).unwrap()),
+    ];
+    for p in &mut planners {
+        let path = p.plan(c, c).unwrap().unwrap();
+        assert_eq!(path.length.to_bits(), 0.0f64.to_bits());
+        assert_eq!(filter_path(&grid, &path).length.to_bits(), 0.0f64.to_bits());
+    }
+    assert_eq!(path_cost(&[c]).to_bits(), 0.0f64.to_bits());
+    let costs = vec![2.0f32; 24];
+    let costed = pathfind::CellCostAStar::new(&grid, &costs)
+        .unwrap()
+        .plan_with_cost(c, c)
+        .unwrap()
+        .unwrap();
+    assert_eq!(costed.cost.to_bits(), 0.0f64.to_bits());
+}
+
+/// JPS+ tables are refused past 32,767 cells a side and past 2^28 cells in all, before they are
+/// allocated.
+#[test]
+fn jump_tables_check_sides_and_total() {
+    let max_cells = pathfind::MAX_JUMP_TABLE_CELLS;
+    for (w, h) in [(32_768, 1), (1, 32_768), (16_384, 16_385)] {
+        let grid = BitGrid::new(w, h).unwrap();
+        assert!(
+            matches!(
+                JumpPointSearchPlus::new(&grid),
+                Err(pathfind::PathfindError::GridTooLargeForTables { max_cells: m, .. }) if m == max_cells
+            ),
+            "{w}x{h}"
+        );
+    }
+    assert!(JumpPointSearchPlus::new(&BitGrid::new(32_767, 2).unwrap()).is_ok());
+}

@@ -11,6 +11,7 @@ use slam_core::{GraphPose, Pose2, Pose3, PoseGraph, quaternion_from_xyzw, quater
 
 use crate::error::{GraphFileError, UnknownTag};
 use crate::information_repair::{InformationRepair, RepairedEdge};
+use crate::se2_text::{Se2Format, se2_text};
 
 /// A graph read from a g2o file: 2D or 3D.
 #[derive(Clone, Debug)]
@@ -265,40 +266,15 @@ pub fn g2o_text_se3(graph: &PoseGraph<Pose3>) -> String {
 /// g2o text of an SE(2) graph (full precision).
 #[must_use]
 pub fn g2o_text_se2(graph: &PoseGraph<Pose2>) -> String {
-    let mut s = String::new();
-    for n in graph.nodes() {
-        let t = n.pose.translation.vector;
-        let _ = writeln!(
-            s,
-            "VERTEX_SE2 {} {} {} {}",
-            n.id,
-            t.x,
-            t.y,
-            n.pose.rotation.angle()
-        );
-    }
-    for n in graph.nodes().iter().filter(|n| n.fixed) {
-        let _ = writeln!(s, "FIX {}", n.id);
-    }
-    for e in graph.edges() {
-        let (a, b) = (graph.nodes()[e.from].id, graph.nodes()[e.to].id);
-        let t = e.measurement.translation.vector;
-        let i = &e.information;
-        let _ = writeln!(
-            s,
-            "EDGE_SE2 {a} {b} {} {} {} {} {} {} {} {} {}",
-            t.x,
-            t.y,
-            e.measurement.rotation.angle(),
-            i[(0, 0)],
-            i[(0, 1)],
-            i[(0, 2)],
-            i[(1, 1)],
-            i[(1, 2)],
-            i[(2, 2)]
-        );
-    }
-    s
+    se2_text(
+        graph,
+        &Se2Format {
+            vertex: "VERTEX_SE2",
+            edge: "EDGE_SE2",
+            information: [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)],
+            fix_lines: true,
+        },
+    )
 }
 
 /// Write a graph as a g2o file.

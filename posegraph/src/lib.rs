@@ -54,6 +54,7 @@ mod levenberg_marquardt;
 mod linearize;
 mod loop_support;
 mod normal_equations;
+mod se2_text;
 mod solver;
 mod sparse_cholesky;
 pub mod toro;

@@ -433,6 +433,14 @@ pub enum CloudError {
         /// The size given.
         size: f32,
     },
+    /// A finite point lies more than 2^63 voxels from the origin: its voxel cannot be numbered.
+    #[error("point {index} lies too far from the origin for voxels of {size} m")]
+    VoxelOutOfRange {
+        /// The point's index in the cloud.
+        index: usize,
+        /// The voxel size given.
+        size: f32,
+    },
 }
 
 /// A setting of a [`GraphSlamConfig`](crate::GraphSlamConfig) is out of its range (a zero sigma

@@ -128,8 +128,9 @@ impl PartialEq for GeometryBits {
 }
 impl Eq for GeometryBits {}
 
-/// Largest number of cells a grid may hold (2^36, 8 GiB of bits): keeps index arithmetic in range.
-pub const MAX_GRID_CELLS: u64 = 1 << 36;
+/// Largest number of cells a grid may hold: 2^32 (512 MiB of bits), so that a cell's row-major
+/// index fits the `u32` the planners store per cell (about 20 bytes per cell, 80 GiB at this limit).
+pub const MAX_GRID_CELLS: u64 = 1 << 32;
 
 impl BitGrid {
     /// An all-free grid of `width` x `height` cells with unit resolution at the origin.
@@ -582,6 +583,11 @@ mod tests {
         assert!(matches!(
             BitGrid::new(u32::MAX, u32::MAX),
             Err(GridError::TooLarge { .. })
+        ));
+        // One row past 2^32 cells: a planner's u32 cell index would wrap.
+        assert!(matches!(
+            BitGrid::new(1 << 16, (1 << 16) + 1),
+            Err(GridError::TooLarge { max_cells, .. }) if max_cells == 1 << 32
         ));
     }
 

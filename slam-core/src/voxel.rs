@@ -17,22 +17,30 @@ struct Accumulator {
     ring: u16,
 }
 
-/// Integer voxel coordinates of `p`, or `None` when they leave the i32 range (or `p` is not finite).
+/// 2^63, exact in f64: the first voxel coordinate an i64 key cannot hold.
+const TWO_POW_63: f64 = (1u64 << 63) as f64;
+
+/// Integer voxel coordinates of `p`, `Ok(None)` when `p` is not finite, `Err(())` when a finite
+/// coordinate is more than 2^63 voxels from the origin.
 #[inline]
-fn voxel_key(p: &Point3<f32>, inv: f64) -> Option<(i32, i32, i32)> {
+fn voxel_key(p: &Point3<f32>, inv: f64) -> Result<Option<(i64, i64, i64)>, ()> {
+    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+        return Ok(None);
+    }
     let f = |v: f32| {
         let x = f64::from(v) * inv;
-        // Also false for NaN.
-        if !(x >= f64::from(i32::MIN) && x < f64::from(i32::MAX) + 1.0) {
-            return None;
+        // 2^63 is exact in f64; i64 keys reach every finite point a metre-scale voxel can see
+        // (i32 keys lost finite points beyond 2 m at 1 nm voxels).
+        if !(-TWO_POW_63..TWO_POW_63).contains(&x) {
+            return Err(());
         }
         // Truncate, then step down for negatives: `f64::floor` is a library call on baseline
-        // x86-64, and this loop runs for every point of every scan.
-        #[allow(clippy::cast_possible_truncation)]
-        let t = x as i32;
-        Some(if f64::from(t) > x { t - 1 } else { t })
+        // x86-64, and this loop runs for every point of every scan. The step cannot wrap: a
+        // truncated value above `x` is negative.
+        let t = x as i64;
+        Ok(if (t as f64) > x { t - 1 } else { t })
     };
-    Some((f(p.x)?, f(p.y)?, f(p.z)?))
+    Ok(Some((f(p.x)?, f(p.y)?, f(p.z)?)))
 }
 
 impl PointCloud {
@@ -56,20 +64,26 @@ impl PointCloud {
     /// ```
     ///
     /// # Errors
-    /// [`CloudError::InvalidVoxelSize`] unless `voxel_size` is finite and positive.
+    /// [`CloudError::InvalidVoxelSize`] unless `voxel_size` is finite and positive,
+    /// [`CloudError::VoxelOutOfRange`] for a finite point more than 2^63 voxels from the origin
+    /// (never silently dropped).
     pub fn voxel_downsample(&self, voxel_size: f32) -> Result<PointCloud, CloudError> {
         if !(voxel_size.is_finite() && voxel_size > 0.0) {
             return Err(CloudError::InvalidVoxelSize { size: voxel_size });
         }
         let inv = 1.0 / f64::from(voxel_size);
-        let mut index: FxHashMap<(i32, i32, i32), u32> = FxHashMap::default();
+        let mut index: FxHashMap<(i64, i64, i64), u32> = FxHashMap::default();
         index.reserve(self.len() / 4);
         let mut acc: Vec<Accumulator> = Vec::new();
         let ring = self.ring();
         let intensity = self.intensity();
         let time = self.time();
         for (i, p) in self.points().iter().enumerate() {
-            let Some(key) = voxel_key(p, inv) else {
+            let Some(key) = voxel_key(p, inv).map_err(|()| CloudError::VoxelOutOfRange {
+                index: i,
+                size: voxel_size,
+            })?
+            else {
                 continue;
             };
             let slot = *index.entry(key).or_insert_with(|| {
@@ -137,9 +151,9 @@ mod tests {
             let cloud = PointCloud::from_points(pts.iter().map(|&(x, y, z)| Point3::new(x, y, z)).collect());
             let down = cloud.voxel_downsample(voxel).unwrap();
             let inv = 1.0 / f64::from(voxel);
-            let mut oracle: BTreeMap<(i32, i32, i32), (Vector3<f64>, u32)> = BTreeMap::new();
+            let mut oracle: BTreeMap<(i64, i64, i64), (Vector3<f64>, u32)> = BTreeMap::new();
             for p in cloud.points() {
-                let k = voxel_key(p, inv).unwrap();
+                let k = voxel_key(p, inv).unwrap().unwrap();
                 let e = oracle.entry(k).or_insert((Vector3::zeros(), 0));
                 e.0 += nalgebra::convert::<_, Vector3<f64>>(p.coords);
                 e.1 += 1;
@@ -166,5 +180,30 @@ mod tests {
         let d = c.voxel_downsample(1.0).unwrap();
         assert_eq!(d.len(), 1);
         assert_eq!(d.intensity(), Some(&[1.0][..]));
+    }
+
+    #[test]
+    fn tiny_voxels_keep_far_finite_points() {
+        // At 1 nm voxels a point 5 m out is 5e9 voxels away: past i32, which dropped it.
+        let pts = vec![Point3::new(5.0, -7.0, 1.0), Point3::new(0.0, 0.0, 0.0)];
+        let down = PointCloud::from_points(pts.clone())
+            .voxel_downsample(1e-9)
+            .unwrap();
+        assert_eq!(down.points(), &pts[..]);
+        // Floor, not truncation, on the negative side: -0.5 voxels is voxel -1, not 0.
+        let inv = 1.0 / 1e-9f64;
+        assert_eq!(
+            voxel_key(&Point3::new(-0.5e-9, 0.0, 0.0), inv),
+            Ok(Some((-1, 0, 0)))
+        );
+    }
+
+    #[test]
+    fn out_of_range_finite_point_is_an_error() {
+        let c = PointCloud::from_points(vec![Point3::origin(), Point3::new(0.0, 3.0e38, 0.0)]);
+        assert!(matches!(
+            c.voxel_downsample(1e-3),
+            Err(CloudError::VoxelOutOfRange { index: 1, .. })
+        ));
     }
 }

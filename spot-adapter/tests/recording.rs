@@ -10,7 +10,10 @@ use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::io::{write_kitti_bin, write_kitti_poses};
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::AdapterError;
-use spot_adapter::record::{KittiOdometry, KittiSequence, Recording, RecordingWriter};
+use spot_adapter::record::{
+    IndexEntry, KittiOdometry, KittiSequence, MAX_RECORDING_FILE_BYTES, Recording, RecordingWriter,
+    calibration_text, parse_calibration, parse_index,
+};
 use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -221,4 +224,73 @@ fn kitti_folder_reads_scans_poses_times_and_calibration() {
         Err(AdapterError::Recording { .. })
     ));
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Files a recording names must be regular files within the size limit: a cloud, the index or
+/// the calibration linked to `/dev/zero` (endless) or a sparse file past the limit is refused when
+/// the recording is opened, without reading it.
+#[cfg(unix)]
+#[test]
+fn devices_and_oversized_files_are_refused() {
+    let dir = temp_dir("devices");
+    let _ = short_run().record(&dir).unwrap();
+    let refused = |dir: &std::path::Path, name: &str, what: &str| match Recording::open(dir) {
+        Err(AdapterError::Recording { path, message }) => {
+            assert!(path.ends_with(name), "{path:?}");
+            assert!(message.contains(what), "{message}");
+        }
+        other => panic!("{name}: {other:?}"),
+    };
+    for name in ["clouds/000002.pcd", "index.txt", "calibration.txt"] {
+        let file = dir.join(name);
+        let saved = std::fs::read(&file).unwrap();
+        std::fs::remove_file(&file).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", &file).unwrap();
+        refused(&dir, name, "not a regular file");
+        std::fs::remove_file(&file).unwrap();
+        // A sparse file one byte past the limit takes no disk space.
+        std::fs::File::create(&file)
+            .unwrap()
+            .set_len(MAX_RECORDING_FILE_BYTES + 1)
+            .unwrap();
+        refused(&dir, name, "more than the limit");
+        std::fs::write(&file, saved).unwrap();
+    }
+    assert_eq!(Recording::open(&dir).unwrap().len(), 6);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The index and calibration texts parse from memory and write back to the same entries.
+#[test]
+fn index_and_calibration_text_round_trip() {
+    let text = "# spot-nav recording v1\n# index stamp cloud\n0 0.1 clouds/000000.pcd\n\n7 1e-7 ./a/b.pcd\n";
+    let entries = parse_index(text).unwrap();
+    assert_eq!(
+        entries[1],
+        IndexEntry {
+            index: 7,
+            stamp: 1e-7,
+            cloud: PathBuf::from("./a/b.pcd")
+        }
+    );
+    let back: String = entries.iter().map(|e| e.to_line() + "\n").collect();
+    assert_eq!(parse_index(&back).unwrap(), entries);
+    for (bad, line) in [
+        ("x 0.1 a.pcd", 1),
+        ("\n0 inf a.pcd", 2),
+        ("0 0.1 /dev/zero", 1),
+    ] {
+        match parse_index(bad) {
+            Err(AdapterError::Recording { message, .. }) => {
+                assert!(message.starts_with(&format!("line {line}:")), "{message}");
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    let pose = Pose3::from_parts(
+        Translation3::new(0.1, -0.2, 0.45),
+        UnitQuaternion::from_euler_angles(0.01, -0.02, 3.0),
+    );
+    assert_eq!(parse_calibration(&calibration_text(&pose)).unwrap(), pose);
+    assert!(parse_calibration("body_T_lidar 0 0 0 0 0 0 2").is_err());
 }

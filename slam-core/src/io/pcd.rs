@@ -317,9 +317,22 @@ fn push_point(
     Ok(())
 }
 
+/// Most bytes one byte of LZF data can expand to: a 3-byte back reference copies 264 bytes.
+const LZF_MAX_EXPANSION: usize = 88;
+
 /// Decompress PCL's LZF blocks (`binary_compressed`).
 fn lzf_decompress(input: &[u8], out_len: usize, base: usize) -> Result<Vec<u8>, FormatError> {
-    let mut out = Vec::with_capacity(out_len);
+    if out_len > input.len().saturating_mul(LZF_MAX_EXPANSION) {
+        return Err(byte_err(
+            base,
+            format!(
+                "{} bytes of LZF data cannot decompress to the {out_len} bytes stated",
+                input.len()
+            ),
+        ));
+    }
+    // Grow with the output rather than trusting the stated size up front.
+    let mut out = Vec::with_capacity(out_len.min(input.len().saturating_mul(4)));
     let mut ip = 0;
     while ip < input.len() {
         let ctrl = usize::from(input[ip]);
@@ -474,7 +487,8 @@ fn parse_ascii(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointClo
         .map_err(|_| byte_err(header.data_offset, "ascii data is not UTF-8"))?;
     let values_per_point: usize = header.fields.iter().map(|f| f.count).sum();
     let mut sink = sink_for(layout, n.min(data.len() / 2 + 1));
-    let mut tokens: Vec<&str> = Vec::with_capacity(values_per_point);
+    // Grows to the tokens a line really has: COUNT is the file's word, not memory's.
+    let mut tokens: Vec<&str> = Vec::new();
     for (k, line) in text.lines().enumerate() {
         let line_no = header.data_line + k;
         if sink.xyz.len() == n {

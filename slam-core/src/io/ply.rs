@@ -213,6 +213,41 @@ fn store(sink: &mut ChannelSink, slots: &[VertexSlot], values: &[f64]) -> Option
     Some(())
 }
 
+/// Check that the binary data can hold the records the header states before reading them:
+/// each record of an element needs at least its scalars and list counts.
+fn check_binary_sizes(
+    elements: &[Element],
+    data_offset: usize,
+    end: usize,
+) -> Result<(), FormatError> {
+    let data_len = end - data_offset;
+    let mut need = 0usize;
+    for el in elements {
+        let least: usize = el
+            .properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar { scalar, .. } => scalar.size(),
+                Property::List { count, .. } => count.size(),
+            })
+            .sum();
+        need = least
+            .checked_mul(el.count)
+            .and_then(|n| n.checked_add(need))
+            .filter(|&n| n <= data_len)
+            .ok_or_else(|| {
+                byte_err(
+                    end,
+                    format!(
+                        "{} {} records of at least {least} bytes do not fit in {data_len} bytes of data",
+                        el.count, el.name
+                    ),
+                )
+            })?;
+    }
+    Ok(())
+}
+
 /// Parse a PLY file held in memory.
 ///
 /// # Errors
@@ -242,13 +277,20 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
     );
     match header.format {
         Format::Binary { little_endian } => {
+            check_binary_sizes(&header.elements[..=vi], header.data_offset, bytes.len())?;
             let mut pos = header.data_offset;
             let mut values = Vec::new();
             for (ei, el) in header.elements.iter().enumerate() {
                 if ei > vi {
                     break;
                 }
-                for _ in 0..el.count {
+                // An element without properties holds no bytes, however many records it states.
+                let records = if el.properties.is_empty() {
+                    0
+                } else {
+                    el.count
+                };
+                for _ in 0..records {
                     values.clear();
                     for p in &el.properties {
                         match *p {

@@ -16,8 +16,9 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use slam_core::Pose3;
-use slam_core::io::{parse_kitti_poses, read_kitti_bin, read_kitti_poses};
+use slam_core::io::{parse_kitti_bin, parse_kitti_poses};
 
+use super::bounded_file::{MAX_RECORDING_FILE_BYTES, read_bounded, read_bounded_text};
 use crate::error::AdapterError;
 use crate::robot::Sample;
 
@@ -43,7 +44,7 @@ pub struct KittiSequence {
 }
 
 fn read_text(path: &Path) -> Result<String, AdapterError> {
-    fs::read_to_string(path).map_err(|e| AdapterError::io(path, e))
+    read_bounded_text(path, MAX_RECORDING_FILE_BYTES)
 }
 
 /// The `Tr:` line of a KITTI `calib.txt` as a pose.
@@ -81,7 +82,7 @@ impl KittiSequence {
         let bad = |path: PathBuf, message: String| AdapterError::Recording { path, message };
         let poses_path = dir.join("poses.txt");
         let poses = if poses_path.exists() {
-            let p = read_kitti_poses(&poses_path)?;
+            let p = parse_kitti_poses(&read_text(&poses_path)?)?;
             if p.len() != scans.len() {
                 return Err(bad(
                     poses_path,
@@ -173,8 +174,8 @@ impl KittiSequence {
             KittiOdometry::None => Pose3::identity(),
         };
         Some(
-            read_kitti_bin(path)
-                .map_err(AdapterError::from)
+            read_bounded(path, MAX_RECORDING_FILE_BYTES)
+                .and_then(|bytes| Ok(parse_kitti_bin(&bytes)?))
                 .map(|cloud| Sample {
                     stamp: self.stamps[i],
                     odom_t_body,

@@ -48,11 +48,14 @@
 //! # Ok::<(), spot_adapter::MessageError>(())
 //! ```
 //!
+//! Every file is read only when it is a regular file of at most [`MAX_RECORDING_FILE_BYTES`].
+//!
 //! Uses `robot` (the sample type) and `slam-core`'s file formats only.
 
 mod bag;
 mod bag_file;
 mod bag_samples;
+mod bounded_file;
 mod cloud_folder;
 mod frame_tree;
 mod kitti;
@@ -76,7 +79,11 @@ pub use point_cloud2::{
     CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,
     TimeUnit,
 };
-pub use recording::{Recording, RecordingSamples, RecordingWriter};
+pub use bounded_file::MAX_RECORDING_FILE_BYTES;
+pub use recording::{
+    IndexEntry, Recording, RecordingSamples, RecordingWriter, calibration_text, parse_calibration,
+    parse_index,
+};
 pub use ros_messages::{
     Header, ImuReading, Odometry, PointCloud2, PointField, RosMessageType, TransformStamped,
 };

@@ -10,7 +10,9 @@
 //! ```
 //!
 //! Stamps in the index and in the trajectories must agree line by line, and cloud paths must
-//! lie inside the folder; the reader checks both.
+//! lie inside the folder; the reader checks both. Every file read must be a regular file of at
+//! most [`MAX_RECORDING_FILE_BYTES`](super::MAX_RECORDING_FILE_BYTES) (a link to `/dev/zero` is
+//! refused). [`parse_index`] and [`parse_calibration`] read the two text formats from memory.
 
 use std::fs::{self, File};
 use std::io::{BufRead, BufReader, BufWriter, Lines, Write};
@@ -18,10 +20,14 @@ use std::path::{Component, Path, PathBuf};
 
 use nalgebra::Translation3;
 use slam_core::io::{
-    PcdEncoding, StampedPose, TUM_HEADER, parse_tum, read_pcd, read_tum, write_pcd, write_tum_line,
+    PcdEncoding, StampedPose, TUM_HEADER, parse_pcd, parse_tum, read_tum, write_pcd, write_tum_line,
 };
 use slam_core::{FormatError, Pose3, quaternion_from_xyzw, quaternion_to_xyzw};
 
+use super::bounded_file::{
+    MAX_RECORDING_FILE_BYTES, check_regular_file, open_regular_file, read_bounded,
+    read_bounded_text,
+};
 use crate::error::AdapterError;
 use crate::robot::Sample;
 
@@ -90,14 +96,9 @@ impl RecordingWriter {
         let dir = dir.as_ref().to_path_buf();
         let clouds = dir.join(CLOUDS);
         fs::create_dir_all(&clouds).map_err(|e| AdapterError::io(&clouds, e))?;
-        let t = body_t_lidar.translation.vector;
-        let q = quaternion_to_xyzw(&body_t_lidar.rotation);
-        let calib = format!(
-            "# LiDAR pose in Spot's body frame: tx ty tz qx qy qz qw\nbody_T_lidar {} {} {} {} {} {} {}\n",
-            t.x, t.y, t.z, q[0], q[1], q[2], q[3]
-        );
         let path = dir.join(CALIBRATION);
-        fs::write(&path, calib).map_err(|e| AdapterError::io(&path, e))?;
+        fs::write(&path, calibration_text(&body_t_lidar))
+            .map_err(|e| AdapterError::io(&path, e))?;
         // A stale ground truth from an earlier recording in the same folder would disagree.
         let stale = dir.join(GROUND_TRUTH);
         if stale.exists() {
@@ -149,10 +150,17 @@ impl RecordingWriter {
                 "ground truth must be given for all samples or none".into()
             ));
         }
-        let name = format!("{CLOUDS}/{:06}.pcd", self.written);
-        write_pcd(self.dir.join(&name), &sample.cloud, PcdEncoding::Binary)?;
-        self.index
-            .line(&format!("{} {} {name}", self.written, sample.stamp))?;
+        let entry = IndexEntry {
+            index: self.written as u64,
+            stamp: sample.stamp,
+            cloud: PathBuf::from(format!("{CLOUDS}/{:06}.pcd", self.written)),
+        };
+        write_pcd(
+            self.dir.join(&entry.cloud),
+            &sample.cloud,
+            PcdEncoding::Binary,
+        )?;
+        self.index.line(&entry.to_line())?;
         self.odometry.pose(&StampedPose {
             stamp: sample.stamp,
             pose: sample.odom_t_body,
@@ -208,7 +216,7 @@ impl std::fmt::Debug for LineReader {
 
 impl LineReader {
     fn open(path: PathBuf) -> Result<Self, AdapterError> {
-        let file = File::open(&path).map_err(|e| AdapterError::io(&path, e))?;
+        let file = open_regular_file(&path, MAX_RECORDING_FILE_BYTES)?;
         Ok(Self {
             lines: BufReader::new(file).lines(),
             path,
@@ -250,38 +258,96 @@ impl LineReader {
     }
 }
 
-/// One index line: the stamp and the cloud's path inside the folder.
-fn parse_index_line(
-    reader: &LineReader,
-    dir: &Path,
-    line: usize,
-    text: &str,
-) -> Result<(f64, PathBuf), AdapterError> {
-    let fields: Vec<&str> = text.split_whitespace().collect();
-    let [_, stamp, cloud] = fields.as_slice() else {
-        return Err(reader.error(line, "expected: index stamp cloud"));
-    };
-    let stamp = stamp
-        .parse::<f64>()
-        .ok()
-        .filter(|s| s.is_finite())
-        .ok_or_else(|| reader.error(line, format!("stamp {stamp:?} is not a finite number")))?;
-    let relative = Path::new(cloud);
-    if !relative
-        .components()
-        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
-    {
-        return Err(reader.error(
-            line,
-            format!("cloud path {cloud:?} must be relative and stay inside the recording"),
-        ));
-    }
-    Ok((stamp, dir.join(relative)))
+/// One line of a recording's index: `index stamp cloud-path`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IndexEntry {
+    /// The scan's number as written (the writer counts from 0).
+    pub index: u64,
+    /// The scan's stamp, seconds.
+    pub stamp: f64,
+    /// The cloud file, relative to the recording's folder and inside it.
+    pub cloud: PathBuf,
 }
 
-fn parse_calibration(path: &Path, text: &str) -> Result<Pose3, AdapterError> {
+impl IndexEntry {
+    /// The entry of one index line, or what is wrong with it.
+    fn parse(text: &str) -> Result<Self, String> {
+        let fields: Vec<&str> = text.split_whitespace().collect();
+        let [index, stamp, cloud] = fields.as_slice() else {
+            return Err("expected: index stamp cloud".into());
+        };
+        let index = index
+            .parse::<u64>()
+            .map_err(|_| format!("index {index:?} is not a whole number"))?;
+        let stamp = stamp
+            .parse::<f64>()
+            .ok()
+            .filter(|s| s.is_finite())
+            .ok_or_else(|| format!("stamp {stamp:?} is not a finite number"))?;
+        let relative = Path::new(cloud);
+        if !relative
+            .components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+        {
+            return Err(format!(
+                "cloud path {cloud:?} must be relative and stay inside the recording"
+            ));
+        }
+        Ok(Self {
+            index,
+            stamp,
+            cloud: relative.to_path_buf(),
+        })
+    }
+
+    /// The index line of this entry (the stamp printed so that it reads back exactly).
+    #[must_use]
+    pub fn to_line(&self) -> String {
+        format!("{} {} {}", self.index, self.stamp, self.cloud.display())
+    }
+}
+
+/// Parse the text of a recording's `index.txt`: blank lines and `#` comments skipped, one
+/// [`IndexEntry`] per other line.
+///
+/// # Errors
+/// [`AdapterError::Recording`] naming `index.txt` and the line: not three fields, an index that
+/// is not a whole number, a stamp that is not finite, a cloud path that is absolute or leaves
+/// the folder (`..`).
+pub fn parse_index(text: &str) -> Result<Vec<IndexEntry>, AdapterError> {
+    text.lines()
+        .enumerate()
+        .map(|(k, l)| (k + 1, l.trim()))
+        .filter(|(_, l)| !(l.is_empty() || l.starts_with('#')))
+        .map(|(line, l)| {
+            IndexEntry::parse(l).map_err(|message| AdapterError::Recording {
+                path: PathBuf::from(INDEX),
+                message: format!("line {line}: {message}"),
+            })
+        })
+        .collect()
+}
+
+/// The text of `calibration.txt` for a LiDAR mounted at `body_t_lidar` (reads back exactly).
+#[must_use]
+pub fn calibration_text(body_t_lidar: &Pose3) -> String {
+    let t = body_t_lidar.translation.vector;
+    let q = quaternion_to_xyzw(&body_t_lidar.rotation);
+    format!(
+        "# LiDAR pose in Spot's body frame: tx ty tz qx qy qz qw\nbody_T_lidar {} {} {} {} {} {} {}\n",
+        t.x, t.y, t.z, q[0], q[1], q[2], q[3]
+    )
+}
+
+/// Parse the text of a recording's `calibration.txt`: the `body_T_lidar tx ty tz qx qy qz qw`
+/// line.
+///
+/// # Errors
+/// [`AdapterError::Recording`] naming `calibration.txt`: no such line, not 7 finite numbers, or
+/// a quaternion that is not unit.
+pub fn parse_calibration(text: &str) -> Result<Pose3, AdapterError> {
     let bad = |message: String| AdapterError::Recording {
-        path: path.to_path_buf(),
+        path: PathBuf::from(CALIBRATION),
         message,
     };
     let line = text
@@ -303,6 +369,19 @@ fn parse_calibration(path: &Path, text: &str) -> Result<Pose3, AdapterError> {
     Ok(Pose3::from_parts(Translation3::new(v[0], v[1], v[2]), q))
 }
 
+/// Errors of an in-memory parse of the file `name`, renamed to the file's full `path`.
+fn at_path(e: AdapterError, name: &str, path: &Path) -> AdapterError {
+    match e {
+        AdapterError::Recording { path: p, message } if p == Path::new(name) => {
+            AdapterError::Recording {
+                path: path.to_path_buf(),
+                message,
+            }
+        }
+        other => other,
+    }
+}
+
 impl Recording {
     /// Open the recording in `dir`, checking it whole in one streaming pass.
     ///
@@ -313,8 +392,9 @@ impl Recording {
     pub fn open(dir: impl AsRef<Path>) -> Result<Self, AdapterError> {
         let dir = dir.as_ref().to_path_buf();
         let cal_path = dir.join(CALIBRATION);
-        let cal = fs::read_to_string(&cal_path).map_err(|e| AdapterError::io(&cal_path, e))?;
-        let body_t_lidar = parse_calibration(&cal_path, &cal)?;
+        let cal = read_bounded_text(&cal_path, MAX_RECORDING_FILE_BYTES)?;
+        let body_t_lidar =
+            parse_calibration(&cal).map_err(|e| at_path(e, CALIBRATION, &cal_path))?;
         let has_ground_truth = dir.join(GROUND_TRUTH).exists();
         let mut recording = Self {
             dir,
@@ -432,7 +512,10 @@ impl Entries {
             }
             return Ok(None);
         };
-        let (stamp, cloud) = parse_index_line(&self.index, &self.dir, line, &text)?;
+        let entry = IndexEntry::parse(&text).map_err(|m| self.index.error(line, m))?;
+        let (stamp, cloud) = (entry.stamp, self.dir.join(entry.cloud));
+        // Refused when the folder is opened, not only when the scan is reached.
+        check_regular_file(&cloud, MAX_RECORDING_FILE_BYTES)?;
         let pose_of = |reader: &mut LineReader| -> Result<Pose3, AdapterError> {
             let at = reader.line;
             let pose = reader
@@ -511,8 +594,8 @@ impl Iterator for RecordingSamples {
         };
         self.left = self.left.saturating_sub(1);
         Some(
-            read_pcd(&entry.cloud)
-                .map_err(AdapterError::from)
+            read_bounded(&entry.cloud, MAX_RECORDING_FILE_BYTES)
+                .and_then(|bytes| Ok(parse_pcd(&bytes)?))
                 .map(|cloud| Sample {
                     stamp: entry.stamp,
                     odom_t_body: entry.odom_t_body,

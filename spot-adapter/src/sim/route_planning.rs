@@ -63,7 +63,8 @@ impl Route {
         let grid = inflate(
             &building.occupancy_grid(config.resolution)?,
             config.clearance + 1.5 * config.resolution,
-        );
+        )
+        .map_err(AdapterError::NavigationGrid)?;
         let to_cell = |which: &'static str, p: Vector2<f64>| {
             grid.cell_at(p)
                 .filter(|&c| !grid.is_blocked(c))
