@@ -70,6 +70,7 @@ mod wire;
 pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
 pub use bag_file::{BagFormat, TopicInfo};
 pub use bag_samples::BagSamples;
+pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
 pub use frame_tree::{FrameTree, PoseSeries};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
@@ -79,7 +80,6 @@ pub use point_cloud2::{
     CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,
     TimeUnit,
 };
-pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use recording::{
     IndexEntry, Recording, RecordingSamples, RecordingWriter, calibration_text, parse_calibration,
     parse_index,
