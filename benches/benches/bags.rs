@@ -244,7 +244,7 @@ fn main() {
         .map(|s| s.unwrap_or_else(|e| fail(&e)))
         .collect();
     let started = Instant::now();
-    let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| panic!("{e}"));
+    let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| fail(&e));
     for s in &samples {
         slam.process(&s.scan_input());
     }
@@ -279,7 +279,7 @@ fn main() {
     );
     group.bench_with_input(BenchmarkId::new("slam", SHORT), &samples, |b, samples| {
         b.iter(|| {
-            let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| panic!("{e}"));
+            let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| fail(&e));
             for s in samples {
                 slam.process(&s.scan_input());
             }

@@ -105,7 +105,7 @@ fn a_robot_whose_certificate_is_not_from_the_given_ca_is_refused() {
     let other = fake_spot!("other-ca");
     let mut config = fake.config();
     config.ca_pem = other.ca_pem();
-    let error = SpotClient::connect(config).err().expect("TLS must fail");
+    let error = SpotClient::connect(config).expect_err("TLS must fail");
     assert!(
         matches!(
             error,
@@ -129,9 +129,7 @@ fn bad_credentials_are_a_login_error_that_never_shows_the_password() {
     let wrong = "wrong-password-5417";
     config.credentials = Credentials::new(support::USERNAME, wrong);
     let logged = format!("{config:?}");
-    let error = SpotClient::connect(config)
-        .err()
-        .expect("the login must fail");
+    let error = SpotClient::connect(config).expect_err("the login must fail");
     assert!(
         matches!(&error, SpotError::Login { status: "STATUS_INVALID_LOGIN", username } if username == support::USERNAME),
         "{error:?}"
@@ -157,7 +155,7 @@ fn an_unreachable_robot_is_a_clear_error_within_the_timeout() {
         .unwrap()
         .port();
     let start = Instant::now();
-    let error = SpotClient::connect(config).err().expect("nothing listens");
+    let error = SpotClient::connect(config).expect_err("nothing listens");
     assert!(
         matches!(
             error,
