@@ -302,18 +302,9 @@ impl ScanContextRecognizer {
         };
         keep(self.index.query(here));
         for &(dx, dy) in offsets {
-            // The scan as seen from (dx, dy): its points moved the other way.
             #[allow(clippy::cast_possible_truncation)]
-            let moved = PointCloud::from_points(
-                scan.points()
-                    .iter()
-                    .map(|p| nalgebra::Point3::new(p.x - dx as f32, p.y - dy as f32, p.z))
-                    .collect(),
-            );
-            keep(
-                self.index
-                    .query(&ScanContext::from_cloud(&moved, &self.descriptor)?),
-            );
+            let there = ScanContext::seen_from(scan, &self.descriptor, dx as f32, dy as f32)?;
+            keep(self.index.query(&there));
         }
         best.sort_by(|a, b| a.distance.total_cmp(&b.distance));
         Ok(best)

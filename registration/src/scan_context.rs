@@ -126,6 +126,20 @@ impl ScanContext {
         cloud: &PointCloud,
         config: &ScanContextConfig,
     ) -> Result<Self, RegistrationError> {
+        Self::seen_from(cloud, config, 0.0, 0.0)
+    }
+
+    /// The descriptor of `cloud` as a sensor at `(x, y)` of the cloud's frame, with the same
+    /// heading, would see it (the points are not copied).
+    ///
+    /// # Errors
+    /// As [`ScanContext::from_cloud`].
+    pub fn seen_from(
+        cloud: &PointCloud,
+        config: &ScanContextConfig,
+        x: f32,
+        y: f32,
+    ) -> Result<Self, RegistrationError> {
         config.validate()?;
         let sectors = config.sectors;
         let mut bins = vec![0.0f32; SCAN_CONTEXT_RINGS * sectors];
@@ -141,13 +155,14 @@ impl ScanContext {
         let (min2, max2) = (min_range * min_range, max_range * max_range);
         let mut used = 0usize;
         for p in cloud.points().iter().step_by(config.point_stride) {
-            let range2 = p.x * p.x + p.y * p.y;
+            let (px, py) = (p.x - x, p.y - y);
+            let range2 = px * px + py * py;
             if !(range2.is_finite() && p.z.is_finite()) || range2 < min2 || range2 >= max2 {
                 continue;
             }
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
             let ring = ((range2.sqrt() * rings_per_metre) as usize).min(SCAN_CONTEXT_RINGS - 1);
-            let azimuth = fast_azimuth(p.x, p.y);
+            let azimuth = fast_azimuth(px, py);
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
             let sector = ((azimuth * sectors_per_radian) as usize).min(sectors - 1);
             // A point below the offset floor still marks its bin as seen.
@@ -386,6 +401,17 @@ mod tests {
             }
         }
         assert!(fast_azimuth(0.0, 0.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn seen_from_a_point_is_the_descriptor_of_the_cloud_moved_the_other_way() {
+        let config = ScanContextConfig::default();
+        let scan = room();
+        let moved = scan.transformed(&pose3_from_xyz_rpy(-0.5, 0.25, 0.0, 0.0, 0.0, 0.0));
+        let there = ScanContext::seen_from(&scan, &config, 0.5, -0.25).unwrap();
+        let direct = ScanContext::from_cloud(&moved, &config).unwrap();
+        let m = there.compare(&direct).unwrap();
+        assert!(m.distance < 1e-5 && m.yaw.abs() < 1e-9, "{m:?}");
     }
 
     #[test]
