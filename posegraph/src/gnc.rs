@@ -242,6 +242,10 @@ impl<P: SolverPose> Optimizer<P> for GraduatedNonConvexity {
     fn optimize(&mut self, graph: &mut PoseGraph<P>) -> Result<OptimizationReport, OptimizeError> {
         Ok(self.optimize_robust(graph)?.optimization)
     }
+
+    fn edge_weights(&self) -> Option<&[f64]> {
+        Some(&self.weights)
+    }
 }
 
 /// Squared errors of every edge at the graph's poses.

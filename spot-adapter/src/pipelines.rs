@@ -2,7 +2,7 @@
 //! simulated and recorded runs use it: one place for the settings that the example, the tests
 //! and the benches share.
 
-use posegraph::LevenbergMarquardt;
+use posegraph::GraduatedNonConvexity;
 use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
     ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
@@ -10,10 +10,10 @@ use registration::{
 use slam_core::{GraphSlam, GraphSlamConfig, InvalidSlamConfig, MapRegistrator, PlaceRecognizer};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
-pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, LevenbergMarquardt>;
+pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, GraduatedNonConvexity>;
 
 /// Graph-SLAM with LOAM odometry and loop refinement.
-pub type LoamSlam = GraphSlam<LoamRegistrator, PointToPointIcp, LevenbergMarquardt>;
+pub type LoamSlam = GraphSlam<LoamRegistrator, PointToPointIcp, GraduatedNonConvexity>;
 
 /// The engine settings that go with [`point_to_plane_slam`] and [`loam_slam`]: the defaults,
 /// except that the point-to-point loop check accepts an RMS distance up to 0.2 m (voxel
@@ -27,12 +27,15 @@ pub fn slam_config() -> GraphSlamConfig {
 }
 
 /// The engine with `odometry` and `refine`, the thesis' loop check (point-to-point ICP on
-/// voxelised keyframes) and Levenberg-Marquardt.
+/// voxelised keyframes) and graduated non-convexity over Levenberg-Marquardt with its defaults
+/// (truncated least squares on loop edges, odometry edges known inliers): a loop that passes
+/// the geometric check yet disagrees with the rest of the graph (a look-alike place) is
+/// weighted out instead of bending the map.
 fn assemble<R: MapRegistrator>(
     config: GraphSlamConfig,
     odometry: R,
     refine: R,
-) -> Result<GraphSlam<R, PointToPointIcp, LevenbergMarquardt>, InvalidSlamConfig> {
+) -> Result<GraphSlam<R, PointToPointIcp, GraduatedNonConvexity>, InvalidSlamConfig> {
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
@@ -47,7 +50,7 @@ fn assemble<R: MapRegistrator>(
         odometry,
         loop_check,
         refine,
-        LevenbergMarquardt::default(),
+        GraduatedNonConvexity::default(),
     )
 }
 

@@ -289,3 +289,79 @@ fn added_boxes_are_seen_and_removed_boxes_are_gone() {
         before.cast_ray(&o, &-Vector3::z(), 10.0)
     );
 }
+
+/// `repeated_rooms`: the core's south rooms are copies one pitch apart, and from any point of
+/// the south corridor the building looks the same one pitch further east (every ray within 3 m
+/// ends at the same range), while the default building of the same seed does not.
+#[test]
+fn repeated_rooms_look_the_same_one_pitch_apart() {
+    for seed in [1, 2, 3] {
+        let mut config = BuildingConfig::default();
+        config.repeated_rooms = true;
+        let b = Building::generate(seed, &config).unwrap();
+        let c = b.corridor_loop();
+        let south_core: Vec<_> = b
+            .rooms()
+            .iter()
+            .filter(|r| r.inward == Vector2::new(0.0, 1.0) && r.door.y < 0.5 * b.size().y)
+            .collect();
+        let pitch = south_core[0].max.x - south_core[0].min.x;
+        for r in &south_core {
+            assert!(((r.max.x - r.min.x) - pitch).abs() < 1e-9);
+            assert!(
+                ((r.door.x - r.min.x) - (south_core[0].door.x - south_core[0].min.x)).abs() < 1e-9
+            );
+        }
+        let plain = Building::generate(seed, &BuildingConfig::default()).unwrap();
+        let (mut same, mut differ_plain, mut rays) = (0, 0, 0);
+        // Points on the south corridor's centre line over the repeated stretch, clear of its
+        // ends by more than the rays' reach (the outer band's end rooms are not copies).
+        let y = c[0].y;
+        let n = south_core.len();
+        assert!(n >= 6, "seed {seed}: {n} rooms");
+        assert!(pitch >= 3.0, "seed {seed}: pitch {pitch} m");
+        let (x_lo, x_hi) = (south_core[2].min.x, south_core[n - 3].min.x);
+        let mut x = x_lo;
+        while x < x_hi {
+            for k in 0..72 {
+                for elevation in [-0.3f64, 0.0, 0.3] {
+                    let a = f64::from(k) * 5f64.to_radians();
+                    let d = Vector3::new(
+                        a.cos() * elevation.cos(),
+                        a.sin() * elevation.cos(),
+                        elevation.sin(),
+                    );
+                    let here = Point3::new(x, y, 0.8);
+                    let there = Point3::new(x + pitch, y, 0.8);
+                    let r = |b: &Building, o: &Point3<f64>| b.cast_ray(o, &d, 3.0).map(|h| h.range);
+                    rays += 1;
+                    match (r(&b, &here), r(&b, &there)) {
+                        (Some(p), Some(q)) if (p - q).abs() < 1e-9 => same += 1,
+                        (None, None) => same += 1,
+                        _ => {}
+                    }
+                    if r(&plain, &here).map(|v| (v * 1e6).round())
+                        != r(&plain, &there).map(|v| (v * 1e6).round())
+                    {
+                        differ_plain += 1;
+                    }
+                }
+            }
+            x += 0.37;
+        }
+        assert!(rays > 1000, "seed {seed}: {rays} rays");
+        assert_eq!(
+            same, rays,
+            "seed {seed}: {same} of {rays} rays agree one pitch apart"
+        );
+        assert!(
+            differ_plain * 5 > rays,
+            "seed {seed}: the plain building differs in only {differ_plain} of {rays}"
+        );
+        let start = Route::corridor_loop(&b).point_at(0.0);
+        for (i, room) in b.rooms().iter().enumerate() {
+            let r = Route::between(&b, start, room.entry_point(), &RouteConfig::default());
+            assert!(r.is_ok(), "seed {seed}: room {i} {:?}", r.err());
+        }
+    }
+}

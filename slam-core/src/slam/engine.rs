@@ -40,6 +40,9 @@ struct Keyframe<S, C> {
     coarse: C,
     /// Voxel-filtered scan (LiDAR frame) for the map.
     cloud: PointCloud,
+    /// Distance walked from the first keyframe to this one along the estimate when it was
+    /// made (metres): the drift a loop may correct grows with it.
+    walked: f64,
 }
 
 /// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the
@@ -95,6 +98,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     node_index: NodeIndex,
     pending_loops: Vec<LoopCandidate>,
     last_loop_attempt: Option<usize>,
+    /// The last keyframe that queued a look-alike from place recognition.
+    last_place_attempt: Option<usize>,
     /// Every accepted scan.
     scan_poses: Vec<ScanPose>,
     last_stamp: f64,
@@ -133,6 +138,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             node_index: NodeIndex::default(),
             pending_loops: Vec::new(),
             last_loop_attempt: None,
+            last_place_attempt: None,
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
             last_odometry: None,
@@ -162,6 +168,13 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     #[must_use]
     pub fn graph(&self) -> &PoseGraph<Pose3> {
         &self.graph
+    }
+
+    /// The optimiser, e.g. for the weight it left each loop edge with
+    /// ([`Optimizer::edge_weights`]).
+    #[must_use]
+    pub fn optimizer(&self) -> &O {
+        &self.optimizer
     }
 
     /// Counts and timings so far.
@@ -545,17 +558,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let index = self.keyframes.len();
         // Appearance first (before this keyframe joins the recognizer); a scan the recognizer
         // refuses is counted, and the keyframe goes on without a place match.
-        let look_alike = match self
+        let look_alikes = match self
             .places
             .as_mut()
             .map(|p| p.candidates_then_add(index, &cloud))
         {
-            Some(Ok(found)) => found.into_iter().next(),
+            Some(Ok(found)) => found,
             Some(Err(_)) => {
                 self.report.place_refusals += 1;
-                None
+                Vec::new()
             }
-            None => None,
+            None => Vec::new(),
         };
         let map_cloud = cloud
             .voxel_downsample(self.config.map_voxel_size)
@@ -582,7 +595,16 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if self.insert_node(id, pose, edge.as_ref()).is_err() {
             return self.skip(SkipReason::NonFinitePose, started);
         }
+        let walked = match index {
+            0 => 0.0,
+            _ => {
+                self.keyframes[index - 1].walked
+                    + (pose.translation.vector - self.keyframe_pose(index - 1).translation.vector)
+                        .norm()
+            }
+        };
         self.keyframes.push(Keyframe {
+            walked,
             stamp: scan.stamp,
             odom_t_lidar,
             source: self.odometry.keyframe_source(source),
@@ -598,7 +620,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             keyframe_t_lidar: Pose3::identity(),
         });
 
-        self.queue_loop_candidate(index, &pose, look_alike);
+        self.queue_loop_candidate(index, &pose, &look_alikes);
         self.node_index.insert(index, &pose);
         self.record_scan_time(started);
         if self.config.inline_loop_closure {
@@ -611,36 +633,58 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     }
 
     /// Queue a loop candidate for keyframe `index` at `pose`: the oldest keyframe near it outside
-    /// the local window, or else the look-alike place recognition found.
-    fn queue_loop_candidate(&mut self, index: usize, pose: &Pose3, look_alike: Option<PlaceMatch>) {
+    /// the local window, or else the best look-alike place recognition found. The two kinds are
+    /// throttled apart ([`GraphSlamConfig::loop_min_keyframe_gap`] each), so that look-alikes
+    /// refused one after another (a corridor of identical rooms) never keep a loop by position
+    /// from being tried.
+    fn queue_loop_candidate(&mut self, index: usize, pose: &Pose3, look_alikes: &[PlaceMatch]) {
         let window = self.config.local_map_keyframes;
-        let may_try = self
-            .last_loop_attempt
-            .is_none_or(|l| index >= l + self.config.loop_min_keyframe_gap);
-        if index > window && may_try {
-            let near =
+        if index <= window {
+            return;
+        }
+        let gap = self.config.loop_min_keyframe_gap;
+        let may_try = |last: Option<usize>| last.is_none_or(|l| index >= l + gap);
+        let near = may_try(self.last_loop_attempt)
+            .then(|| {
                 self.node_index
-                    .oldest_within(pose, self.config.loop_search_radius, index - window);
-            let candidate = match near {
-                Some(old) => Some((old, None)),
-                None => look_alike.filter(|m| m.keyframe < index - window).map(|m| {
+                    .oldest_within(pose, self.config.loop_search_radius, index - window)
+            })
+            .flatten();
+        let candidate = match near {
+            Some(old) => {
+                self.last_loop_attempt = Some(index);
+                Some((old, None))
+            }
+            // Only the best look-alike: the next best of a place whose best is recent is
+            // rarely the same place.
+            None if may_try(self.last_place_attempt) => look_alikes
+                .first()
+                .filter(|m| m.keyframe < index - window)
+                .map(|m| {
+                    self.last_place_attempt = Some(index);
                     let turn = Pose3::from_parts(
                         nalgebra::Translation3::identity(),
                         nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, m.yaw),
                     );
                     (m.keyframe, Some(self.keyframe_pose(m.keyframe) * turn))
                 }),
-            };
-            if let Some((old, guess)) = candidate {
-                self.report.place_candidates += usize::from(guess.is_some());
-                self.pending_loops.push(LoopCandidate {
-                    old,
-                    new: index,
-                    guess,
-                });
-                self.last_loop_attempt = Some(index);
-            }
+            None => None,
+        };
+        if let Some((old, guess)) = candidate {
+            self.report.place_candidates += usize::from(guess.is_some());
+            self.pending_loops.push(LoopCandidate {
+                old,
+                new: index,
+                guess,
+            });
         }
+    }
+
+    /// How far (metres) a loop from keyframe `old` to `new` may move `new`: the loop search
+    /// radius plus [`GraphSlamConfig::loop_max_drift_rate`] of the distance walked between them.
+    fn drift_allowance(&self, old: usize, new: usize) -> f64 {
+        let walked = (self.keyframes[new].walked - self.keyframes[old].walked).abs();
+        self.config.loop_search_radius + self.config.loop_max_drift_rate * walked
     }
 
     /// Try the oldest queued loop candidate: coarse alignment of the new keyframe to the
@@ -710,6 +754,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         {
             return rejected;
         }
+        // The correction this loop makes to the new keyframe, against the drift the walk since
+        // the candidate could have gathered.
+        let correction =
+            (refined.pose.translation.vector - self.keyframe_pose(new).translation.vector).norm();
+        if correction > self.drift_allowance(cand, new) {
+            self.report.loops_beyond_drift += 1;
+            return rejected;
+        }
         let cand_pose = self.keyframe_pose(cand);
         let info = Self::information(
             self.config.loop_information,
@@ -731,6 +783,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         if self.optimizer.optimize(&mut self.graph).is_err() {
             self.report.optimizer_failures += 1;
+        }
+        if let Some(weights) = self.optimizer.edge_weights() {
+            // Odometry edges join consecutive keyframes; every other edge is a loop.
+            let nodes = self.graph.nodes();
+            self.report.loops_weighted_out = self
+                .graph
+                .edges()
+                .iter()
+                .zip(weights)
+                .filter(|(e, w)| nodes[e.from].id.abs_diff(nodes[e.to].id) != 1 && **w < 0.5)
+                .count();
         }
         self.report.loops_closed += 1;
         self.report.place_loops_closed += usize::from(candidate.guess.is_some());

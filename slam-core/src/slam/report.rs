@@ -100,6 +100,15 @@ pub struct SlamReport {
     pub place_loops_closed: usize,
     /// Keyframe scans the place recognizer refused (too few points in its range).
     pub place_refusals: usize,
+    /// Loops that passed the geometric check but were refused because they would move the new
+    /// keyframe further than the walk since the old one could have drifted
+    /// ([`GraphSlamConfig::loop_max_drift_rate`](super::GraphSlamConfig)): look-alike places.
+    pub loops_beyond_drift: usize,
+    /// Loop edges the optimiser weighted out in its last run (an optimiser that decides
+    /// outliers, see [`Optimizer::edge_weights`](crate::Optimizer::edge_weights); 0 with one
+    /// that keeps every edge): accepted by the geometric check, yet inconsistent with the rest
+    /// of the graph, so they do not bend the map.
+    pub loops_weighted_out: usize,
     /// Optimiser runs that returned an error (the graph was kept as it was).
     pub optimizer_failures: usize,
     /// Milliseconds of each `process` call (odometry path), in order: the most recent ones, at

@@ -61,4 +61,11 @@ pub trait Optimizer<P: GraphPose> {
     /// Invalid graphs (no fixed node, disconnected nodes, bad information) or a factorisation that
     /// cannot be recovered. Stopping at the iteration cap is not an error: see the report.
     fn optimize(&mut self, graph: &mut PoseGraph<P>) -> Result<OptimizationReport, OptimizeError>;
+
+    /// For an optimiser that decides which edges are outliers (graduated non-convexity): the
+    /// weight in `[0, 1]` each edge ended the last run with, in [`PoseGraph::edges`] order (below
+    /// 0.5: weighted out). `None` (the default) for an optimiser that keeps every edge.
+    fn edge_weights(&self) -> Option<&[f64]> {
+        None
+    }
 }

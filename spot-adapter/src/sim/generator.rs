@@ -35,6 +35,11 @@ pub struct BuildingConfig {
     pub pilaster_spacing: (f64, f64),
     /// Furniture pieces per room, e.g. 1..=3.
     pub furniture_per_room: (usize, usize),
+    /// Perceptual aliasing along the south corridor: its rooms on both sides are copies of one
+    /// room each (the same width, door and furniture, repeated every few metres), and so are
+    /// the pilasters on its inner wall. A robot walking that corridor sees the same place again
+    /// and again, as in a hotel or an office floor of identical cells. Default false.
+    pub repeated_rooms: bool,
 }
 
 impl Default for BuildingConfig {
@@ -51,6 +56,7 @@ impl Default for BuildingConfig {
             door_height: 2.1,
             pilaster_spacing: (4.0, 8.0),
             furniture_per_room: (1, 3),
+            repeated_rooms: false,
         }
     }
 }
@@ -211,6 +217,51 @@ impl Draft<'_> {
     }
 }
 
+/// The repeated stretch of [`BuildingConfig::repeated_rooms`]: the core's south side cut into
+/// `rooms` equal rooms of `pitch`, from `x0`; each room's door (and the outer band's, opposite)
+/// and the corridor's pilaster at the same offset from the room's west wall.
+#[derive(Clone, Copy, Debug)]
+struct Repetition {
+    x0: f64,
+    pitch: f64,
+    rooms: usize,
+    door_width: f64,
+    /// Door centre from the west wall: core rooms, outer-band rooms.
+    core_door: f64,
+    outer_door: f64,
+    /// Pilaster centre from the west wall, clear of the core door.
+    pilaster: f64,
+}
+
+impl Repetition {
+    fn draw(rng: &mut SimRng, config: &BuildingConfig, kx0: f64, kx1: f64) -> Self {
+        let mean = 0.5 * (config.room_width.0 + config.room_width.1);
+        // At least three rooms, so that the outer band keeps an end room on each side.
+        let rooms = (((kx1 - kx0) / mean).round() as usize).max(3);
+        let pitch = (kx1 - kx0) / rooms as f64;
+        let t = config.wall_thickness;
+        let door_width = rng.range(config.door_width.0, config.door_width.1);
+        let core_door = door_on(rng, t, 0.0, pitch, door_width);
+        let outer_door = door_on(rng, t, 0.0, pitch, door_width);
+        // Half a pitch from the door: clear of it whatever the room width (>= 2.5 m).
+        let pilaster = (core_door + 0.5 * pitch) % pitch;
+        Self {
+            x0: kx0,
+            pitch,
+            rooms,
+            door_width,
+            core_door,
+            outer_door,
+            pilaster,
+        }
+    }
+
+    /// The west wall of room `j` (`j = rooms`: the east end).
+    fn x(&self, j: usize) -> f64 {
+        self.x0 + self.pitch * j as f64
+    }
+}
+
 /// Split `[lo, hi]` into rooms about `width` wide: returns the inner cut positions.
 fn cuts(rng: &mut SimRng, lo: f64, hi: f64, width: (f64, f64)) -> Vec<f64> {
     let len = hi - lo;
@@ -273,33 +324,20 @@ impl Building {
 
         // The corridor's outer walls with the doors of the outer-band rooms.
         let (cx0, cx1, cy0, cy1) = (band, w - band, band, h - band);
+        let core = [cx0 + cw, cx1 - cw, cy0 + cw, cy1 - cw];
+        let repeat = config
+            .repeated_rooms
+            .then(|| Repetition::draw(&mut rng, config, core[0], core[1]));
+        // Furnished rooms copied into others: (template room, copy room, x shift).
+        let mut copies: Vec<(usize, usize, f64)> = Vec::new();
         for south in [true, false] {
-            // South/north bands span the full width; the end rooms must reach the corridor by
-            // at least 2.5 m so that their door fits.
-            let first = cx0 + rng.range(2.5, 3.5);
-            let last = cx1 - rng.range(2.5, 3.5);
-            let mut xs = vec![0.0, first];
-            xs.extend(cuts(&mut rng, first, last, config.room_width));
-            xs.extend([last, w]);
-            let (y_wall, y_out) = if south { (cy0, 0.0) } else { (cy1, h) };
-            let mut doors = Vec::new();
-            for pair in xs.windows(2) {
-                let (a, b) = (pair[0], pair[1]);
-                let width = door_w(&mut rng);
-                let c = door_on(&mut rng, t, a.max(cx0), b.min(cx1), width);
-                doors.push((c, width));
-                let inward = Vector2::new(0.0, if south { -1.0 } else { 1.0 });
-                rooms.push(Room {
-                    min: Vector2::new(a, y_out.min(y_wall)),
-                    max: Vector2::new(b, y_out.max(y_wall)),
-                    door: Vector2::new(c, y_wall),
-                    inward,
-                });
-                if b < w {
-                    d.wall(false, b, y_out.min(y_wall), y_out.max(y_wall), &[]);
-                }
-            }
-            d.wall(true, y_wall, 0.0, w, &doors);
+            let plan = Band {
+                south,
+                size: (w, h),
+                corridor: (cx0, cx1, cy0, cy1),
+                repeat: repeat.filter(|_| south),
+            };
+            plan.build(&mut d, &mut rng, &mut rooms, &mut copies);
         }
         for west in [true, false] {
             let mut ys = vec![cy0];
@@ -326,14 +364,11 @@ impl Building {
         }
 
         // The core inside the loop: two rows of rooms, doors onto the corridor's inner walls.
-        let core = [cx0 + cw, cx1 - cw, cy0 + cw, cy1 - cw];
-        let (south_doors, north_doors) = core_rooms(&mut d, &mut rng, core, &mut rooms);
-        pilasters(&mut d, &mut rng, core, &south_doors, &north_doors);
+        let (south_doors, north_doors) =
+            core_rooms(&mut d, &mut rng, core, &mut rooms, repeat, &mut copies);
+        pilasters(&mut d, &mut rng, core, &south_doors, &north_doors, repeat);
 
-        // Pillars in large rooms, furniture against room walls; nothing in front of a door.
-        for room in &rooms {
-            furnish(&mut d, &mut rng, room);
-        }
+        furnish_rooms(&mut d, &mut rng, &rooms, &copies);
 
         Ok(Self::from_generated(
             d.boxes,
@@ -359,6 +394,8 @@ fn core_rooms(
     rng: &mut SimRng,
     [kx0, kx1, ky0, ky1]: [f64; 4],
     rooms: &mut Vec<Room>,
+    repeat: Option<Repetition>,
+    copies: &mut Vec<(usize, usize, f64)>,
 ) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
     let config = d.cfg;
     let ymid = 0.5 * (ky0 + ky1);
@@ -367,14 +404,28 @@ fn core_rooms(
     d.wall(false, kx1, ky0, ky1, &[]);
     let mut inner_doors = [Vec::new(), Vec::new()];
     for (row, south) in [true, false].into_iter().enumerate() {
-        let mut xs = vec![kx0];
-        xs.extend(cuts(rng, kx0, kx1, config.room_width));
-        xs.push(kx1);
+        let repeated = repeat.filter(|_| south);
+        let xs: Vec<f64> = if let Some(r) = repeated {
+            (0..=r.rooms).map(|j| r.x(j)).collect()
+        } else {
+            let mut xs = vec![kx0];
+            xs.extend(cuts(rng, kx0, kx1, config.room_width));
+            xs.push(kx1);
+            xs
+        };
         let (y_wall, y_far) = if south { (ky0, ymid) } else { (ky1, ymid) };
-        for pair in xs.windows(2) {
+        let template = rooms.len();
+        for (k, pair) in xs.windows(2).enumerate() {
             let (a, b) = (pair[0], pair[1]);
-            let width = rng.range(config.door_width.0, config.door_width.1);
-            let c = door_on(rng, config.wall_thickness, a, b, width);
+            let (c, width) = if let Some(r) = repeated {
+                if k > 0 {
+                    copies.push((template, rooms.len(), a - kx0));
+                }
+                (a + r.core_door, r.door_width)
+            } else {
+                let width = rng.range(config.door_width.0, config.door_width.1);
+                (door_on(rng, config.wall_thickness, a, b, width), width)
+            };
             inner_doors[row].push((c, width));
             rooms.push(Room {
                 min: Vector2::new(a, y_wall.min(y_far)),
@@ -400,6 +451,7 @@ fn pilasters(
     [kx0, kx1, ky0, ky1]: [f64; 4],
     south_doors: &[(f64, f64)],
     north_doors: &[(f64, f64)],
+    repeat: Option<Repetition>,
 ) {
     let config = d.cfg;
     let (t, ceiling) = (config.wall_thickness, d.ceiling);
@@ -413,7 +465,12 @@ fn pilasters(
         (false, kx0, ky0, ky1, -1.0, &[][..]),
         (false, kx1, ky0, ky1, 1.0, &[][..]),
     ] {
-        let mut s = a + draw(rng, config.pilaster_spacing) * 0.5;
+        // The repeated stretch has one pilaster per room, at the same place in each.
+        let repeated = repeat.filter(|_| horizontal && sign < 0.0);
+        let mut s = match repeated {
+            Some(r) => a + r.pilaster,
+            None => a + draw(rng, config.pilaster_spacing) * 0.5,
+        };
         while s < b - 1.0 {
             let clear = doors
                 .iter()
@@ -439,8 +496,107 @@ fn pilasters(
                     );
                 }
             }
-            s += draw(rng, config.pilaster_spacing);
+            s += match repeated {
+                Some(r) => r.pitch,
+                None => draw(rng, config.pilaster_spacing),
+            };
         }
+    }
+}
+
+/// Pillars in large rooms, furniture against room walls; nothing in front of a door. A copy
+/// (`copies`: template room, copy room, x shift) gets its template's furniture moved along.
+fn furnish_rooms(
+    d: &mut Draft<'_>,
+    rng: &mut SimRng,
+    rooms: &[Room],
+    copies: &[(usize, usize, f64)],
+) {
+    for (i, room) in rooms.iter().enumerate() {
+        if copies.iter().any(|&(_, copy, _)| copy == i) {
+            continue;
+        }
+        let before = d.boxes.len();
+        furnish(d, rng, room);
+        let added = before..d.boxes.len();
+        for &(_, _, dx) in copies.iter().filter(|&&(template, _, _)| template == i) {
+            for k in added.clone() {
+                let mut b = d.boxes[k];
+                b.min.x += dx;
+                b.max.x += dx;
+                d.boxes.push(b);
+            }
+        }
+    }
+}
+
+/// The south or north band of rooms between the outer wall and the corridor, spanning the full
+/// width.
+struct Band {
+    south: bool,
+    /// Building width and depth.
+    size: (f64, f64),
+    /// The corridor loop's outer walls: x0, x1, y0, y1.
+    corridor: (f64, f64, f64, f64),
+    /// The repeated stretch, on the south band when asked for.
+    repeat: Option<Repetition>,
+}
+
+impl Band {
+    /// Rooms, their side walls and the corridor wall with their doors.
+    fn build(
+        &self,
+        d: &mut Draft<'_>,
+        rng: &mut SimRng,
+        rooms: &mut Vec<Room>,
+        copies: &mut Vec<(usize, usize, f64)>,
+    ) {
+        let config = d.cfg;
+        let t = config.wall_thickness;
+        let (w, h) = self.size;
+        let (cx0, cx1, cy0, cy1) = self.corridor;
+        let south = self.south;
+        // The end rooms must reach the corridor by at least 2.5 m so that their door fits.
+        let (first, last) = if let Some(r) = self.repeat {
+            (r.x(1), r.x(r.rooms - 1))
+        } else {
+            (cx0 + rng.range(2.5, 3.5), cx1 - rng.range(2.5, 3.5))
+        };
+        let mut xs = vec![0.0, first];
+        if let Some(r) = self.repeat {
+            xs.extend((2..r.rooms - 1).map(|j| r.x(j)));
+        } else {
+            xs.extend(cuts(rng, first, last, config.room_width));
+        }
+        xs.extend([last, w]);
+        let (y_wall, y_out) = if south { (cy0, 0.0) } else { (cy1, h) };
+        let mut doors = Vec::new();
+        let template = rooms.len() + 1;
+        for (k, pair) in xs.windows(2).enumerate() {
+            let (a, b) = (pair[0], pair[1]);
+            let inner = k > 0 && k + 2 < xs.len();
+            let (c, width) = if let Some(r) = self.repeat.filter(|_| inner) {
+                if k > 1 {
+                    copies.push((template, rooms.len(), a - r.x(1)));
+                }
+                (a + r.outer_door, r.door_width)
+            } else {
+                let width = rng.range(config.door_width.0, config.door_width.1);
+                (door_on(rng, t, a.max(cx0), b.min(cx1), width), width)
+            };
+            doors.push((c, width));
+            let inward = Vector2::new(0.0, if south { -1.0 } else { 1.0 });
+            rooms.push(Room {
+                min: Vector2::new(a, y_out.min(y_wall)),
+                max: Vector2::new(b, y_out.max(y_wall)),
+                door: Vector2::new(c, y_wall),
+                inward,
+            });
+            if b < w {
+                d.wall(false, b, y_out.min(y_wall), y_out.max(y_wall), &[]);
+            }
+        }
+        d.wall(true, y_wall, 0.0, w, &doors);
     }
 }
 
