@@ -23,7 +23,7 @@ use slam_core::{
 };
 use spot_adapter::nav::{NavigationMap, NavigatorConfig};
 use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_slam, scan_to_scan_registrator, slam_config,
+    loam_slam, point_to_plane_slam, scan_context_places, scan_to_scan_registrator, slam_config,
 };
 use spot_adapter::record::{
     BagConfig, OdometrySource, PointCloud2Config, ReturnFilter, SampleSource, ScanToScanConfig,
@@ -122,6 +122,10 @@ struct Args {
     /// Turn off the engine's deskewing of scans with per-point times.
     #[arg(long)]
     no_deskew: bool,
+    /// Seek loops by position only: no Scan Context place recognition (on by default, so that
+    /// loops are found however far the estimate drifted).
+    #[arg(long)]
+    no_place_recognition: bool,
     /// Write the map, trajectory, pose graph and grid to this folder.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -242,11 +246,17 @@ where
     match args.registration {
         Registration::PointToPlane => {
             let mut slam = point_to_plane_slam(config)?;
+            if !args.no_place_recognition {
+                slam = slam.with_place_recognizer(scan_context_places());
+            }
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args)
         }
         Registration::Loam => {
             let mut slam = loam_slam(config)?;
+            if !args.no_place_recognition {
+                slam = slam.with_place_recognizer(scan_context_places());
+            }
             let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
             report(&slam, &mapping, args)
         }
@@ -272,9 +282,12 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             + report.skipped_non_finite_pose
     )?;
     out!(
-        "loops       {} closed of {} tried; {} odometry fallbacks, {} odometry faults",
+        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end); {} odometry fallbacks, {} odometry faults",
         report.loops_closed,
         report.loops_attempted,
+        report.place_loops_closed,
+        report.loops_beyond_drift,
+        report.loops_weighted_out,
         report.odometry_fallbacks,
         report.odometry_faults
     )?;
