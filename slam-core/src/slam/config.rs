@@ -59,7 +59,7 @@ pub struct GraphSlamConfig {
     /// so a far loop after a long lap passes, while a look-alike place a few rooms back, whose
     /// loop would teleport the robot by metres after a short walk, is refused before it
     /// reaches the graph (repeated rooms match each other geometrically, and their loops agree
-    /// with one another, so a robust back end alone does not catch them).
+    /// with one another: a robust back end is the second line, not the only one).
     pub loop_max_drift_rate: f64,
     /// Robust kernel on loop-closure edges (a wrong loop must not wreck the map).
     pub loop_kernel: Option<RobustKernel>,

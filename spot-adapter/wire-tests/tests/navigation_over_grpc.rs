@@ -4,7 +4,7 @@
 //! for the command that answers it, step the simulator by it for one LiDAR turn.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-#[path = "../../tests/common/mod.rs"]
+#[path = "../../tests/integration/common/mod.rs"]
 mod common;
 mod support;
 

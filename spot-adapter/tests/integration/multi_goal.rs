@@ -5,11 +5,9 @@
 //! tests.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
 use std::sync::OnceLock;
 
-use common::{Start, building_and_map, random_goals, run_legs};
+use crate::common::{Start, building_and_map, random_goals, run_legs};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, NavigatorConfig};

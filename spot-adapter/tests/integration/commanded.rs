@@ -162,7 +162,7 @@ fn a_walker_crosses_the_corridor_to_and_fro_and_counts_when_it_walks_into_the_ro
     assert!((seen[12] - from).norm() < 1e-9, "{}", seen[12]);
     assert_eq!(spot.collisions(), 0, "it never came near the robot");
     // One that walks across the robot's own position collides with it.
-    let (mut crossed, start, _) = crate::spot();
+    let (mut crossed, start, _) = self::spot();
     crossed
         .add_walker(start - 0.8 * left, start + 0.8 * left, 1.0, half, 1.7)
         .unwrap();

@@ -4,9 +4,7 @@
 //! ground truth.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
-use common::{Start, building_and_map, run_legs};
+use crate::common::{Start, building_and_map, run_legs};
 use nalgebra::Vector2;
 use registration::{IcpConfig, PointToPlaneIcp};
 use spot_adapter::AdapterError;

@@ -1,0 +1,21 @@
+//! spot-adapter's integration tests in one binary: one link instead of one per file, and one
+//! harness that runs every test across the cores (`cargo test -p spot-adapter --release --test
+//! integration [MODULE::]NAME`). Each module is one subject; `common` is what the navigation
+//! tests share.
+
+mod common;
+
+mod aliasing;
+mod bags;
+mod building;
+mod commanded;
+mod config;
+mod evaluation;
+mod lidar_only;
+mod multi_goal;
+mod navigation;
+mod place_recognition;
+mod point_cloud2_fuzz;
+mod recording;
+mod simulator;
+mod slam_loop;
