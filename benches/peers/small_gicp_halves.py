@@ -1,5 +1,5 @@
 """Accuracy against exact ground truth, beside small_gicp: a real HDL-32E scan split into two random
-halves (the same xorshift coin flips as registration/tests/common), one half moved by a known
+halves (the same xorshift coin flips as registration/tests/integration/common), one half moved by a known
 transform, registered back by small_gicp's single-thread PLANE_ICP and by ours (the `register`
 example), both at 0.25 m voxels with pairs within 1 m (the settings of the speed comparison).
 

@@ -6,10 +6,8 @@
 //!
 //! The bundled M3500 and a synthetic ring run in the normal suite; `ring.g2o` (issue 17's
 //! Geman-McClure case and the wrong loops) and sphere2500 (shared data) with
-//! `cargo test -p posegraph --release --test gnc -- --ignored`.
+//! `cargo test -p posegraph --release --test integration gnc:: -- --ignored`.
 #![allow(clippy::unwrap_used, clippy::panic)]
-
-mod common;
 
 use std::path::PathBuf;
 
@@ -357,7 +355,7 @@ fn known_inliers_and_losses() {
 /// Vertigo's ring.g2o from the shared data folder (GPL-3.0, so not bundled), first node fixed,
 /// and plain LM's optimum of it.
 fn ring_g2o() -> (PoseGraph<Pose2>, Vec<Pose2>) {
-    let Some(path) = common::shared("ring.g2o") else {
+    let Some(path) = crate::common::shared("ring.g2o") else {
         panic!("ring.g2o not found in the shared data folder (SPOT_NAV_DATA)");
     };
     let G2oGraph::Se2(mut clean) = read_g2o(path).unwrap() else {
@@ -437,7 +435,7 @@ fn geman_mcclure_on_ring_g2o_from_the_files_guess() {
 #[test]
 #[ignore = "reads the shared data folder (about a minute); run with --ignored"]
 fn sphere2500_with_10_percent_wrong_loops() {
-    let Some(path) = common::shared("sphere2500.g2o") else {
+    let Some(path) = crate::common::shared("sphere2500.g2o") else {
         eprintln!("sphere2500.g2o not found; skipping");
         return;
     };

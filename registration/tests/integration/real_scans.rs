@@ -2,9 +2,7 @@
 //! published reference pose, and on degenerate input.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
-use common::{error, here, random_halves, random_halves_with, reference, target_scan};
+use crate::common::{error, here, random_halves, random_halves_with, reference, target_scan};
 use nalgebra::Point3;
 use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
@@ -271,7 +269,7 @@ fn invalid_settings_are_errors() {
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
     let icp = PointToPlaneIcp::default();
-    common::rejects_empty_and_nan(&icp);
+    crate::common::rejects_empty_and_nan(&icp);
     // A single plane: translation along it and rotation about its normal are unobservable.
     let plane: Vec<Point3<f32>> = (0..4000)
         .map(|i| Point3::new((i % 80) as f32 * 0.1, (i / 80) as f32 * 0.1, 0.0))
@@ -339,7 +337,7 @@ fn coincident_or_collinear_targets_are_refused() {
 /// with them to 0.7-3.8 cm).
 #[test]
 fn os1_128_steps_match_the_reference_poses() {
-    let (frames, poses) = common::os1_128();
+    let (frames, poses) = crate::common::os1_128();
     let icp = PointToPlaneIcp::default();
     for k in 0..2 {
         let reference = poses[k].inverse() * poses[k + 1];

@@ -3,9 +3,7 @@
 //! degenerate input.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
-use common::{error, garage_frames, here, os1_128, random_halves, reference, target_scan};
+use crate::common::{error, garage_frames, here, os1_128, random_halves, reference, target_scan};
 use registration::{LidarLayout, LoamConfig, LoamFeatures, LoamRegistrator};
 use slam_core::io::read_ply;
 use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
@@ -129,7 +127,7 @@ fn static_garage_sequence_does_not_drift() {
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
     let loam = LoamRegistrator::default();
-    common::rejects_empty_and_nan(&loam);
+    crate::common::rejects_empty_and_nan(&loam);
     let mut bad = loam;
     bad.config.tukey_threshold = -1.0;
     assert!(matches!(

@@ -2,8 +2,6 @@
 //! graph of the same size, and graphs whose cost is not finite at the start.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
 use nalgebra::{Matrix3, Vector3};
 use posegraph::{
     GaussNewton, GncConfig, GraduatedNonConvexity, LevenbergMarquardt, SolverPose,
@@ -17,7 +15,7 @@ use slam_core::{
 /// A noisy SE(2) chain of `n` nodes (node 0 fixed) plus `loops` (node pairs), measurements from
 /// a zig-zag truth with noise from `seed`.
 fn se2_graph(n: u64, loops: &[(u64, u64)], seed: u64) -> PoseGraph<Pose2> {
-    let mut r = common::rng(seed);
+    let mut r = crate::common::rng(seed);
     let truth: Vec<Pose2> = (0..n)
         .map(|i| {
             #[allow(clippy::cast_precision_loss)]
@@ -48,7 +46,7 @@ fn se2_graph(n: u64, loops: &[(u64, u64)], seed: u64) -> PoseGraph<Pose2> {
 
 /// The same for SE(3) (a helix).
 fn se3_graph(n: u64, loops: &[(u64, u64)], seed: u64) -> PoseGraph<Pose3> {
-    let mut r = common::rng(seed);
+    let mut r = crate::common::rng(seed);
     let truth: Vec<Pose3> = (0..n)
         .map(|i| {
             #[allow(clippy::cast_precision_loss)]

@@ -2,9 +2,7 @@
 //! scans with free space from their beams, unknown cells in the ROS map.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
-use common::room;
+use crate::common::room;
 use gridmap::{
     CellState, FloorConfig, FloorMap, GridMapError, ObstacleBandConfig, OccupancyGrid,
     OccupancyGridBuilder, OccupancyGridConfig, UnknownCells, floor_hints_below, read_ros_map,

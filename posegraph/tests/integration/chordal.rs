@@ -3,9 +3,7 @@
 //! the file's own guess stops in a local minimum.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
-use common::{rng, shared};
+use crate::common::{rng, shared};
 use std::time::Instant;
 
 use nalgebra::{Matrix3, Matrix6, Vector2, Vector3, Vector6};

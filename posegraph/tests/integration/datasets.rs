@@ -2,9 +2,7 @@
 //! (GTSAM 4.3 LM, log-map error; our cost is `sum e^T Omega e` = 2 x GTSAM's error).
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
-use common::shared;
+use crate::common::shared;
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -2,8 +2,6 @@
 //! repaired on request (nearest positive-definite matrix), every repair reported.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
 use posegraph::LevenbergMarquardt;
 use posegraph::g2o::{G2oGraph, g2o_text_se3, parse_g2o, parse_g2o_with, read_g2o, read_g2o_with};
 use posegraph::information_repair::InformationRepair;
@@ -90,7 +88,8 @@ fn shared_se3_sets_load_with_repair() {
         "torus3D.g2o",
         "sphere_bignoise_vertex3.g2o",
     ] {
-        let path = common::shared(name).unwrap_or_else(|| panic!("{name} not in the shared data"));
+        let path =
+            crate::common::shared(name).unwrap_or_else(|| panic!("{name} not in the shared data"));
         let plain = read_g2o(&path);
         let (_, repaired) =
             read_g2o_with(&path, InformationRepair::nearest_positive_definite()).unwrap();

@@ -2,9 +2,7 @@
 //! trail, unseen changes decay back to the static map, and only the window is touched.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
-use common::{World, block, room};
+use crate::common::{World, block, room};
 use gridmap::{
     CellRect, CellState, FloorMap, GridMapError, LiveLayer, LiveLayerConfig, LocalCell,
     ObstacleBandConfig, OccupancyGrid, OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid,

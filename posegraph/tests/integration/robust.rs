@@ -2,9 +2,7 @@
 //! loops every pose ends within 5 cm of the truth.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
-use common::rng;
+use crate::common::rng;
 use nalgebra::{Matrix6, Vector6};
 use posegraph::LevenbergMarquardt;
 use slam_core::{Optimizer, Pose3, PoseGraph, RobustKernel, pose3_from_xyz_rpy, se3_exp};

@@ -3,8 +3,6 @@
 //! door stays open under the hard inflation that a 0.40 m inflation closes.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-mod common;
-
 use gridmap::{
     CellRect, CellState, ClearanceCostConfig, DistanceField, FloorConfig, FloorMap, GridMapError,
     ObstacleBandConfig, OccupancyGrid, OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid,
@@ -118,7 +116,7 @@ proptest! {
 /// cells). The hard inflation of 0.30 m leaves two cells open, 0.40 m closes it.
 #[test]
 fn a_door_of_0_9_m_stays_open_under_the_hard_inflation() {
-    let world = common::room(-0.8);
+    let world = crate::common::room(-0.8);
     let cloud = world.surface_cloud(-0.15, -0.15, 12.15, 6.15, 0.04);
     let floor = FloorMap::estimate(
         &cloud,

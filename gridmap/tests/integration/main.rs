@@ -1,0 +1,10 @@
+//! gridmap's integration tests in one binary: one link instead of one per file, and one
+//! harness that runs every test across the cores (`cargo test -p gridmap --release --test
+//! integration [MODULE::]NAME`).
+
+mod common;
+
+mod floor_band;
+mod gridmap;
+mod live_layer;
+mod planning_grid;

@@ -1,0 +1,12 @@
+//! posegraph's integration tests in one binary: one link instead of one per file, and one
+//! harness that runs every test across the cores (`cargo test -p posegraph --release --test
+//! integration [MODULE::]NAME`).
+
+mod common;
+
+mod chordal;
+mod datasets;
+mod gnc;
+mod information_repair;
+mod robust;
+mod solver_faults;

@@ -1,0 +1,9 @@
+//! registration's integration tests in one binary: one link instead of one per file, and one
+//! harness that runs every test across the cores (`cargo test -p registration --release --test
+//! integration [MODULE::]NAME`).
+
+mod common;
+
+mod loam;
+mod real_scans;
+mod voxel_hash_map;
