@@ -36,7 +36,10 @@ fn huge_map_headers_are_refused_before_allocating() {
         .arg("-c")
         .arg(r#"ulimit -v 1048576 && ulimit -t 20 && exec "$0" "$@""#)
         .arg(std::env::current_exe().unwrap())
-        .args(["--exact", "huge_map_headers_are_refused_before_allocating"])
+        .args([
+            "--exact",
+            "bounded_memory::huge_map_headers_are_refused_before_allocating",
+        ])
         .args(["--nocapture", "--test-threads=1"])
         .env(CHILD, "1")
         .output()
@@ -46,5 +49,11 @@ fn huge_map_headers_are_refused_before_allocating() {
         "capped child: {}\n{}",
         out.status,
         String::from_utf8_lossy(&out.stderr)
+    );
+    // The filter must have found the test: a child that ran nothing would pass vacuously.
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("1 passed"),
+        "the capped child ran no test: {}",
+        String::from_utf8_lossy(&out.stdout)
     );
 }

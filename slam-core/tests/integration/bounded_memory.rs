@@ -22,7 +22,8 @@ fn capped(test: &str, body: impl FnOnce()) {
         .arg("-c")
         .arg(r#"ulimit -v 1048576 && ulimit -t 20 && exec "$0" "$@""#)
         .arg(exe)
-        .args(["--exact", test, "--nocapture", "--test-threads=1"])
+        .args(["--exact", &format!("bounded_memory::{test}")])
+        .args(["--nocapture", "--test-threads=1"])
         .env(CHILD, "1")
         .output()
         .unwrap();
@@ -31,6 +32,12 @@ fn capped(test: &str, body: impl FnOnce()) {
         "{test} in a capped child: {}\n{}",
         out.status,
         String::from_utf8_lossy(&out.stderr)
+    );
+    // The filter must have found the test: a child that ran nothing would pass vacuously.
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("1 passed"),
+        "the capped child ran no test: {}",
+        String::from_utf8_lossy(&out.stdout)
     );
 }
 

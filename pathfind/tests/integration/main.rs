@@ -1,0 +1,8 @@
+//! pathfind's integration tests in one binary: one link instead of one per file, and one
+//! harness that runs every test across the cores (`cargo test -p pathfind --release --test
+//! integration [MODULE::]NAME`).
+
+mod bounded_memory;
+mod cell_costs;
+mod movingai_golden;
+mod planners;
