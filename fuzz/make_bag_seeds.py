@@ -179,11 +179,11 @@ MOUNT = [0.2, 0.0, 0.15, 0.0, 0.0, 0.0, 1.0]
 
 def layouts(p):
     """The clouds' field layouts, by name: (columns, height, big endian)."""
-    t = p["t"].astype(np.float64) * 1e-9  # the PCD's t is nanoseconds since the scan's start
+    t = p["t"].astype(np.float64)  # the PCD's t: seconds since the scan's start
     xyz = [("x", p["x"], "f4"), ("y", p["y"], "f4"), ("z", p["z"], "f4")]
     return {
         # Ouster's driver: x y z pad intensity t(ns) reflectivity ring(u16) pad.
-        "ouster": (xyz + [("", 4, None), ("intensity", p["intensity"], "f4"), ("t", p["t"], "u4"),
+        "ouster": (xyz + [("", 4, None), ("intensity", p["intensity"], "f4"), ("t", np.round(t * 1e9), "u4"),
                           ("reflectivity", np.zeros(len(p)), "u2"), ("ring", p["ring"], "u2"), ("", 8, None)], 1, False),
         # Velodyne's: x y z pad intensity ring(u16) pad time (f32 seconds since the stamp).
         "velodyne": (xyz + [("", 4, None), ("intensity", p["intensity"], "f4"), ("ring", p["ring"], "u2"),
@@ -200,7 +200,7 @@ def layouts(p):
 
 def cloud_message(m, stamp, p, layout):
     columns, height, big_endian = layouts(p)[layout]
-    absolute = stamp + p["t"].astype(np.float64) * 1e-9
+    absolute = stamp + p["t"].astype(np.float64)
     filled = []
     for name, values, kind in columns:
         if name == "timestamp":
