@@ -92,6 +92,20 @@ pub enum AdapterError {
         /// The mcap crate's reason (boxed: it is large).
         source: Box<mcap::McapError>,
     },
+    /// An MCAP schema or channel record holds a string longer than the record.
+    #[error(
+        "{path}: MCAP record 0x{opcode:02x}: a string of {claimed} bytes where {left} remain in its record"
+    )]
+    McapString {
+        /// The file.
+        path: PathBuf,
+        /// The record's opcode (3 schema, 4 channel).
+        opcode: u8,
+        /// The length the string claims (or 4, for a length cut off).
+        claimed: u64,
+        /// The bytes left in the record.
+        left: usize,
+    },
     /// A ROS 1 bag cannot be read (truncated, corrupt, unindexed).
     #[error("{path}: {source}")]
     Ros1Bag {

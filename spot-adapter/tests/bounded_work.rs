@@ -1,12 +1,13 @@
-//! Messages found by fuzzing (`fuzz/`, targets `point_cloud2`, `ros1_bag`, `mcap_bag`) whose
+//! Messages and bags found by fuzzing (`fuzz/`, targets `point_cloud2` and `mcap_bag`) whose
 //! decoding took time or memory out of proportion to their bytes: decoded in a child process
 //! capped in CPU time and address space (`ulimit -t`, `ulimit -v`), because a hang or an
 //! allocation failure cannot be caught in the process itself.
 #![cfg(unix)]
 #![allow(clippy::unwrap_used, clippy::panic)]
 
+use spot_adapter::AdapterError;
 use spot_adapter::record::{
-    Header, PointCloud2, PointCloud2Config, PointCloud2Decoder, PointField,
+    Bag, BagConfig, Header, PointCloud2, PointCloud2Config, PointCloud2Decoder, PointField,
 };
 
 /// Set in the child: run the checks instead of spawning.
@@ -79,4 +80,74 @@ fn clouds_of_empty_rows_decode_without_visiting_them() {
         return;
     }
     in_capped_child("clouds_of_empty_rows_decode_without_visiting_them", 5);
+}
+
+/// An MCAP record: opcode, u64 length, body.
+fn mcap_record(opcode: u8, body: &[u8]) -> Vec<u8> {
+    let mut out = vec![opcode];
+    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    out.extend_from_slice(body);
+    out
+}
+
+fn open_mcap(name: &str, records: &[Vec<u8>]) -> Result<Bag, AdapterError> {
+    let dir = std::env::temp_dir().join(format!("spot-adapter-bounded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let mut bytes = b"\x89MCAP0\r\n".to_vec();
+    for r in records {
+        bytes.extend_from_slice(r);
+    }
+    std::fs::write(&path, bytes).unwrap();
+    let bag = Bag::open(&path, &BagConfig::default());
+    std::fs::remove_dir_all(&dir).unwrap();
+    bag
+}
+
+fn open_mcap_with_long_strings() {
+    let header = mcap_record(1, &[0, 0, 0, 0, 0, 0, 0, 0]);
+    // A channel whose topic claims 4 GiB (the `mcap` crate reserved that much before reading
+    // it; the fuzzer's input is `fuzz/regressions/mcap_bag/channel_topic_claims_4_gib`).
+    let mut channel = vec![1, 0, 0, 0];
+    channel.extend_from_slice(&u32::MAX.to_le_bytes());
+    channel.extend_from_slice(b"/points");
+    match open_mcap("channel.mcap", &[header.clone(), mcap_record(4, &channel)]) {
+        Err(AdapterError::McapString {
+            opcode: 4,
+            claimed,
+            left: 7,
+            ..
+        }) => assert_eq!(claimed, u64::from(u32::MAX)),
+        other => panic!("{other:?}"),
+    }
+    // A schema's name, likewise.
+    let mut schema = vec![1, 0];
+    schema.extend_from_slice(&u32::MAX.to_le_bytes());
+    let err = open_mcap("schema.mcap", &[header, mcap_record(3, &schema)]).unwrap_err();
+    assert!(
+        matches!(err, AdapterError::McapString { opcode: 3, .. }),
+        "{err}"
+    );
+    // A header (not needed for messages, so not parsed) and a metadata record, likewise: the
+    // file is then refused for its missing end, not aborted.
+    let mut long = vec![0xff, 0xff, 0xff, 0xff];
+    long.extend_from_slice(b"ros2");
+    let err = open_mcap(
+        "header.mcap",
+        &[mcap_record(1, &long), mcap_record(12, &long)],
+    )
+    .unwrap_err();
+    assert!(matches!(err, AdapterError::Mcap { .. }), "{err}");
+}
+
+#[test]
+fn mcap_strings_longer_than_their_record_are_refused_before_allocating() {
+    if std::env::var_os(CHILD).is_some() {
+        open_mcap_with_long_strings();
+        return;
+    }
+    in_capped_child(
+        "mcap_strings_longer_than_their_record_are_refused_before_allocating",
+        20,
+    );
 }
