@@ -92,19 +92,18 @@ pub enum AdapterError {
         /// The mcap crate's reason (boxed: it is large).
         source: Box<mcap::McapError>,
     },
-    /// An MCAP schema or channel record holds a string longer than the record.
-    #[error(
-        "{path}: MCAP record 0x{opcode:02x}: a string of {claimed} bytes where {left} remain in its record"
-    )]
-    McapString {
+    /// An MCAP record holds a string, or an uncompressed chunk a record, longer than itself.
+    #[error("{path}: MCAP {what} of {claimed} bytes where {left} remain")]
+    McapLength {
         /// The file.
         path: PathBuf,
-        /// The record's opcode (3 schema, 4 channel).
-        opcode: u8,
-        /// The length the string claims (or 4, for a length cut off).
+        /// What is too long, and where ("channel record: a string", "uncompressed chunk: a
+        /// record").
+        what: &'static str,
+        /// The length it claims (for a length field cut off: the field's size).
         claimed: u64,
-        /// The bytes left in the record.
-        left: usize,
+        /// The bytes left around it.
+        left: u64,
     },
     /// A ROS 1 bag cannot be read (truncated, corrupt, unindexed).
     #[error("{path}: {source}")]

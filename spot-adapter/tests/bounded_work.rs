@@ -112,12 +112,15 @@ fn open_mcap_with_long_strings() {
     channel.extend_from_slice(&u32::MAX.to_le_bytes());
     channel.extend_from_slice(b"/points");
     match open_mcap("channel.mcap", &[header.clone(), mcap_record(4, &channel)]) {
-        Err(AdapterError::McapString {
-            opcode: 4,
+        Err(AdapterError::McapLength {
+            what,
             claimed,
             left: 7,
             ..
-        }) => assert_eq!(claimed, u64::from(u32::MAX)),
+        }) => {
+            assert_eq!(what, "channel record: a string");
+            assert_eq!(claimed, u64::from(u32::MAX));
+        }
         other => panic!("{other:?}"),
     }
     // A schema's name, likewise.
@@ -125,7 +128,13 @@ fn open_mcap_with_long_strings() {
     schema.extend_from_slice(&u32::MAX.to_le_bytes());
     let err = open_mcap("schema.mcap", &[header, mcap_record(3, &schema)]).unwrap_err();
     assert!(
-        matches!(err, AdapterError::McapString { opcode: 3, .. }),
+        matches!(
+            err,
+            AdapterError::McapLength {
+                what: "schema record: a string",
+                ..
+            }
+        ),
         "{err}"
     );
     // A header (not needed for messages, so not parsed) and a metadata record, likewise: the
@@ -150,4 +159,28 @@ fn mcap_strings_longer_than_their_record_are_refused_before_allocating() {
         "mcap_strings_longer_than_their_record_are_refused_before_allocating",
         20,
     );
+}
+
+#[test]
+fn records_past_their_uncompressed_mcap_chunk_are_refused() {
+    // An uncompressed chunk of 20 bytes whose message record claims 100: the `mcap` crate read
+    // on past the chunk and subtracted with overflow (a panic in debug builds; the fuzzer's
+    // input is `fuzz/regressions/mcap_bag/chunk_record_past_its_chunk`).
+    let mut message = vec![5];
+    message.extend_from_slice(&100u64.to_le_bytes());
+    message.extend_from_slice(&[0; 11]);
+    let mut chunk = vec![0u8; 32]; // times, sizes, CRC, no compression
+    chunk.extend_from_slice(&(message.len() as u64).to_le_bytes());
+    chunk.extend_from_slice(&message);
+    let filler = mcap_record(12, &[0; 120]);
+    let header = mcap_record(1, &[0, 0, 0, 0, 0, 0, 0, 0]);
+    match open_mcap("chunk.mcap", &[header, mcap_record(6, &chunk), filler]) {
+        Err(AdapterError::McapLength {
+            what,
+            claimed: 100,
+            left: 11,
+            ..
+        }) => assert_eq!(what, "uncompressed chunk: a record"),
+        other => panic!("{other:?}"),
+    }
 }

@@ -245,7 +245,7 @@ impl Bag {
     /// Open the bag at `path` (`.mcap` or `.bag`) and check it in one streaming pass.
     ///
     /// # Errors
-    /// [`AdapterError::Io`], [`AdapterError::Mcap`], [`AdapterError::McapString`],
+    /// [`AdapterError::Io`], [`AdapterError::Mcap`], [`AdapterError::McapLength`],
     /// [`AdapterError::Ros1Bag`] or [`AdapterError::Recording`] for a file that cannot be read
     /// (truncated, not a bag); [`AdapterError::Message`] for a message that cannot be decoded, a cloud topic of another
     /// type, a missing transform; [`AdapterError::Recording`] when the topics asked for are
