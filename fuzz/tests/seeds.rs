@@ -1,14 +1,16 @@
-//! Every seed (real files cut small, see `make_seeds.py`) must parse and read back the same, and
-//! every input a fuzzing run saved under `regressions/<target>/` must run to its end without a
-//! panic, on stable Rust: `cargo test --manifest-path fuzz/Cargo.toml`.
+//! Every seed (real files cut small, see `make_seeds.py` and `make_bag_seeds.py`) must parse and
+//! read back the same (or keep its invariants, for the bag and ROS message targets), and every
+//! input a fuzzing run saved under `regressions/<target>/` must run to its end without a panic,
+//! on stable Rust: `cargo test --manifest-path fuzz/Cargo.toml`.
 
 use std::path::Path;
 
-use spot_nav_fuzz::round_trip;
+use spot_nav_fuzz::{invariants, round_trip};
 
-type RoundTrip = fn(&[u8]) -> bool;
+/// A target's check: true when the input parsed (and passed), a panic when it broke a rule.
+type Check = fn(&[u8]) -> bool;
 
-const TARGETS: [(&str, RoundTrip); 12] = [
+const TARGETS: [(&str, Check); 16] = [
     ("pcd", round_trip::pcd),
     ("ply", round_trip::ply),
     ("kitti_bin", round_trip::kitti_bin),
@@ -21,6 +23,10 @@ const TARGETS: [(&str, RoundTrip); 12] = [
     ("ros_map", round_trip::ros_map),
     ("recording_index", round_trip::recording_index),
     ("recording_calibration", round_trip::recording_calibration),
+    ("ros1_bag", invariants::ros1_bag),
+    ("mcap_bag", invariants::mcap_bag),
+    ("point_cloud2", invariants::point_cloud2),
+    ("ros_message", invariants::ros_message),
 ];
 
 /// The files of `dir` (none when it does not exist), sorted.

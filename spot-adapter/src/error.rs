@@ -92,6 +92,19 @@ pub enum AdapterError {
         /// The mcap crate's reason (boxed: it is large).
         source: Box<mcap::McapError>,
     },
+    /// An MCAP record holds a string, or an uncompressed chunk a record, longer than itself.
+    #[error("{path}: MCAP {what} of {claimed} bytes where {left} remain")]
+    McapLength {
+        /// The file.
+        path: PathBuf,
+        /// What is too long, and where ("channel record: a string", "uncompressed chunk: a
+        /// record").
+        what: &'static str,
+        /// The length it claims (for a length field cut off: the field's size).
+        claimed: u64,
+        /// The bytes left around it.
+        left: u64,
+    },
     /// A ROS 1 bag cannot be read (truncated, corrupt, unindexed).
     #[error("{path}: {source}")]
     Ros1Bag {

@@ -245,9 +245,9 @@ impl Bag {
     /// Open the bag at `path` (`.mcap` or `.bag`) and check it in one streaming pass.
     ///
     /// # Errors
-    /// [`AdapterError::Io`], [`AdapterError::Mcap`], [`AdapterError::Ros1Bag`] or
-    /// [`AdapterError::Recording`] for a file that cannot be read (truncated, not a bag);
-    /// [`AdapterError::Message`] for a message that cannot be decoded, a cloud topic of another
+    /// [`AdapterError::Io`], [`AdapterError::Mcap`], [`AdapterError::McapLength`],
+    /// [`AdapterError::Ros1Bag`] or [`AdapterError::Recording`] for a file that cannot be read
+    /// (truncated, not a bag); [`AdapterError::Message`] for a message that cannot be decoded, a cloud topic of another
     /// type, a missing transform; [`AdapterError::Recording`] when the topics asked for are
     /// absent or the choice is ambiguous.
     pub fn open(path: impl AsRef<Path>, config: &BagConfig) -> Result<Self, AdapterError> {

@@ -1,17 +1,18 @@
 //! The messages of a bag file in file order, one at a time, whichever format it is in: ROS 2
-//! MCAP (the `mcap` crate's streaming reader over a buffered file: memory is that of the largest
-//! chunk) or ROS 1 (the `rosbag` crate over a memory map, one chunk decompressed at a time).
+//! MCAP ([`McapMessages`], over the `mcap` crate's streaming reader: memory is that of the
+//! largest chunk) or ROS 1 (the `rosbag` crate over a memory map, one chunk decompressed at a time).
 //! Payloads come out undecoded, with their topic, type and serialisation.
 
 use std::collections::{HashMap, VecDeque};
 use std::fs::File;
-use std::io::{BufReader, Read};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use crate::error::AdapterError;
+use crate::record::mcap_file::McapMessages;
 use crate::record::ros_messages::RosMessageType;
 use crate::record::wire::Wire;
 
@@ -66,7 +67,7 @@ pub(crate) struct RawMessage {
 pub(crate) enum BagMessages {
     Mcap {
         path: PathBuf,
-        reader: Box<mcap::io::MessageReader<BufReader<File>>>,
+        reader: Box<McapMessages>,
         topics: HashMap<u16, Arc<TopicInfo>>,
     },
     Ros1(Box<Ros1Messages>),
@@ -85,18 +86,11 @@ impl BagMessages {
     /// The messages of the bag at `path`, in `format`.
     pub(crate) fn open(path: &Path, format: BagFormat) -> Result<Self, AdapterError> {
         match format {
-            BagFormat::Mcap => {
-                let file = File::open(path).map_err(|e| AdapterError::io(path, e))?;
-                Ok(Self::Mcap {
-                    path: path.to_path_buf(),
-                    reader: Box::new(mcap::io::MessageReader::new_with_options(
-                        BufReader::with_capacity(1 << 20, file),
-                        mcap::sans_io::LinearReaderOptions::default()
-                            .with_record_length_limit(MAX_RECORD_BYTES),
-                    )),
-                    topics: HashMap::new(),
-                })
-            }
+            BagFormat::Mcap => Ok(Self::Mcap {
+                path: path.to_path_buf(),
+                reader: Box::new(McapMessages::open(path, MAX_RECORD_BYTES)?),
+                topics: HashMap::new(),
+            }),
             BagFormat::Ros1 => Ok(Self::Ros1(Box::new(Ros1Messages::open(path)?))),
         }
     }
@@ -107,19 +101,10 @@ impl Iterator for BagMessages {
 
     fn next(&mut self) -> Option<Self::Item> {
         match self {
-            Self::Mcap {
-                path,
-                reader,
-                topics,
-            } => {
+            Self::Mcap { reader, topics, .. } => {
                 let message = match reader.next()? {
                     Ok(m) => m,
-                    Err(source) => {
-                        return Some(Err(AdapterError::Mcap {
-                            path: path.clone(),
-                            source: Box::new(source),
-                        }));
-                    }
+                    Err(e) => return Some(Err(e)),
                 };
                 let channel = &message.channel;
                 let topic = topics.entry(channel.id).or_insert_with(|| {
@@ -147,7 +132,7 @@ impl Iterator for BagMessages {
                 Some(Ok(RawMessage {
                     topic: Arc::clone(topic),
                     log_time: message.log_time,
-                    data: message.data.into_owned(),
+                    data: message.data,
                 }))
             }
             Self::Ros1(r) => r.next(),

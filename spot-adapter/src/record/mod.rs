@@ -60,6 +60,7 @@ mod cloud_folder;
 mod frame_tree;
 mod kitti;
 mod lidar_only;
+mod mcap_file;
 mod no_return;
 mod point_cloud2;
 mod recording;

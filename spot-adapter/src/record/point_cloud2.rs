@@ -416,7 +416,10 @@ impl PointCloud2Decoder {
             a.copy_from_slice(&p[o..o + 4]);
             f32::from_le_bytes(a)
         };
-        for row in 0..msg.height as usize {
+        // A cloud of width 0 has no point whatever its height claims: its empty rows are not
+        // walked, so the work stays in proportion to the data.
+        let rows = if n == 0 { 0 } else { msg.height as usize };
+        for row in 0..rows {
             let start = row * row_step;
             for p in msg.data[start..start + row_points as usize].chunks_exact(step) {
                 let t = layout.time.as_ref().map(|f| {

@@ -7,7 +7,7 @@ use nalgebra::{Translation3, Vector3};
 use slam_core::{Pose3, quaternion_from_xyzw};
 
 use crate::error::MessageError;
-use crate::record::wire::WireReader;
+use crate::record::wire::{Wire, WireReader};
 
 /// The message types a bag reader understands, by their ROS name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,6 +108,18 @@ pub struct PointCloud2<'a> {
 }
 
 impl<'a> PointCloud2<'a> {
+    /// The message serialised in `data` (one bag payload) in `wire`'s serialisation, its point
+    /// data borrowed from `data`. Bytes after the message are ignored.
+    ///
+    /// # Errors
+    /// [`MessageError::Truncated`] when `data` ends inside the message or a count claims more
+    /// than it holds, [`MessageError::InvalidString`] for a name that is not UTF-8 (or a CDR
+    /// string without its NUL), [`MessageError::Encapsulation`] for a CDR header that is not
+    /// plain CDR.
+    pub fn parse(data: &'a [u8], wire: Wire) -> Result<Self, MessageError> {
+        Self::decode(&mut WireReader::new(data, wire)?)
+    }
+
     pub(crate) fn decode(r: &mut WireReader<'a>) -> Result<Self, MessageError> {
         let header = Header::decode(r)?;
         let height = r.u32()?;
@@ -162,6 +174,16 @@ pub struct Odometry {
 }
 
 impl Odometry {
+    /// The message serialised in `data` in `wire`'s serialisation (the pose part; covariance and
+    /// twist after it are not read).
+    ///
+    /// # Errors
+    /// As [`PointCloud2::parse`]; [`MessageError::InvalidPose`] for a non-finite translation or
+    /// a quaternion that cannot be normalised.
+    pub fn parse(data: &[u8], wire: Wire) -> Result<Self, MessageError> {
+        Self::decode(&mut WireReader::new(data, wire)?)
+    }
+
     pub(crate) fn decode(r: &mut WireReader<'_>) -> Result<Self, MessageError> {
         Ok(Self {
             header: Header::decode(r)?,
@@ -180,6 +202,17 @@ pub struct TransformStamped {
     pub child_frame_id: String,
     /// `parent_T_child`.
     pub transform: Pose3,
+}
+
+impl TransformStamped {
+    /// The transforms of the `tf2_msgs/TFMessage` serialised in `data` in `wire`'s
+    /// serialisation.
+    ///
+    /// # Errors
+    /// As [`Odometry::parse`].
+    pub fn parse_tf_message(data: &[u8], wire: Wire) -> Result<Vec<Self>, MessageError> {
+        decode_tf_message(&mut WireReader::new(data, wire)?)
+    }
 }
 
 /// `tf2_msgs/TFMessage`: its transforms.
@@ -216,6 +249,14 @@ pub struct ImuReading {
 }
 
 impl ImuReading {
+    /// The message serialised in `data` in `wire`'s serialisation.
+    ///
+    /// # Errors
+    /// As [`PointCloud2::parse`].
+    pub fn parse(data: &[u8], wire: Wire) -> Result<Self, MessageError> {
+        Self::decode(&mut WireReader::new(data, wire)?)
+    }
+
     pub(crate) fn decode(r: &mut WireReader<'_>) -> Result<Self, MessageError> {
         let header = Header::decode(r)?;
         let q = r.f64_array::<4>()?;
@@ -239,7 +280,6 @@ impl ImuReading {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::record::wire::Wire;
 
     #[test]
     fn type_names_in_both_spellings() {
