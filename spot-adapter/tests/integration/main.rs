@@ -7,6 +7,7 @@ mod common;
 
 mod aliasing;
 mod bags;
+mod bounded_work;
 mod building;
 mod commanded;
 mod config;

@@ -22,7 +22,8 @@ fn in_capped_child(name: &str, cpu_seconds: u32) {
             r#"ulimit -v 1048576 && ulimit -t {cpu_seconds} && exec "$0" "$@""#
         ))
         .arg(std::env::current_exe().unwrap())
-        .args(["--exact", name, "--nocapture", "--test-threads=1"])
+        .args(["--exact", &format!("bounded_work::{name}")])
+        .args(["--nocapture", "--test-threads=1"])
         .env(CHILD, "1")
         .output()
         .unwrap();
@@ -31,6 +32,12 @@ fn in_capped_child(name: &str, cpu_seconds: u32) {
         "capped child: {}\n{}",
         out.status,
         String::from_utf8_lossy(&out.stderr)
+    );
+    // The filter must have found the test: a child that ran nothing would pass vacuously.
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("1 passed"),
+        "the capped child ran no test: {}",
+        String::from_utf8_lossy(&out.stdout)
     );
 }
 
