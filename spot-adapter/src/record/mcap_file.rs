@@ -33,7 +33,7 @@ pub(crate) struct McapMessage {
 }
 
 /// The messages of an MCAP file, read one record at a time (memory: the largest record or
-/// decompressed chunk, at most `record_length_limit`).
+/// decompressed chunk, at most the record length limit).
 pub(crate) struct McapMessages {
     path: PathBuf,
     file: BufReader<File>,
@@ -89,6 +89,13 @@ fn check_strings(opcode: u8, record: &[u8]) -> Result<(), (u64, u64)> {
     }
     Ok(())
 }
+
+/// Most bytes asked of the file at once: the reader's buffer grows with the data read, not with
+/// the length a record claims.
+const READ_STEP: usize = 1 << 20;
+/// Most bytes a chunk may decompress to per byte of the file (point clouds compress 2 to 5
+/// times; lz4 cannot exceed 255): a chunk claiming more is refused before its buffer is made.
+const MAX_EXPANSION: u64 = 1024;
 
 /// Bytes of a record's opcode and length.
 const RECORD_HEAD: u64 = 9;
@@ -177,10 +184,16 @@ fn check_chunk_records(
 }
 
 impl McapMessages {
-    /// The messages of the MCAP file at `path`, no record or chunk longer than
-    /// `record_length_limit` bytes.
+    /// The messages of the MCAP file at `path`, no record or decompressed chunk longer than
+    /// `record_length_limit` bytes or [`MAX_EXPANSION`] times the file's length.
     pub(crate) fn open(path: &Path, record_length_limit: usize) -> Result<Self, AdapterError> {
         let mut file = File::open(path).map_err(|e| AdapterError::io(path, e))?;
+        let file_len = file
+            .metadata()
+            .map_err(|e| AdapterError::io(path, e))?
+            .len();
+        let limit = usize::try_from(file_len.saturating_mul(MAX_EXPANSION))
+            .map_or(record_length_limit, |l| l.min(record_length_limit));
         let mut heads = BufReader::with_capacity(1 << 12, &mut file);
         if let Err((claimed, left)) = check_chunks(&mut heads) {
             return Err(AdapterError::McapLength {
@@ -197,7 +210,7 @@ impl McapMessages {
             file: BufReader::with_capacity(1 << 20, file),
             reader: LinearReader::new_with_options(
                 LinearReaderOptions::default()
-                    .with_record_length_limit(record_length_limit)
+                    .with_record_length_limit(limit)
                     .with_emit_chunks(false),
             ),
             channels: ChannelAccumulator::default(),
@@ -219,7 +232,7 @@ impl McapMessages {
             let (opcode, data) = match event {
                 LinearReadEvent::ReadRequest(need) => {
                     let read = loop {
-                        match self.file.read(self.reader.insert(need)) {
+                        match self.file.read(self.reader.insert(need.min(READ_STEP))) {
                             Ok(n) => break n,
                             Err(e) if e.kind() == ErrorKind::Interrupted => {}
                             Err(e) => return Some(Err(AdapterError::io(&self.path, e))),

@@ -191,3 +191,25 @@ fn records_past_their_uncompressed_mcap_chunk_are_refused() {
         other => panic!("{other:?}"),
     }
 }
+
+fn open_mcap_claiming_a_gigabyte() {
+    // A 30-byte file whose first record claims just under 1 GiB: its buffer used to be made
+    // at the length claimed (the fuzzer's MCAP inputs ran at 45 per second, 1.2 GB resident).
+    let mut record = vec![1];
+    record.extend_from_slice(&((1u64 << 30) - 16).to_le_bytes());
+    record.extend_from_slice(&[0; 12]);
+    let err = open_mcap("claim.mcap", &[record]).unwrap_err();
+    assert!(matches!(err, AdapterError::Mcap { .. }), "{err}");
+}
+
+#[test]
+fn mcap_buffers_grow_with_the_data_not_with_the_lengths_claimed() {
+    if std::env::var_os(CHILD).is_some() {
+        open_mcap_claiming_a_gigabyte();
+        return;
+    }
+    in_capped_child(
+        "mcap_buffers_grow_with_the_data_not_with_the_lengths_claimed",
+        20,
+    );
+}
