@@ -27,7 +27,7 @@ use spot_adapter::nav::{
     Goal, NavigationMap, NavigationStep, Navigator, NavigatorConfig, PlannerKind,
 };
 use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_slam, point_to_plane_tracker, slam_config,
+    loam_slam, point_to_plane_slam, point_to_plane_tracker, scan_context_places, slam_config,
 };
 use spot_adapter::robot::{MobilityCommand, Robot};
 use spot_adapter::sim::{
@@ -395,8 +395,15 @@ fn mission(args: &Args) -> Result<()> {
         building.rooms().len()
     )?;
     let mapped = match args.registration {
-        Registration::PointToPlane => map_building(point_to_plane_slam(slam_config())?, sim)?,
-        Registration::Loam => map_building(loam_slam(slam_config())?, sim)?,
+        // Loops by position and by appearance, as the slam example seeks them.
+        Registration::PointToPlane => map_building(
+            point_to_plane_slam(slam_config())?.with_place_recognizer(scan_context_places()),
+            sim,
+        )?,
+        Registration::Loam => map_building(
+            loam_slam(slam_config())?.with_place_recognizer(scan_context_places()),
+            sim,
+        )?,
     };
 
     let start = lap_end.translation.vector.xy();
