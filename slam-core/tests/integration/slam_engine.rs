@@ -684,7 +684,21 @@ fn bad_settings_are_refused_by_name() {
             1e-200
         ))
     );
-    let cases: [(GraphSlamConfig, &str); 6] = [
+    let cases: [(GraphSlamConfig, &str); 8] = [
+        (
+            GraphSlamConfig {
+                loop_max_drift_rate: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_max_drift_rate",
+        ),
+        (
+            GraphSlamConfig {
+                loop_max_drift_rate: -0.01,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_max_drift_rate",
+        ),
         (
             GraphSlamConfig {
                 keyframe_distance: f64::NAN,

@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 
-use slam_core::{GraphSlamConfig, Optimizer, Pose3};
+use slam_core::{GraphSlamConfig, Pose3};
 use spot_adapter::eval::TrajectoryEvaluation;
 use spot_adapter::pipelines::{point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -40,26 +40,7 @@ fn lap(seed: u64, aliased: bool, places: bool, config: GraphSlamConfig) -> Lap {
         );
         slam.process(&sample.scan_input());
     }
-    let stamps: Vec<u64> = slam
-        .keyframe_trajectory()
-        .iter()
-        .map(|k| k.stamp.to_bits())
-        .collect();
-    let graph = slam.graph();
-    let weights = Optimizer::<Pose3>::edge_weights(slam.optimizer()).unwrap_or(&[]);
-    let loops = graph
-        .edges()
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| graph.nodes()[e.from].id.abs_diff(graph.nodes()[e.to].id) != 1)
-        .map(|(k, e)| {
-            let (a, b) = (graph.nodes()[e.from].id, graph.nodes()[e.to].id);
-            let truth =
-                world_t_lidar[&stamps[a as usize]].inverse() * world_t_lidar[&stamps[b as usize]];
-            let error = (truth.translation.vector - e.measurement.translation.vector).norm();
-            (weights.get(k).is_none_or(|&w| w >= 0.5), error)
-        })
-        .collect();
+    let loops = crate::common::loop_edges_against_truth(&slam, &world_t_lidar);
     let (e, _) =
         TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
             .unwrap();

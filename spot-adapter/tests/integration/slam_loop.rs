@@ -162,22 +162,10 @@ fn run_overlapping_lap<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>
         );
         slam.process(&sample.scan_input());
     }
-    let stamps: Vec<u64> = slam
-        .keyframe_trajectory()
-        .iter()
-        .map(|k| k.stamp.to_bits())
-        .collect();
-    let graph = slam.graph();
-    let loop_errors = graph
-        .edges()
-        .iter()
-        .filter(|e| graph.nodes()[e.from].id.abs_diff(graph.nodes()[e.to].id) != 1)
-        .map(|e| {
-            let (a, b) = (graph.nodes()[e.from].id, graph.nodes()[e.to].id);
-            let truth = world_t_lidar[&stamps[usize::try_from(a).unwrap()]].inverse()
-                * world_t_lidar[&stamps[usize::try_from(b).unwrap()]];
-            (truth.translation.vector - e.measurement.translation.vector).norm()
-        })
+    // Whether GNC kept them or not: every loop edge must agree with the truth.
+    let loop_errors = crate::common::loop_edges_against_truth(&slam, &world_t_lidar)
+        .into_iter()
+        .map(|(_, error)| error)
         .collect();
     let (e, _) =
         TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)

@@ -202,3 +202,37 @@ pub fn run_legs(
     assert_eq!(pending, 0, "no room for every box on the routes");
     legs
 }
+
+/// Every loop edge (nodes whose ids are not consecutive) of `slam`'s final graph: whether the
+/// optimiser kept it (weight at least 0.5, or an optimiser that keeps every edge) and the
+/// distance between its measurement and the ground truth's relative pose, from `world_t_lidar`
+/// keyed by the scans' stamps (`f64::to_bits`).
+pub fn loop_edges_against_truth<
+    R: slam_core::MapRegistrator,
+    C: slam_core::MapRegistrator,
+    O: slam_core::Optimizer<Pose3>,
+>(
+    slam: &slam_core::GraphSlam<R, C, O>,
+    world_t_lidar: &std::collections::HashMap<u64, Pose3>,
+) -> Vec<(bool, f64)> {
+    let stamps: Vec<u64> = slam
+        .keyframe_trajectory()
+        .iter()
+        .map(|k| k.stamp.to_bits())
+        .collect();
+    let graph = slam.graph();
+    let weights = slam.optimizer().edge_weights().unwrap_or(&[]);
+    let pose_of = |id: u64| world_t_lidar[&stamps[usize::try_from(id).unwrap()]];
+    graph
+        .edges()
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| graph.nodes()[e.from].id.abs_diff(graph.nodes()[e.to].id) != 1)
+        .map(|(k, e)| {
+            let (a, b) = (graph.nodes()[e.from].id, graph.nodes()[e.to].id);
+            let truth = pose_of(a).inverse() * pose_of(b);
+            let error = (truth.translation.vector - e.measurement.translation.vector).norm();
+            (weights.get(k).is_none_or(|&w| w >= 0.5), error)
+        })
+        .collect()
+}
