@@ -1,11 +1,14 @@
 //! Reading a ROS 2 bag (MCAP, zstd chunks) against the SLAM it feeds: the time to read and
-//! decode one scan's messages (cloud, odometry, tf) against the engine's time for that scan, and
-//! the peak memory of reading a bag against one twice as long (each read in a child process).
+//! decode one scan's messages (cloud, odometry, tf) against the engine's time for that scan; the
+//! time reading adds to the engine's when the bag is read ahead on a thread of its own
+//! (`ReadAhead`, as the `slam` example reads); one cloud message's decoding alone; and the peak
+//! memory of reading a bag against one twice as long (each read in a child process).
 //!
 //! The bag holds the first scans of a simulated lap (seed 1), written with the `mcap` crate
 //! (zstd chunks, and once uncompressed as `ros2 bag record` writes by default) and a CDR encoder
 //! below. `cargo bench -p spot-nav-benches --bench bags`
 
+use std::borrow::Borrow;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -16,7 +19,9 @@ use std::time::Instant;
 use criterion::{BenchmarkId, Criterion, Throughput};
 use slam_core::Pose3;
 use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
-use spot_adapter::record::{Bag, BagConfig};
+use spot_adapter::record::{
+    Bag, BagConfig, PointCloud2, PointCloud2Config, PointCloud2Decoder, ReadAhead, Wire,
+};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
@@ -176,6 +181,17 @@ fn write_bag(
     Ok(())
 }
 
+/// The engine run on `samples`; how many there were.
+fn slam_on<S: Borrow<Sample>>(samples: impl Iterator<Item = S>) -> usize {
+    let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| fail(&e));
+    let mut n = 0;
+    for s in samples {
+        slam.process(&s.borrow().scan_input());
+        n += 1;
+    }
+    n
+}
+
 fn open(path: &Path) -> Bag {
     Bag::open(path, &BagConfig::default()).unwrap_or_else(|e| fail(&e))
 }
@@ -203,6 +219,50 @@ fn child_peak(path: &Path) -> u64 {
         .trim()
         .parse()
         .unwrap_or_else(|_| fail(&String::from_utf8_lossy(&out.stderr)))
+}
+
+/// Reading against SLAM, per scan: reading alone (the zstd bag `bag`, the uncompressed one at
+/// `plain`), SLAM on `samples` in memory, and SLAM fed by `bag` read ahead on a thread of its
+/// own (what the `slam` example does). Runs alternate and medians of 9 are taken, of the
+/// difference per pair of runs for the read-ahead, as the machine's speed drifts between runs.
+fn read_against_slam(bag: &Bag, plain: &Path, samples: &[Sample]) {
+    let per_scan = |f: &mut dyn FnMut() -> usize| {
+        let started = Instant::now();
+        let n = f();
+        started.elapsed().as_secs_f64() * 1e3 / n as f64
+    };
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let plain_bag = open(plain);
+    let (mut read, mut read_plain, mut slam, mut added) = (vec![], vec![], vec![], vec![]);
+    for _ in 0..9 {
+        read_plain.push(per_scan(&mut || {
+            plain_bag.samples().unwrap_or_else(|e| fail(&e)).count()
+        }));
+        read.push(per_scan(&mut || {
+            bag.samples().unwrap_or_else(|e| fail(&e)).count()
+        }));
+        let in_memory = per_scan(&mut || slam_on(samples.iter()));
+        let ahead = per_scan(&mut || {
+            let source = ReadAhead::new(bag.samples().unwrap_or_else(|e| fail(&e)), 4);
+            slam_on(source.map(|s| s.unwrap_or_else(|e| fail(&e))))
+        });
+        slam.push(in_memory);
+        added.push(ahead - in_memory);
+    }
+    let (read_ms, slam_ms, added_ms) = (median(read), median(slam), median(added));
+    let plain_ms = median(read_plain);
+    println!(
+        "bags/read_vs_slam: reading {read_ms:.2} ms per scan (zstd), {plain_ms:.2} ms (uncompressed), SLAM {slam_ms:.2} ms per scan: reading is {:.1} % (zstd), {:.1} % (uncompressed) of SLAM",
+        100.0 * read_ms / slam_ms,
+        100.0 * plain_ms / slam_ms
+    );
+    println!(
+        "bags/read_ahead: SLAM fed by the bag read ahead takes {added_ms:+.2} ms per scan more than on samples in memory ({:+.1} % of SLAM; median of 9 paired runs)",
+        100.0 * added_ms / slam_ms
+    );
 }
 
 fn main() {
@@ -236,26 +296,13 @@ fn main() {
         b as f64 / a as f64
     );
 
-    // Reading against SLAM, per scan, once through the short bag each.
     let bag = open(&short);
     let samples: Vec<Sample> = bag
         .samples()
         .unwrap_or_else(|e| fail(&e))
         .map(|s| s.unwrap_or_else(|e| fail(&e)))
         .collect();
-    let started = Instant::now();
-    let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| fail(&e));
-    for s in &samples {
-        slam.process(&s.scan_input());
-    }
-    let slam_ms = started.elapsed().as_secs_f64() * 1e3 / samples.len() as f64;
-    let started = Instant::now();
-    let read = bag.samples().unwrap_or_else(|e| fail(&e)).count();
-    let read_ms = started.elapsed().as_secs_f64() * 1e3 / read as f64;
-    println!(
-        "bags/read_vs_slam: reading {read_ms:.2} ms per scan, SLAM {slam_ms:.2} ms per scan: reading is {:.1} % of SLAM",
-        100.0 * read_ms / slam_ms
-    );
+    read_against_slam(&bag, &plain, &samples);
 
     let mut c = Criterion::default().configure_from_args();
     let mut group = c.benchmark_group("bags");
@@ -277,15 +324,39 @@ fn main() {
             b.iter(|| bag.samples().unwrap_or_else(|e| fail(&e)).count());
         },
     );
+    // One scan's cloud message parsed and decoded, the part of reading that is ours.
+    let message = cloud_message(&samples[SHORT / 2]);
+    group.throughput(Throughput::Elements(1));
+    group.bench_with_input(
+        BenchmarkId::new("decode_point_cloud2", samples[SHORT / 2].cloud.len()),
+        &message,
+        |b, message| {
+            let mut decoder = PointCloud2Decoder::new(PointCloud2Config::default());
+            b.iter(|| {
+                let msg = PointCloud2::parse(message, Wire::Cdr).unwrap_or_else(|e| fail(&e));
+                decoder
+                    .decode(&msg)
+                    .unwrap_or_else(|e| fail(&e))
+                    .cloud
+                    .len()
+            });
+        },
+    );
+    group.throughput(Throughput::Elements(SHORT as u64));
     group.bench_with_input(BenchmarkId::new("slam", SHORT), &samples, |b, samples| {
-        b.iter(|| {
-            let mut slam = point_to_plane_slam(slam_config()).unwrap_or_else(|e| fail(&e));
-            for s in samples {
-                slam.process(&s.scan_input());
-            }
-            slam.keyframe_count()
-        });
+        b.iter(|| slam_on(samples.iter()));
     });
+    group.bench_with_input(
+        BenchmarkId::new("slam_read_ahead_zstd", SHORT),
+        &short,
+        |b, path| {
+            let bag = open(path);
+            b.iter(|| {
+                let source = ReadAhead::new(bag.samples().unwrap_or_else(|e| fail(&e)), 4);
+                slam_on(source.map(|s| s.unwrap_or_else(|e| fail(&e))))
+            });
+        },
+    );
     group.finish();
     c.final_summary();
     let _ = std::fs::remove_dir_all(&dir);

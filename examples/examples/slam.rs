@@ -26,8 +26,8 @@ use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, scan_context_places, scan_to_scan_registrator, slam_config,
 };
 use spot_adapter::record::{
-    BagConfig, OdometrySource, PointCloud2Config, ReturnFilter, SampleSource, ScanToScanConfig,
-    ScanToScanOdometry, SourceConfig, TimeUnit, open_recording,
+    BagConfig, OdometrySource, PointCloud2Config, ReadAhead, ReturnFilter, SampleSource,
+    ScanToScanConfig, ScanToScanOdometry, SourceConfig, TimeUnit, open_recording,
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -181,6 +181,9 @@ fn source_config(args: &Args) -> SourceConfig {
     }
 }
 
+/// Scans read ahead of the engine (each a few hundred kB to a few MB).
+const READ_AHEAD: usize = 4;
+
 fn slam(args: &Args) -> Result<()> {
     let mut config = slam_config();
     if args.no_deskew {
@@ -189,7 +192,7 @@ fn slam(args: &Args) -> Result<()> {
     if let Some(path) = &args.recording {
         let source = open_recording(path, &source_config(args))?;
         out!("{}", source.description)?;
-        let mut samples: Box<dyn SampleSource> = if source.has_odometry && !args.no_odometry {
+        let samples: Box<dyn SampleSource> = if source.has_odometry && !args.no_odometry {
             source.samples
         } else {
             out!(
@@ -201,6 +204,9 @@ fn slam(args: &Args) -> Result<()> {
                 ScanToScanConfig::default(),
             ))
         };
+        // Reading (and a LiDAR-only source's scan-to-scan registration) runs on a thread of
+        // its own, a few scans ahead of the engine.
+        let mut samples = ReadAhead::new(samples, READ_AHEAD);
         backend(
             args,
             config,

@@ -63,6 +63,7 @@ mod lidar_only;
 mod mcap_file;
 mod no_return;
 mod point_cloud2;
+mod read_ahead;
 mod recording;
 mod ros_messages;
 mod source;
@@ -81,6 +82,7 @@ pub use point_cloud2::{
     CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,
     TimeUnit,
 };
+pub use read_ahead::ReadAhead;
 pub use recording::{
     IndexEntry, Recording, RecordingSamples, RecordingWriter, calibration_text, parse_calibration,
     parse_index,

@@ -21,8 +21,9 @@ use crate::record::no_return::{DroppedPoints, ReturnFilter};
 use crate::record::recording::Recording;
 use crate::robot::Sample;
 
-/// A stream of samples from a recording, with the points its reader removed.
-pub trait SampleSource: ExactSizeIterator<Item = Result<Sample, AdapterError>> {
+/// A stream of samples from a recording, with the points its reader removed. `Send`, so that
+/// it can be read ahead on a thread of its own ([`ReadAhead`](crate::record::ReadAhead)).
+pub trait SampleSource: ExactSizeIterator<Item = Result<Sample, AdapterError>> + Send {
     /// Points removed from the samples read so far (non-finite and no-return).
     fn dropped_points(&self) -> DroppedPoints;
 }
@@ -39,7 +40,12 @@ impl SampleSource for CloudFolderSamples {
     }
 }
 
-impl<R: slam_core::Registrator, I: SampleSource> SampleSource for ScanToScanOdometry<R, I> {
+impl<R, I> SampleSource for ScanToScanOdometry<R, I>
+where
+    R: slam_core::Registrator + Send,
+    R::Target: Send,
+    I: SampleSource,
+{
     fn dropped_points(&self) -> DroppedPoints {
         self.inner().dropped_points()
     }
@@ -92,7 +98,9 @@ impl<I: ExactSizeIterator<Item = Result<Sample, AdapterError>>> ExactSizeIterato
 {
 }
 
-impl<I: ExactSizeIterator<Item = Result<Sample, AdapterError>>> SampleSource for ReturnFiltered<I> {
+impl<I: ExactSizeIterator<Item = Result<Sample, AdapterError>> + Send> SampleSource
+    for ReturnFiltered<I>
+{
     fn dropped_points(&self) -> DroppedPoints {
         self.dropped
     }
