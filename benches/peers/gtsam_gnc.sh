@@ -11,7 +11,7 @@ cd "$(dirname "$0")/../.."
 data="${SPOT_NAV_DATA:-../shared/data}/posegraph"
 cases="${1:-ring,m3500,sphere}"
 venv=target/peers/gtsam-venv
-out=target/peers/robust
+out="$PWD/target/peers/robust"
 if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
