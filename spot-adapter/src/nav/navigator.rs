@@ -243,6 +243,12 @@ pub struct Navigator<R: Registrator> {
     /// The goal for which the robot already waited its patience out: it does not wait again on
     /// the way there (a box that stays would have it turn back and forth).
     waited_out_for: Option<Vector2<f64>>,
+    /// Where paths to the current goal were blocked (cell centres, metres): a periodic replan
+    /// that would lead back through one of them keeps the current path instead. What blocked
+    /// a path seen from close by can look clear from a few metres off (the edge cells of a
+    /// box are hit by fewer beams), and without this the robot turned back and forth between
+    /// the way past it and the way round.
+    blocked_at: Vec<Vector2<f64>>,
     replans: usize,
     recoveries: usize,
     stuck: StuckMonitor,
@@ -293,6 +299,7 @@ impl<R: Registrator> Navigator<R> {
             waited: 0,
             waiting_on: (None, 0),
             waited_out_for: None,
+            blocked_at: Vec::new(),
             replans: 0,
             recoveries: 0,
         })
@@ -326,6 +333,7 @@ impl<R: Registrator> Navigator<R> {
             self.stuck.reset();
             self.waypoints.clear();
             self.path_cells.clear();
+            self.blocked_at.clear();
         }
         let status = self.localiser.update(sample);
         match status {
@@ -407,19 +415,38 @@ impl<R: Registrator> Navigator<R> {
         target: Vector2<f64>,
     ) -> Result<Option<NavigationStep>, AdapterError> {
         self.cycles_since_plan += 1;
+        let blocked = !self.path_cells.is_empty() && self.planning.blocks_any(&self.path_cells);
         let replan = self.path_cells.is_empty()
-            || self.planning.blocks_any(&self.path_cells)
+            || blocked
             || self.cycles_since_plan >= self.config.replan_every;
         if !replan {
             self.waited = 0;
             return Ok(None);
         }
+        if blocked {
+            self.remember_blockage();
+        }
         let plan = self.plan(position, target)?;
+        // A periodic replan back through a place that blocked an earlier path to this goal:
+        // the current path, still clear, stands (its waypoints made afresh from here).
+        if !blocked
+            && !self.path_cells.is_empty()
+            && plan
+                .as_ref()
+                .is_some_and(|(_, cells)| self.passes_blockage(cells))
+        {
+            self.follow_on(position, target);
+            self.cycles_since_plan = 0;
+            self.waited = 0;
+            return Ok(None);
+        }
         let resolution = self.planning.blocked().geometry().resolution;
         let live_length = plan
             .as_ref()
             .map(|(_, cells)| cells_length(cells) * resolution);
-        if self.waited_out_for != Some(target)
+        // With no way round at all, something new blocking the way is waited for again (a
+        // person met twice): only once the patience runs out is the answer `NoPath`.
+        if (self.waited_out_for != Some(target) || plan.is_none())
             && let Some(blockage) = self.worth_waiting(position, target, live_length)?
         {
             // Something new stands in the way and the way around is far longer (or there is
@@ -428,8 +455,9 @@ impl<R: Registrator> Navigator<R> {
             let unchanged = last == Some(blockage);
             self.waiting_on = (Some(blockage), if unchanged { same + 1 } else { 0 });
             self.waited += 1;
+            // A blockage that stays put is given up on early only when there is a way round.
             if self.waited < self.config.detour_patience
-                && self.waiting_on.1 < STILL_BLOCKAGE_CYCLES
+                && (self.waiting_on.1 < STILL_BLOCKAGE_CYCLES || plan.is_none())
             {
                 self.stuck.commanded(&VelocityCommand::new(0.0, 0.0));
                 return Ok(Some(NavigationStep::Hold));
@@ -456,6 +484,35 @@ impl<R: Registrator> Navigator<R> {
             return Ok(Some(NavigationStep::Hold));
         }
         Ok(Some(NavigationStep::NoPath))
+    }
+
+    /// Record where the current path is blocked (its first and last blocked cells).
+    fn remember_blockage(&mut self) {
+        let grid = self.planning.blocked();
+        let first = self.path_cells.iter().find(|c| grid.is_blocked(**c)).copied();
+        let last = self.path_cells.iter().rfind(|c| grid.is_blocked(**c)).copied();
+        for c in first.into_iter().chain(last) {
+            let at = grid.cell_center(c);
+            if !self
+                .blocked_at
+                .iter()
+                .any(|b| (b - at).norm() < BLOCKAGE_RADIUS)
+            {
+                self.blocked_at.push(at);
+            }
+        }
+    }
+
+    /// Whether the path through `cells` passes within [`BLOCKAGE_RADIUS`] of a place that
+    /// blocked an earlier path to the current goal.
+    fn passes_blockage(&self, cells: &[Cell]) -> bool {
+        let grid = self.planning.blocked();
+        cells.iter().any(|&c| {
+            let at = grid.cell_center(c);
+            self.blocked_at
+                .iter()
+                .any(|b| (b - at).norm() < BLOCKAGE_RADIUS)
+        })
     }
 
     /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
@@ -591,15 +648,22 @@ impl<R: Registrator> Navigator<R> {
         let Some(cells) = plan_cells(&self.planning, self.config.planner, position, goal)? else {
             return Ok(None);
         };
+        let waypoints = self.waypoints_along(&cells, goal);
+        Ok(Some((waypoints, cells)))
+    }
+
+    /// Waypoints (metres) along the dense `cells` of a path to `goal`, after its first cell:
+    /// the turning points a straight segment with room to spare cannot skip, then the goal.
+    fn waypoints_along(&self, cells: &[Cell], goal: Vector2<f64>) -> Vec<Vector2<f64>> {
         let grid = self.planning.blocked();
         // Shortcuts only where they keep room to spare; in narrow places the path's cells.
         let roomy = self.roomy_grid();
         let filtered = filter_path(
             &roomy,
             &GridPath {
-                length: cells_length(&cells),
+                length: cells_length(cells),
                 expanded: 0,
-                cells: cells.clone(),
+                cells: cells.to_vec(),
             },
         );
         let mut waypoints: Vec<Vector2<f64>> = filtered
@@ -614,7 +678,26 @@ impl<R: Registrator> Navigator<R> {
         } else {
             waypoints.push(goal);
         }
-        Ok(Some((waypoints, cells)))
+        waypoints
+    }
+
+    /// The current path from its cell nearest `position` on, its waypoints made afresh: the
+    /// route kept, as a replan from here along it would give.
+    fn follow_on(&mut self, position: Vector2<f64>, goal: Vector2<f64>) {
+        let grid = self.planning.blocked();
+        let nearest = self
+            .path_cells
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                let d = |c: &Cell| (grid.cell_center(*c) - position).norm_squared();
+                d(a.1).total_cmp(&d(b.1))
+            })
+            .map_or(0, |(k, _)| k);
+        self.path_cells.drain(..nearest);
+        let cells = std::mem::take(&mut self.path_cells);
+        self.waypoints = self.waypoints_along(&cells, goal);
+        self.path_cells = cells;
     }
 
     /// The planning grid with every cell closer than the shortcut clearance to an obstacle
@@ -733,6 +816,10 @@ struct Blockage {
     last: Cell,
     count: usize,
 }
+
+/// A periodic replan may not lead back within this distance (metres) of where an earlier path
+/// to the same goal was blocked: about a box's half width plus the hard inflation.
+const BLOCKAGE_RADIUS: f64 = 0.6;
 
 /// Waiting cycles with the blocked way unchanged after which the blockage counts as still (a
 /// box, not a person walking): 10 (2 s).
