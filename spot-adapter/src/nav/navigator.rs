@@ -489,8 +489,16 @@ impl<R: Registrator> Navigator<R> {
     /// Record where the current path is blocked (its first and last blocked cells).
     fn remember_blockage(&mut self) {
         let grid = self.planning.blocked();
-        let first = self.path_cells.iter().find(|c| grid.is_blocked(**c)).copied();
-        let last = self.path_cells.iter().rfind(|c| grid.is_blocked(**c)).copied();
+        let first = self
+            .path_cells
+            .iter()
+            .find(|c| grid.is_blocked(**c))
+            .copied();
+        let last = self
+            .path_cells
+            .iter()
+            .rfind(|c| grid.is_blocked(**c))
+            .copied();
         for c in first.into_iter().chain(last) {
             let at = grid.cell_center(c);
             if !self
