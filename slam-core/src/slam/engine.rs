@@ -6,6 +6,7 @@ use nalgebra::{Matrix6, Vector6};
 
 use super::config::{EdgeInformation, GraphSlamConfig};
 use super::deskew::deskew;
+use super::information::{combined_information, fixed_information};
 use super::node_index::NodeIndex;
 use super::report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
 use crate::cloud::PointCloud;
@@ -331,17 +332,22 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         reg_info: Option<&Matrix6<f64>>,
         pose: &Pose3,
     ) -> Matrix6<f64> {
+        // Registration information is for a left perturbation of map_T_lidar; the edge error
+        // perturbs the relative pose on the right: Omega' = Ad(X)^T Omega Ad(X).
+        let in_edge_frame = |info: &Matrix6<f64>, scale: f64| {
+            let ad = se3_adjoint(pose);
+            let m = ad.transpose() * info * ad * scale;
+            (m + m.transpose()) * 0.5
+        };
+        let fallback = || fixed_information(0.05, 1f64.to_radians());
         match (kind, reg_info) {
             (EdgeInformation::FromRegistration { scale }, Some(info)) => {
-                // Registration information is for a left perturbation of map_T_lidar; the edge
-                // error perturbs the relative pose on the right: Omega' = Ad(X)^T Omega Ad(X).
-                let ad = se3_adjoint(pose);
-                let m = ad.transpose() * info * ad * scale;
-                let sym = (m + m.transpose()) * 0.5;
-                if Pose3::information_is_valid(&sym) {
-                    return sym;
+                let m = in_edge_frame(info, scale);
+                if Pose3::information_is_valid(&m) {
+                    m
+                } else {
+                    fallback()
                 }
-                fixed_information(0.05, 1f64.to_radians())
             }
             (
                 EdgeInformation::Fixed {
@@ -349,10 +355,27 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                     rotation_sigma,
                 },
                 _,
+            )
+            | (
+                EdgeInformation::FixedAndRegistration {
+                    translation_sigma,
+                    rotation_sigma,
+                    ..
+                },
+                None,
             ) => fixed_information(translation_sigma, rotation_sigma),
-            (EdgeInformation::FromRegistration { .. }, None) => {
-                fixed_information(0.05, 1f64.to_radians())
+            (
+                EdgeInformation::FixedAndRegistration {
+                    translation_sigma,
+                    rotation_sigma,
+                    scale,
+                },
+                Some(info),
+            ) => {
+                let fixed = fixed_information(translation_sigma, rotation_sigma);
+                combined_information(&fixed, &in_edge_frame(info, scale)).unwrap_or(fixed)
             }
+            (EdgeInformation::FromRegistration { .. }, None) => fallback(),
         }
     }
 
@@ -809,13 +832,4 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             mean_squared_error: mse,
         }
     }
-}
-
-/// Diagonal information from standard deviations (tangent order `[rho; phi]`).
-fn fixed_information(translation_sigma: f64, rotation_sigma: f64) -> Matrix6<f64> {
-    let (t, r) = (
-        1.0 / (translation_sigma * translation_sigma),
-        1.0 / (rotation_sigma * rotation_sigma),
-    );
-    Matrix6::from_diagonal(&nalgebra::Vector6::new(t, t, t, r, r, r))
 }

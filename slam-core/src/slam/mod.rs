@@ -14,6 +14,7 @@
 mod config;
 mod deskew;
 mod engine;
+mod information;
 mod node_index;
 mod report;
 

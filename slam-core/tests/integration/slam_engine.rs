@@ -684,6 +684,18 @@ fn bad_settings_are_refused_by_name() {
             1e-200
         ))
     );
+    let nan_scale = GraphSlamConfig {
+        odometry_information: EdgeInformation::FixedAndRegistration {
+            translation_sigma: 0.01,
+            rotation_sigma: 0.01,
+            scale: f64::NAN,
+        },
+        ..GraphSlamConfig::default()
+    };
+    assert_eq!(
+        build(nan_scale).map(|(setting, _)| setting),
+        Some("GraphSlamConfig::odometry_information::scale")
+    );
     let cases: [(GraphSlamConfig, &str); 8] = [
         (
             GraphSlamConfig {

@@ -40,6 +40,12 @@ pub struct BuildingConfig {
     /// the pilasters on its inner wall. A robot walking that corridor sees the same place again
     /// and again, as in a hotel or an office floor of identical cells. Default false.
     pub repeated_rooms: bool,
+    /// A blank north corridor: the doors along it are shut and its inner wall has no
+    /// pilasters, so that its walls are flat from end to end, as in a service corridor. A
+    /// LiDAR sees nothing there that fixes how far it walked along the corridor, so
+    /// registration slips along it and a LiDAR-only lap does not close. The rooms behind the
+    /// shut doors are left out of [`Building::rooms`]. Default false.
+    pub blank_corridor: bool,
 }
 
 impl Default for BuildingConfig {
@@ -57,6 +63,7 @@ impl Default for BuildingConfig {
             pilaster_spacing: (4.0, 8.0),
             furniture_per_room: (1, 3),
             repeated_rooms: false,
+            blank_corridor: false,
         }
     }
 }
@@ -369,6 +376,11 @@ impl Building {
         pilasters(&mut d, &mut rng, core, &south_doors, &north_doors, repeat);
 
         furnish_rooms(&mut d, &mut rng, &rooms, &copies);
+        if config.blank_corridor {
+            // The rooms behind the shut doors: those whose door is on the north corridor's
+            // walls (the west and east rooms' doors face along x).
+            rooms.retain(|r| r.inward.x != 0.0 || r.door.y < core[3] - 1e-9);
+        }
 
         Ok(Self::from_generated(
             d.boxes,
@@ -440,7 +452,13 @@ fn core_rooms(
     }
     let [south_doors, north_doors] = inner_doors;
     d.wall(true, ky0, kx0, kx1, &south_doors);
-    d.wall(true, ky1, kx0, kx1, &north_doors);
+    d.wall(
+        true,
+        ky1,
+        kx0,
+        kx1,
+        shut_if(config.blank_corridor, &north_doors),
+    );
     (south_doors, north_doors)
 }
 
@@ -475,7 +493,8 @@ fn pilasters(
             let clear = doors
                 .iter()
                 .all(|&(dc, dw)| (s - dc).abs() > 0.5 * dw + half + 0.3);
-            if clear {
+            let blank = config.blank_corridor && horizontal && sign > 0.0;
+            if clear && !blank {
                 let face = c + sign * 0.5 * t;
                 let (f0, f1) = if sign < 0.0 {
                     (face - depth, face)
@@ -596,8 +615,20 @@ impl Band {
                 d.wall(false, b, y_out.min(y_wall), y_out.max(y_wall), &[]);
             }
         }
-        d.wall(true, y_wall, 0.0, w, &doors);
+        d.wall(
+            true,
+            y_wall,
+            0.0,
+            w,
+            shut_if(config.blank_corridor && !south, &doors),
+        );
     }
+}
+
+/// No door openings when `shut`, else `doors`: the doors' places are drawn either way, so that
+/// the rest of the building stays the same.
+fn shut_if(shut: bool, doors: &[(f64, f64)]) -> &[(f64, f64)] {
+    if shut { &[] } else { doors }
 }
 
 /// Put furniture (and in large rooms a pillar) into `room`.

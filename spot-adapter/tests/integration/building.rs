@@ -175,15 +175,20 @@ fn routes_stay_clear_of_obstacles() {
     ));
 }
 
+/// Every room of `b` has a route from the corridor loop's start to its entry point.
+fn assert_every_room_is_reachable(b: &Building, seed: u64) {
+    let start = Route::corridor_loop(b).point_at(0.0);
+    for (i, room) in b.rooms().iter().enumerate() {
+        let r = Route::between(b, start, room.entry_point(), &RouteConfig::default());
+        assert!(r.is_ok(), "seed {seed}: room {i} {:?}", r.err());
+    }
+}
+
 #[test]
 fn every_room_is_reachable_from_the_corridor() {
     for seed in 0..4 {
         let b = building(seed);
-        let start = Route::corridor_loop(&b).point_at(0.0);
-        for (i, room) in b.rooms().iter().enumerate() {
-            let r = Route::between(&b, start, room.entry_point(), &RouteConfig::default());
-            assert!(r.is_ok(), "seed {seed}: room {i} {:?}", r.err());
-        }
+        assert_every_room_is_reachable(&b, seed);
     }
 }
 
@@ -358,10 +363,69 @@ fn repeated_rooms_look_the_same_one_pitch_apart() {
             differ_plain * 5 > rays,
             "seed {seed}: the plain building differs in only {differ_plain} of {rays}"
         );
-        let start = Route::corridor_loop(&b).point_at(0.0);
-        for (i, room) in b.rooms().iter().enumerate() {
-            let r = Route::between(&b, start, room.entry_point(), &RouteConfig::default());
-            assert!(r.is_ok(), "seed {seed}: room {i} {:?}", r.err());
+        assert_every_room_is_reachable(&b, seed);
+    }
+}
+
+/// `blank_corridor`: along the north corridor every horizontal ray across it, to either wall,
+/// ends at the same range (no door, no pilaster), where the default building of the same seed
+/// has openings and pilasters; everything off that corridor is the same box for box, the
+/// shut rooms are left out of `rooms()` and every room left is reachable.
+#[test]
+fn the_blank_corridor_has_flat_walls_and_changes_nothing_else() {
+    for seed in [1, 2, 3] {
+        let mut config = BuildingConfig::default();
+        config.blank_corridor = true;
+        let b = Building::generate(seed, &config).unwrap();
+        let plain = building(seed);
+        let c = *b.corridor_loop();
+        let (y, half) = (c[2].y, 0.5 * b.corridor_width());
+        let width = |b: &Building, x: f64, z: f64| {
+            let o = Point3::new(x, y, z);
+            let left = b.cast_ray(&o, &Vector3::y(), 10.0).map(|h| h.range);
+            let right = b.cast_ray(&o, &-Vector3::y(), 10.0).map(|h| h.range);
+            (left, right)
+        };
+        let (mut flat, mut plain_differs, mut rays) = (0, 0, 0);
+        // Clear of the corners by a corridor width.
+        let mut x = c[3].x + 2.0 * half;
+        while x < c[2].x - 2.0 * half {
+            for z in [0.3, 1.0, 1.8] {
+                rays += 1;
+                let (l, r) = width(&b, x, z);
+                let wall = half - 0.1;
+                if l.is_some_and(|v| (v - wall).abs() < 1e-9)
+                    && r.is_some_and(|v| (v - wall).abs() < 1e-9)
+                {
+                    flat += 1;
+                }
+                plain_differs += usize::from(width(&plain, x, z) != (l, r));
+            }
+            x += 0.05;
         }
+        assert!(rays > 1000, "seed {seed}: {rays} rays");
+        assert_eq!(
+            flat, rays,
+            "seed {seed}: {flat} of {rays} rays end at the walls"
+        );
+        assert!(
+            plain_differs * 10 > rays,
+            "seed {seed}: the default building differs in only {plain_differs} of {rays}"
+        );
+        // Off the north corridor's walls, the same boxes.
+        let north =
+            |bx: &&SolidBox| bx.max.y > c[2].y - half - 0.5 && bx.min.y < c[2].y + half + 0.5;
+        let off: Vec<_> = b.boxes().iter().filter(|bx| !north(bx)).collect();
+        let plain_off: Vec<_> = plain.boxes().iter().filter(|bx| !north(bx)).collect();
+        assert_eq!(off, plain_off, "seed {seed}");
+        assert!(b.rooms().len() < plain.rooms().len());
+        // No door left on the north corridor's walls (the west and east rooms' doors face
+        // along x).
+        assert!(
+            b.rooms()
+                .iter()
+                .all(|r| r.inward.x != 0.0 || (r.door.y - c[2].y).abs() > half + 0.2)
+        );
+        assert_every_room_is_reachable(&b, seed);
     }
 }
