@@ -16,6 +16,12 @@ use slam_core::Cell;
 /// layer blocks), when the live layer's last scan saw none of them occupied: memories of
 /// something that moved on, or that the sensor cannot see from here. `None` when the last scan
 /// sees one of them (something stands there now: wait for it) or there are none.
+// Cell offsets within a few cells of a map cell: the casts are exact.
+#[allow(
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss,
+    clippy::cast_precision_loss
+)]
 pub(crate) fn unseen_blockers(
     live: &LiveLayer,
     blocked: &[Cell],
@@ -51,7 +57,6 @@ pub(crate) fn unseen_blockers(
                 {
                     continue;
                 }
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
                 let c = Cell::new(x as u32, y as u32);
                 if combined.state(c) != CellState::Occupied
                     || map.state(c) == CellState::Occupied
@@ -67,4 +72,33 @@ pub(crate) fn unseen_blockers(
         }
     }
     (!blockers.is_empty()).then_some(blockers)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gridmap::{LiveLayerConfig, OccupancyGrid};
+    use slam_core::GridGeometry;
+
+    #[test]
+    fn only_live_obstacles_within_the_inflation_that_no_scan_sees_are_blockers() {
+        let geometry = GridGeometry {
+            origin: nalgebra::Vector2::zeros(),
+            resolution: 0.1,
+        };
+        let mut map = OccupancyGrid::new(100, 100, geometry, CellState::Free).unwrap();
+        // A wall cell on the map itself: never a blocker.
+        map.set(Cell::new(50, 52), CellState::Occupied).unwrap();
+        let mut live = LiveLayer::new(map, LiveLayerConfig::default()).unwrap();
+        // Something marked (a person's cell, a stuck robot's mark): no scan saw it.
+        live.mark(Cell::new(50, 50), CellState::Occupied, 1.0)
+            .unwrap();
+        assert_eq!(
+            unseen_blockers(&live, &[Cell::new(50, 53)], 0.3),
+            Some(vec![Cell::new(50, 50)])
+        );
+        // Farther than the inflation from every blocked cell: nothing.
+        assert_eq!(unseen_blockers(&live, &[Cell::new(50, 54)], 0.3), None);
+        assert_eq!(unseen_blockers(&live, &[], 0.3), None);
+    }
 }
