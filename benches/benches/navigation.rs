@@ -14,7 +14,7 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 use slam_core::{PointCloud, Pose3, Registrator};
 use spot_adapter::nav::{NavigationMap, NavigationStep, Navigator, NavigatorConfig};
-use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::{MobilityCommand, Robot};
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, Route, SimulatedSpot, SimulationConfig,
@@ -68,7 +68,7 @@ fn navigation(c: &mut Criterion) {
     group.bench_function("prepare_map", |b| {
         b.iter(|| {
             let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config);
-            let target = point_to_plane_tracker().prepare_target(&map);
+            let target = point_to_plane_localiser().prepare_target(&map);
             black_box((navigation.is_ok(), target.is_ok()))
         });
     });
@@ -80,7 +80,7 @@ fn navigation(c: &mut Criterion) {
         return;
     };
     let Ok(mut nav) = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         &map,
         &navigation,
         spot.body_pose(),
@@ -124,7 +124,7 @@ fn walk_cycles(
         return;
     };
     let Ok(mut nav) = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         map,
         navigation,
         spot.body_pose(),

@@ -27,7 +27,7 @@ use spot_adapter::nav::{
     Goal, NavigationMap, NavigationStep, Navigator, NavigatorConfig, PlannerKind,
 };
 use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_slam, point_to_plane_tracker, scan_context_places, slam_config,
+    loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places, slam_config,
 };
 use spot_adapter::robot::{MobilityCommand, Robot};
 use spot_adapter::sim::{
@@ -434,7 +434,7 @@ fn mission(args: &Args) -> Result<()> {
             )
         });
     let mut nav = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         &mapped.map,
         &mapped.navigation,
         mapped.map_t_body * kidnap,

@@ -24,7 +24,7 @@ use nalgebra::{Point3, Vector2, Vector3};
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::grpc::{Credentials, SpotClient, SpotConfig};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
-use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::{MobilityCommand, Robot, VelocityCommand};
 use spot_nav_examples::{parse_goal, parse_numbers};
 
@@ -128,7 +128,7 @@ fn run(args: &Args) -> Result<DriveOutcome> {
         (map, navigation, odom_t_body, goal.coords.xy())
     };
     let mut navigator = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         &map,
         &navigation,
         map_t_body,

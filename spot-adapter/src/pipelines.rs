@@ -69,6 +69,21 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
     }
 }
 
+/// Point-to-plane ICP for localising a scan against a building's map (the [`Navigator`]'s):
+/// [`point_to_plane_tracker`] with the map thinned to 0.1 m instead of 0.25 m. A voxel wider than
+/// a wall is thick mixes the wall's two faces into one centroid inside the wall: a room the map
+/// saw mostly through one such wall was localised onto that virtual surface, 0.11 m and 0.6°
+/// off with 57 % of the scan matched (building 5, 20 random goals, leg 3), where a 0.1 m map
+/// registers the same scan within 2 cm and 0.1°.
+///
+/// [`Navigator`]: crate::nav::Navigator
+#[must_use]
+pub fn point_to_plane_localiser() -> PointToPlaneIcp {
+    let mut icp = point_to_plane_tracker();
+    icp.config.target_voxel = 0.1;
+    icp
+}
+
 /// Point-to-plane ICP for scan-to-scan odometry of a source without any
 /// ([`ScanToScanOdometry`](crate::record::ScanToScanOdometry)): from a constant-velocity guess
 /// a few centimetres off, Tukey 20 cm, pairs within 1 m.

@@ -1,7 +1,8 @@
 //! Localisation against a map that knows when it is lost: each scan corrects the odometry's
-//! prediction by registration; the health of those corrections is tracked, a large correction is
-//! taken once consecutive scans confirm it, and after repeated failures a wide search over seeds
-//! around the estimate relocalises the robot, or reports it lost.
+//! prediction by registration; the health of those corrections is tracked, a correction larger
+//! than the odometry can have drifted since the last one is taken once consecutive scans confirm
+//! it, and after repeated failures a wide search over seeds around the estimate relocalises the
+//! robot, or reports it lost.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use slam_core::{Alignment, Pose3, Registrator};
@@ -12,14 +13,26 @@ use crate::robot::Sample;
 /// Settings of the localiser. Lengths in metres, angles in radians.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocaliserConfig {
-    /// A correction that moves the odometry's prediction farther than this is not taken from one
-    /// scan, 0.3 m (odometry drifts millimetres between two scans: a larger correction is a
-    /// wrong match or a genuine recovery, which the next scans must confirm).
+    /// A correction that moves the odometry's prediction farther than this is never taken from
+    /// one scan, 0.3 m (a wrong match or a genuine recovery, which the next scans must
+    /// confirm) ...
     pub max_correction: f64,
     /// ... or turns it more than this, 0.1 rad (5.7°).
     pub max_correction_angle: f64,
-    /// A registration counts only when it converged with at least this share of the scan's
-    /// points matched, 0.5.
+    /// Nor one that moves the prediction farther than the odometry can have drifted since the
+    /// last correction taken: this (0.05 m, a registration's scatter and a step's drift) plus
+    /// [`Self::odometry_drift`] times the distance walked since. Odometry drifts millimetres
+    /// between two scans, so a one-scan jump of 0.17 m is a registration that slid into a wrong
+    /// minimum (a 0.1 m map beside a box, building 6).
+    pub correction_floor: f64,
+    /// Drift of the odometry per metre walked that a correction may undo, 0.05 (Spot's is about
+    /// 2 %: two and a half times that).
+    pub odometry_drift: f64,
+    /// A registration counts only with at least this share of the scan's points matched, 0.5;
+    /// a correction larger than the odometry's drift (see [`Self::correction_floor`]) only when
+    /// the registration converged too. One within the drift is taken unconverged: beside a box
+    /// a fine map's registration can swap pairs back and forth within millimetres of the truth
+    /// for all its iterations.
     pub min_inlier_ratio: f64,
     /// Consecutive scans whose large corrections agree (within 5 cm and 0.02 rad, once carried
     /// by the odometry) before the correction is taken, 3.
@@ -46,6 +59,8 @@ impl Default for LocaliserConfig {
         Self {
             max_correction: 0.3,
             max_correction_angle: 0.1,
+            correction_floor: 0.05,
+            odometry_drift: 0.05,
             min_inlier_ratio: 0.5,
             confirm_after: 3,
             lost_after: 5,
@@ -68,6 +83,8 @@ impl LocaliserConfig {
         for (setting, value) in [
             ("max_correction", self.max_correction),
             ("max_correction_angle", self.max_correction_angle),
+            ("correction_floor", self.correction_floor),
+            ("odometry_drift", self.odometry_drift),
             ("search_radius", self.search_radius),
             ("search_step", self.search_step),
             ("search_angle", self.search_angle),
@@ -175,6 +192,8 @@ pub(crate) struct Localiser<R: Registrator> {
     map: R::Target,
     map_t_body: Pose3,
     last_odom_t_body: Option<Pose3>,
+    /// Distance walked by the odometry since the last correction taken (metres).
+    walked_since_correction: f64,
     candidate: Option<Candidate>,
     health: LocalisationHealth,
 }
@@ -192,6 +211,7 @@ impl<R: Registrator> Localiser<R> {
             map,
             map_t_body,
             last_odom_t_body: None,
+            walked_since_correction: 0.0,
             candidate: None,
             health: LocalisationHealth::default(),
         }
@@ -205,16 +225,18 @@ impl<R: Registrator> Localiser<R> {
         self.health
     }
 
-    /// Whether `a` counts as a good registration.
+    /// Whether `a` matched enough of the scan to count.
     fn good(&self, a: &Alignment) -> bool {
-        a.converged && a.inlier_ratio >= self.config.min_inlier_ratio
+        a.inlier_ratio >= self.config.min_inlier_ratio
     }
 
     /// Predict from the odometry, correct by registering `sample`'s scan, track the health,
     /// and search wide when the robot seems lost.
     pub(crate) fn update(&mut self, sample: &Sample) -> LocalisationStatus {
         if let Some(last) = self.last_odom_t_body.replace(sample.odom_t_body) {
-            self.map_t_body *= last.inverse() * sample.odom_t_body;
+            let step = last.inverse() * sample.odom_t_body;
+            self.walked_since_correction += step.translation.vector.norm();
+            self.map_t_body *= step;
         }
         let Ok(source) = self.registrator.prepare_source(&sample.cloud) else {
             return self.failed();
@@ -228,18 +250,23 @@ impl<R: Registrator> Localiser<R> {
         } else {
             self.health.converged = false;
         }
-        let Some(corrected) = aligned
+        let Some((corrected, converged)) = aligned
             .ok()
             .filter(|a| self.good(a))
-            .map(|a| a.pose * sample.body_t_lidar.inverse())
+            .map(|a| (a.pose * sample.body_t_lidar.inverse(), a.converged))
         else {
             return self.failed_with(sample, &source);
         };
         let jump = self.map_t_body.inverse() * corrected;
-        let small = jump.translation.vector.norm() <= self.config.max_correction
+        let drifted = self.config.correction_floor
+            + self.config.odometry_drift * self.walked_since_correction;
+        let small = jump.translation.vector.norm() <= drifted.min(self.config.max_correction)
             && jump.rotation.angle() <= self.config.max_correction_angle;
         if small {
             return self.accept(corrected, LocalisationStatus::Corrected);
+        }
+        if !converged {
+            return self.failed_with(sample, &source);
         }
         // A large correction: taken once consecutive scans agree on it.
         let count = match self.candidate {
@@ -260,6 +287,7 @@ impl<R: Registrator> Localiser<R> {
 
     fn accept(&mut self, pose: Pose3, status: LocalisationStatus) -> LocalisationStatus {
         self.map_t_body = pose;
+        self.walked_since_correction = 0.0;
         self.candidate = None;
         self.health.consecutive_failures = 0;
         self.health.searches = 0;

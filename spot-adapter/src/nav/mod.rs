@@ -10,6 +10,7 @@ mod localiser;
 mod navigation_map;
 mod navigator;
 mod stuck;
+mod unseen;
 
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};

@@ -14,6 +14,7 @@ use crate::error::AdapterError;
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser, LocaliserConfig};
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::stuck::{StuckConfig, StuckMonitor, StuckState};
+use crate::nav::unseen::unseen_blockers;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 
 /// Settings of [`Navigator`] (and of the [`NavigationMap`] it plans on). Lengths in metres,
@@ -350,10 +351,11 @@ impl<R: Registrator> Navigator<R> {
         let pose = self.localiser.pose();
         // Only scans the map confirmed go into the live layer: a scan placed wrongly would
         // paint obstacles where there are none.
-        if matches!(
+        let fused = matches!(
             status,
             LocalisationStatus::Corrected | LocalisationStatus::Relocalised
-        ) {
+        );
+        if fused {
             self.fuse(sample, &pose)?;
         }
         let position = pose.translation.vector.xy();
@@ -385,7 +387,9 @@ impl<R: Registrator> Navigator<R> {
                 return Ok(NavigationStep::Blocked);
             }
         }
-        if let Some(answer) = self.replan_if_needed(position, target)? {
+        if let Some(answer) =
+            self.replan_if_needed(position, target, fused.then_some(sample.stamp))?
+        {
             return Ok(answer);
         }
         let near = 0.5 * self.config.goal_tolerance;
@@ -408,11 +412,13 @@ impl<R: Registrator> Navigator<R> {
 
     /// Replan when there is no path, the path crosses a newly blocked cell, or the periodic
     /// replan is due; an answer when no path is left (`NoPath`, or `Hold` while the estimate is
-    /// unconfirmed).
+    /// unconfirmed). `fused_at` is the stamp of this cycle's scan when it went into the live
+    /// layer.
     fn replan_if_needed(
         &mut self,
         position: Vector2<f64>,
         target: Vector2<f64>,
+        fused_at: Option<f64>,
     ) -> Result<Option<NavigationStep>, AdapterError> {
         self.cycles_since_plan += 1;
         let blocked = !self.path_cells.is_empty() && self.planning.blocks_any(&self.path_cells);
@@ -426,7 +432,7 @@ impl<R: Registrator> Navigator<R> {
         if blocked {
             self.remember_blockage();
         }
-        let plan = self.plan(position, target)?;
+        let mut plan = self.plan(position, target)?;
         // A periodic replan back through a place that blocked an earlier path to this goal:
         // the current path, still clear, stands (its waypoints made afresh from here).
         if !blocked
@@ -440,15 +446,19 @@ impl<R: Registrator> Navigator<R> {
             self.waited = 0;
             return Ok(None);
         }
-        let resolution = self.planning.blocked().geometry().resolution;
-        let live_length = plan
-            .as_ref()
-            .map(|(_, cells)| cells_length(cells) * resolution);
-        // With no way round at all, something new blocking the way is waited for again (a
-        // person met twice): only once the patience runs out is the answer `NoPath`.
-        if (self.waited_out_for != Some(target) || plan.is_none())
-            && let Some(blockage) = self.worth_waiting(position, target, live_length)?
+        let mut waiting = self.waiting_for(position, target, plan.as_ref())?;
+        // What blocks the way and this scan does not see (a person who walked past close by,
+        // under the lowest beam: nothing clears those cells from here) is not waited for: it
+        // is forgotten and the way planned again. Anything still there is seen again.
+        if let (Some((_, cells)), Some(stamp)) = (&waiting, fused_at)
+            && let Some(blockers) =
+                unseen_blockers(&self.live, cells, self.config.planning.inflation)
         {
+            self.forget(&blockers, stamp)?;
+            plan = self.plan(position, target)?;
+            waiting = self.waiting_for(position, target, plan.as_ref())?;
+        }
+        if let Some((blockage, _)) = waiting {
             // Something new stands in the way and the way around is far longer (or there is
             // none): wait for it to move on, while it moves. The next cycle plans again.
             let (last, same) = self.waiting_on;
@@ -484,6 +494,46 @@ impl<R: Registrator> Navigator<R> {
             return Ok(Some(NavigationStep::Hold));
         }
         Ok(Some(NavigationStep::NoPath))
+    }
+
+    /// What blocks the way to `target` (see [`Self::worth_waiting`]) given the live `plan`. With
+    /// no way round at all, something new blocking the way is waited for again (a person met
+    /// twice): only once the patience runs out is the answer `NoPath`.
+    #[allow(clippy::type_complexity)]
+    fn waiting_for(
+        &self,
+        position: Vector2<f64>,
+        target: Vector2<f64>,
+        plan: Option<&(Vec<Vector2<f64>>, Vec<Cell>)>,
+    ) -> Result<Option<(Blockage, Vec<Cell>)>, AdapterError> {
+        if self.waited_out_for == Some(target) && plan.is_some() {
+            return Ok(None);
+        }
+        let resolution = self.planning.blocked().geometry().resolution;
+        let live_length = plan.map(|(_, cells)| cells_length(cells) * resolution);
+        self.worth_waiting(position, target, live_length)
+    }
+
+    /// Return `cells` to the static map's state in the live layer (at `stamp`, seconds) and
+    /// refresh the planning grid there.
+    fn forget(&mut self, cells: &[Cell], stamp: f64) -> Result<(), AdapterError> {
+        let mut changed = CellRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+        for &c in cells {
+            let state = self.live.static_map().state(c);
+            let update = self
+                .live
+                .mark(c, state, stamp)
+                .map_err(AdapterError::NavigationGrid)?;
+            if let Some(r) = update.changed {
+                changed = changed.union(&r);
+            }
+        }
+        self.refresh(changed)
     }
 
     /// Record where the current path is blocked (its first and last blocked cells).
@@ -601,14 +651,14 @@ impl<R: Registrator> Navigator<R> {
 
     /// What blocks the way, when the live path (its length `live_length` in metres, `None`
     /// when there is none) is more than `detour_extra` longer than the path on the map alone,
-    /// which exists: something new stands on the map's path. `None` when there is nothing to
-    /// wait for.
+    /// which exists: something new stands on the map's path. With it the blocked cells of the
+    /// map's path. `None` when there is nothing to wait for.
     fn worth_waiting(
         &self,
         position: Vector2<f64>,
         goal: Vector2<f64>,
         live_length: Option<f64>,
-    ) -> Result<Option<Blockage>, AdapterError> {
+    ) -> Result<Option<(Blockage, Vec<Cell>)>, AdapterError> {
         let resolution = self.planning.blocked().geometry().resolution;
         let extra = self.config.detour_extra;
         // No path can be shorter than the straight line: most plans need no second search.
@@ -636,11 +686,19 @@ impl<R: Registrator> Navigator<R> {
             return Ok(None);
         };
         let (last, count) = blocked.fold((first, 1), |(_, n), k| (k, n + 1));
-        Ok(Some(Blockage {
-            first: map_only[first],
-            last: map_only[last],
-            count,
-        }))
+        let cells = map_only[first..=last]
+            .iter()
+            .filter(|c| grid.is_blocked(**c))
+            .copied()
+            .collect();
+        Ok(Some((
+            Blockage {
+                first: map_only[first],
+                last: map_only[last],
+                count,
+            },
+            cells,
+        )))
     }
 
     /// Waypoints (metres) from `position` to `goal` after the start and the dense cells of the

@@ -19,7 +19,7 @@ use slam_core::{PointCloud, Pose3};
 use spot_adapter::DriveError;
 use spot_adapter::grpc::{SpotClient, SpotError};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
-use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::{Robot, Sample, VelocityCommand};
 use spot_adapter::sim::{Building, CommandedSpot, SimulationConfig};
 
@@ -140,7 +140,7 @@ fn setup(
     config.time_sync.max_age = MAX_SYNC_AGE;
     let spot = SpotClient::connect(config).unwrap();
     let navigator = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         map,
         navigation,
         sim.body_pose(),

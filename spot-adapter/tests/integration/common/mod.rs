@@ -5,7 +5,7 @@
 use nalgebra::Vector2;
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
-use spot_adapter::pipelines::point_to_plane_tracker;
+use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot,
@@ -139,7 +139,7 @@ pub fn run_legs(
             .unwrap();
     }
     let mut nav = Navigator::new(
-        point_to_plane_tracker(),
+        point_to_plane_localiser(),
         map,
         navigation,
         // The estimate starts `kidnap` away from the truth.
