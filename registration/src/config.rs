@@ -45,6 +45,12 @@ pub struct IcpConfig {
     /// ones, and ends 0.006° and 0.05 mm from the pose it reaches without the stage
     /// (point-to-point: 0.004° and 0.6 mm).
     pub coarse_stride: usize,
+    /// Point-to-plane: compute every target point's normal when the target is prepared (on
+    /// all cores) instead of each on its first use. Off by default: an alignment against a
+    /// local map touches a fraction of its points. On for a fixed map that many scans are
+    /// aligned against over time (a navigator's), where first uses would otherwise land in
+    /// whichever cycle first sees a place.
+    pub normals_up_front: bool,
 }
 
 impl Default for IcpConfig {
@@ -61,6 +67,7 @@ impl Default for IcpConfig {
             min_correspondences: 20,
             pair_target_points: 2,
             coarse_stride: 4,
+            normals_up_front: false,
         }
     }
 }

@@ -70,11 +70,15 @@ impl Registrator for PointToPlaneIcp {
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
         self.config.validate()?;
-        PreparedTarget::new(
+        let target = PreparedTarget::new(
             finite_points(cloud, self.config.target_voxel),
             Some(self.config.normal_neighbours),
             self.config.min_correspondences,
-        )
+        )?;
+        if self.config.normals_up_front {
+            target.compute_all_normals();
+        }
+        Ok(target)
     }
 
     fn align(

@@ -127,26 +127,66 @@ impl PreparedTarget {
     /// prepared with normals.
     pub(crate) fn normal(&self, i: usize) -> Option<Vector3<f64>> {
         let cache = self.normals.as_ref()?;
-        Some(*cache.cells[i].get_or_init(|| {
-            let p = self.points[i];
-            #[allow(clippy::cast_possible_truncation)]
-            let nn = self
-                .tree
-                .query(&[p.x as f32, p.y as f32, p.z as f32])
-                .nearest_n::<SquaredEuclidean<f32>>(cache.k)
-                .execute();
-            let pts: Vec<Vector3<f64>> = nn
-                .iter()
-                .map(|r| self.points[r.item as usize].coords)
-                .collect();
-            let mean = pts.iter().sum::<Vector3<f64>>() / pts.len() as f64;
-            let cov = pts.iter().fold(Matrix3::zeros(), |m, q| {
-                m + (q - mean) * (q - mean).transpose()
-            });
-            // Eigenvalues ascending: the first vector is the normal.
-            symmetric_eigen3(&cov).vectors.column(0).into_owned()
-        }))
+        Some(*cache.cells[i].get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k)))
     }
+
+    /// Computes every normal not computed yet, split over the machine's cores (each point's
+    /// normal is the one [`Self::normal`] would give).
+    pub(crate) fn compute_all_normals(&self) {
+        let Some(cache) = self.normals.as_ref() else {
+            return;
+        };
+        let threads = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        let chunk = self.points.len().div_ceil(threads).max(1);
+        let normals: Vec<Vector3<f64>> = std::thread::scope(|scope| {
+            let parts: Vec<_> = (0..self.points.len())
+                .step_by(chunk)
+                .map(|start| {
+                    let end = (start + chunk).min(self.points.len());
+                    let (points, tree, k) = (&self.points, &self.tree, cache.k);
+                    scope.spawn(move || {
+                        (start..end)
+                            .map(|i| pca_normal(points, tree, i, k))
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            parts
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_default())
+                .collect()
+        });
+        for (cell, n) in cache.cells.iter().zip(normals) {
+            let _ = cell.set(n);
+        }
+    }
+}
+
+/// The normal of `points[i]` from the PCA of its `k` nearest points in `tree`.
+#[allow(clippy::cast_precision_loss)]
+fn pca_normal(
+    points: &[Point3<f64>],
+    tree: &ImmutableKdTree<f32, 3>,
+    i: usize,
+    k: std::num::NonZero<usize>,
+) -> Vector3<f64> {
+    let p = points[i];
+    #[allow(clippy::cast_possible_truncation)]
+    let nn = tree
+        .query(&[p.x as f32, p.y as f32, p.z as f32])
+        .nearest_n::<SquaredEuclidean<f32>>(k)
+        .execute();
+    let n = nn.len().max(1) as f64;
+    let mean = nn
+        .iter()
+        .fold(Vector3::zeros(), |m, r| m + points[r.item as usize].coords)
+        / n;
+    let cov = nn.iter().fold(Matrix3::zeros(), |m, r| {
+        let d = points[r.item as usize].coords - mean;
+        m + d * d.transpose()
+    });
+    // Eigenvalues ascending: the first vector is the normal.
+    symmetric_eigen3(&cov).vectors.column(0).into_owned()
 }
 
 impl PreparedTarget {
@@ -225,4 +265,34 @@ pub(crate) fn merge_sources(parts: &[(&Vec<Point3<f64>>, Pose3)]) -> PointCloud 
         .flat_map(|(s, pose)| s.iter().map(move |p| (pose * p).cast::<f32>()))
         .collect();
     PointCloud::from_points(pts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_up_front_equal_the_normals_computed_on_first_use() {
+        // A box's faces and a tilted plane, with a little jitter.
+        let mut points = Vec::new();
+        for i in 0..40 {
+            for j in 0..40 {
+                let (a, b) = (f64::from(i) * 0.05, f64::from(j) * 0.05);
+                let jitter = 0.002 * f64::from((i * 7 + j * 13) % 5);
+                points.push(Point3::new(a, b, jitter));
+                points.push(Point3::new(a, jitter, b));
+                points.push(Point3::new(3.0 + jitter, a, b + 0.3 * a));
+            }
+        }
+        let lazy = PreparedTarget::new(points.clone(), Some(10), 3).unwrap();
+        let eager = PreparedTarget::new(points, Some(10), 3).unwrap();
+        eager.compute_all_normals();
+        let cache = eager.normals.as_ref().unwrap();
+        assert!(cache.cells.iter().all(|c| c.get().is_some()));
+        for i in 0..lazy.len() {
+            assert_eq!(lazy.normal(i), eager.normal(i), "point {i}");
+        }
+        // A wall's normal is its axis (either sign).
+        assert!(lazy.normal((20 * 40 + 20) * 3 + 1).unwrap().y.abs() > 0.99);
+    }
 }

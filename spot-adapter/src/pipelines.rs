@@ -81,6 +81,8 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
 pub fn point_to_plane_localiser() -> PointToPlaneIcp {
     let mut icp = point_to_plane_tracker();
     icp.config.target_voxel = 0.1;
+    // A walk into a part of the map not seen yet would compute its normals in that cycle.
+    icp.config.normals_up_front = true;
     icp
 }
 
