@@ -7,6 +7,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix3, Point3, Vector3};
 use slam_core::{Degeneracy, PointCloud, Pose3, RegistrationError};
 
+use crate::cell_index::CellIndex;
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
@@ -18,6 +19,8 @@ pub struct PreparedTarget {
     /// kilometres where f32 would lose millimetres.
     pub(crate) tree: ImmutableKdTree<f32, 3>,
     normals: Option<NormalCache>,
+    /// Cells for the short searches of an alignment, when the target was prepared with them.
+    cells: Option<CellIndex>,
 }
 
 /// PCA normals of the target points, computed once each on first use.
@@ -120,6 +123,7 @@ impl PreparedTarget {
             points,
             tree,
             normals,
+            cells: None,
         })
     }
 
@@ -128,6 +132,13 @@ impl PreparedTarget {
     pub(crate) fn normal(&self, i: usize) -> Option<Vector3<f64>> {
         let cache = self.normals.as_ref()?;
         Some(*cache.cells[i].get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k)))
+    }
+
+    /// Adds cells of `cell` metres for the alignment's short searches (the k-d tree still
+    /// answers the others); kept without them when the points cannot be numbered in such cells.
+    pub(crate) fn with_cells(mut self, cell: f64) -> Self {
+        self.cells = CellIndex::new(&self.points, cell);
+        self
     }
 
     /// Computes every normal not computed yet, split over the machine's cores (each point's
@@ -205,6 +216,11 @@ impl PreparedTarget {
 impl NearestSearch for PreparedTarget {
     #[allow(clippy::cast_possible_truncation)]
     fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
+        if let Some(cells) = &self.cells
+            && cells.nearest_into(q, n, max_distance, out)
+        {
+            return;
+        }
         out.clear();
         let Some(n) = std::num::NonZero::new(n) else {
             return;

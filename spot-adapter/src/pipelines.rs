@@ -83,6 +83,7 @@ pub fn point_to_plane_localiser() -> PointToPlaneIcp {
     icp.config.target_voxel = 0.1;
     // A walk into a part of the map not seen yet would compute its normals in that cycle.
     icp.config.normals_up_front = true;
+    icp.config.search_cell = 0.2;
     icp
 }
 

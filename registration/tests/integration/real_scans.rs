@@ -346,3 +346,58 @@ fn os1_128_steps_match_the_reference_poses() {
         assert!(rot < 0.2 && trans < 0.05, "step {k}: {rot} deg, {trans} m");
     }
 }
+
+/// Hashed search cells are an exact search: on the real pair, from an offset start, both ICPs end
+/// at the pose they reach with the k-d tree alone, through the same iterations and inliers.
+#[test]
+fn search_cells_give_the_k_d_tree_alignment() {
+    let (source, target, truth) = random_halves();
+    let initial = pose3_from_xyz_rpy(0.08, -0.05, 0.02, 0.01, -0.01, 0.05) * truth;
+    for cell in [0.2, 0.35] {
+        let tree = IcpConfig {
+            source_voxel: 0.2,
+            target_voxel: 0.1,
+            ..IcpConfig::default()
+        };
+        let cells = IcpConfig {
+            search_cell: cell,
+            ..tree
+        };
+        let same = |a: slam_core::Alignment, b: slam_core::Alignment| {
+            let d = a.pose.inverse() * b.pose;
+            assert!(
+                d.translation.vector.norm() < 1e-9 && d.rotation.angle() < 1e-9,
+                "{cell} m cells moved the result by {d:?}"
+            );
+            assert_eq!((a.iterations, a.inliers), (b.iterations, b.inliers));
+        };
+        let plane = |config| {
+            let r = PointToPlaneIcp { config };
+            r.align(
+                &r.prepare_source(&source).unwrap(),
+                &r.prepare_target(&target).unwrap(),
+                &initial,
+            )
+            .unwrap()
+        };
+        same(plane(tree), plane(cells));
+        let point = |config| {
+            let r = PointToPointIcp { config };
+            r.align(
+                &r.prepare_source(&source).unwrap(),
+                &r.prepare_target(&target).unwrap(),
+                &initial,
+            )
+            .unwrap()
+        };
+        same(point(tree), point(cells));
+    }
+    let bad = IcpConfig {
+        search_cell: -1.0,
+        ..IcpConfig::default()
+    };
+    assert!(matches!(
+        PointToPlaneIcp { config: bad }.prepare_target(&target),
+        Err(RegistrationError::InvalidConfig { .. })
+    ));
+}
