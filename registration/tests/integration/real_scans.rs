@@ -347,6 +347,20 @@ fn os1_128_steps_match_the_reference_poses() {
     }
 }
 
+fn aligned<R: Registrator>(
+    r: &R,
+    source: &PointCloud,
+    target: &PointCloud,
+    initial: &Pose3,
+) -> slam_core::Alignment {
+    r.align(
+        &r.prepare_source(source).unwrap(),
+        &r.prepare_target(target).unwrap(),
+        initial,
+    )
+    .unwrap()
+}
+
 /// Hashed search cells are an exact search: on the real pair, from an offset start, both ICPs end
 /// at the pose they reach with the k-d tree alone, through the same iterations and inliers.
 #[test]
@@ -371,26 +385,34 @@ fn search_cells_give_the_k_d_tree_alignment() {
             );
             assert_eq!((a.iterations, a.inliers), (b.iterations, b.inliers));
         };
-        let plane = |config| {
-            let r = PointToPlaneIcp { config };
-            r.align(
-                &r.prepare_source(&source).unwrap(),
-                &r.prepare_target(&target).unwrap(),
+        same(
+            aligned(
+                &PointToPlaneIcp { config: tree },
+                &source,
+                &target,
                 &initial,
-            )
-            .unwrap()
-        };
-        same(plane(tree), plane(cells));
-        let point = |config| {
-            let r = PointToPointIcp { config };
-            r.align(
-                &r.prepare_source(&source).unwrap(),
-                &r.prepare_target(&target).unwrap(),
+            ),
+            aligned(
+                &PointToPlaneIcp { config: cells },
+                &source,
+                &target,
                 &initial,
-            )
-            .unwrap()
-        };
-        same(point(tree), point(cells));
+            ),
+        );
+        same(
+            aligned(
+                &PointToPointIcp { config: tree },
+                &source,
+                &target,
+                &initial,
+            ),
+            aligned(
+                &PointToPointIcp { config: cells },
+                &source,
+                &target,
+                &initial,
+            ),
+        );
     }
     let bad = IcpConfig {
         search_cell: -1.0,
