@@ -74,7 +74,9 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
 /// a wall is thick mixes the wall's two faces into one centroid inside the wall: a room the map
 /// saw mostly through one such wall was localised onto that virtual surface, 0.11 m and 0.6°
 /// off with 57 % of the scan matched (building 5, 20 random goals, leg 3), where a 0.1 m map
-/// registers the same scan within 2 cm and 0.1°.
+/// registers the same scan within 2 cm and 0.1°. The map is fixed and every cycle aligns a scan
+/// against it, so its normals are computed when it is prepared and its points are searched
+/// through 0.2 m hashed cells (exact, a quarter fewer instructions per cycle than the k-d tree).
 ///
 /// [`Navigator`]: crate::nav::Navigator
 #[must_use]
