@@ -51,13 +51,6 @@ pub struct IcpConfig {
     /// aligned against over time (a navigator's), where first uses would otherwise land in
     /// whichever cycle first sees a place.
     pub normals_up_front: bool,
-    /// Side (metres) of the hashed cells that answer an alignment's searches within a few
-    /// cells, the k-d tree answering the rest; 0, the default, leaves every search to the
-    /// tree. Both are exact. Hashing the cells takes a sort of the target's points, so it pays
-    /// for a fixed map that many scans are aligned against: for a building's map thinned to
-    /// 0.1 m, 0.2 m cells take the tracking alignments' searches from 6,900 instructions each
-    /// (the tree's) to about 3,900.
-    pub search_cell: f64,
 }
 
 impl Default for IcpConfig {
@@ -75,7 +68,6 @@ impl Default for IcpConfig {
             pair_target_points: 2,
             coarse_stride: 4,
             normals_up_front: false,
-            search_cell: 0.0,
         }
     }
 }
@@ -106,7 +98,6 @@ impl IcpConfig {
         for (setting, v) in [
             ("IcpConfig::translation_tolerance", c.translation_tolerance),
             ("IcpConfig::rotation_tolerance", c.rotation_tolerance),
-            ("IcpConfig::search_cell", c.search_cell),
         ] {
             check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }

@@ -51,7 +51,6 @@
 //! spinning LiDAR's ring structure (a ring field, or clouds in the sensor frame with a known
 //! layout); for other clouds use the ICP backends.
 
-mod cell_index;
 mod config;
 mod icp;
 mod kernel;

@@ -75,11 +75,6 @@ impl Registrator for PointToPlaneIcp {
             Some(self.config.normal_neighbours),
             self.config.min_correspondences,
         )?;
-        let target = if self.config.search_cell > 0.0 {
-            target.with_cells(self.config.search_cell)
-        } else {
-            target
-        };
         if self.config.normals_up_front {
             target.compute_all_normals();
         }

@@ -58,16 +58,11 @@ impl Registrator for PointToPointIcp {
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
         self.config.validate()?;
-        let target = PreparedTarget::new(
+        PreparedTarget::new(
             finite_points(cloud, self.config.target_voxel),
             None,
             self.config.min_correspondences,
-        )?;
-        Ok(if self.config.search_cell > 0.0 {
-            target.with_cells(self.config.search_cell)
-        } else {
-            target
-        })
+        )
     }
 
     fn align(

@@ -7,7 +7,6 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix3, Point3, Vector3};
 use slam_core::{Degeneracy, PointCloud, Pose3, RegistrationError};
 
-use crate::cell_index::CellIndex;
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
@@ -19,8 +18,6 @@ pub struct PreparedTarget {
     /// kilometres where f32 would lose millimetres.
     pub(crate) tree: ImmutableKdTree<f32, 3>,
     normals: Option<NormalCache>,
-    /// Cells for the short searches of an alignment, when the target was prepared with them.
-    cells: Option<CellIndex>,
 }
 
 /// PCA normals of the target points, computed once each on first use.
@@ -123,7 +120,6 @@ impl PreparedTarget {
             points,
             tree,
             normals,
-            cells: None,
         })
     }
 
@@ -134,13 +130,6 @@ impl PreparedTarget {
         Some(*cache.cells[i].get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k)))
     }
 
-    /// Adds cells of `cell` metres for the alignment's short searches (the k-d tree still
-    /// answers the others); kept without them when the points cannot be numbered in such cells.
-    pub(crate) fn with_cells(mut self, cell: f64) -> Self {
-        self.cells = CellIndex::new(&self.points, cell);
-        self
-    }
-
     /// Computes every normal not computed yet, split over the machine's cores (each point's
     /// normal is the one [`Self::normal`] would give).
     pub(crate) fn compute_all_normals(&self) {
@@ -149,27 +138,29 @@ impl PreparedTarget {
         };
         let threads = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         let chunk = self.points.len().div_ceil(threads).max(1);
-        let normals: Vec<Vector3<f64>> = std::thread::scope(|scope| {
+        std::thread::scope(|scope| {
             let parts: Vec<_> = (0..self.points.len())
                 .step_by(chunk)
                 .map(|start| {
                     let end = (start + chunk).min(self.points.len());
                     let (points, tree, k) = (&self.points, &self.tree, cache.k);
-                    scope.spawn(move || {
+                    let part = scope.spawn(move || {
                         (start..end)
                             .map(|i| pca_normal(points, tree, i, k))
                             .collect::<Vec<_>>()
-                    })
+                    });
+                    (start, part)
                 })
                 .collect();
-            parts
-                .into_iter()
-                .flat_map(|h| h.join().unwrap_or_default())
-                .collect()
+            // Each part fills its own range; a part that failed leaves its normals to first use.
+            for (start, part) in parts {
+                if let Ok(normals) = part.join() {
+                    for (cell, n) in cache.cells[start..].iter().zip(normals) {
+                        let _ = cell.set(n);
+                    }
+                }
+            }
         });
-        for (cell, n) in cache.cells.iter().zip(normals) {
-            let _ = cell.set(n);
-        }
     }
 }
 
@@ -216,11 +207,6 @@ impl PreparedTarget {
 impl NearestSearch for PreparedTarget {
     #[allow(clippy::cast_possible_truncation)]
     fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
-        if let Some(cells) = &self.cells
-            && cells.nearest_into(q, n, max_distance, out)
-        {
-            return;
-        }
         out.clear();
         let Some(n) = std::num::NonZero::new(n) else {
             return;

@@ -78,8 +78,8 @@ impl PointCloud {
         let ring = self.ring();
         let intensity = self.intensity();
         let time = self.time();
-        // A scan lists its points along each ring, and neighbours on a ring mostly share a
-        // voxel: the previous point's voxel is checked before the hash map.
+        // Consecutive points of a scan (one firing's beams near the sensor, neighbours along a
+        // ring) often share a voxel: the previous point's voxel is checked before the hash map.
         let mut last: Option<((i64, i64, i64), u32)> = None;
         for (i, p) in self.points().iter().enumerate() {
             let Some(key) = voxel_key(p, inv).map_err(|()| CloudError::VoxelOutOfRange {

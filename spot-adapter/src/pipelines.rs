@@ -75,10 +75,7 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
 /// saw mostly through one such wall was localised onto that virtual surface, 0.11 m and 0.6°
 /// off with 57 % of the scan matched (building 5, 20 random goals, leg 3), where a 0.1 m map
 /// registers the same scan within 2 cm and 0.1°. The map is fixed and every cycle aligns a scan
-/// against it, so its normals are computed when it is prepared. Its searches stay on the k-d
-/// tree: 0.2 m hashed cells (`IcpConfig::search_cell`) run a quarter fewer instructions per
-/// cycle but took as long in wall-clock time (a 20-goal walk: 63.8 and 64.1 s against 61.6 and
-/// 69.8 s).
+/// against it, so its normals are computed when it is prepared.
 ///
 /// [`Navigator`]: crate::nav::Navigator
 #[must_use]
