@@ -51,6 +51,16 @@ pub struct IcpConfig {
     /// aligned against over time (a navigator's), where first uses would otherwise land in
     /// whichever cycle first sees a place.
     pub normals_up_front: bool,
+    /// Point-to-plane: directions of the motion that the matched surfaces barely constrain
+    /// get no update, so the initial guess's motion stands along them (solution remapping,
+    /// Zhang, Kaess & Singh, ICRA 2016). A direction `v` (unit 6-vector of the left
+    /// perturbation, `[translation; rotation]`) counts as unconstrained when `v^T H v`, the
+    /// information along it, is below this times the sum of the pairs' weights: for a
+    /// translation that is the weighted mean of `(n . v)^2` over the pairs' normals, so 0.01
+    /// means about one pair in a hundred faces that way. In a corridor without features
+    /// registration otherwise slides along the walls on noise; with a prediction from the
+    /// robot's motion it keeps that instead. 0 (the default) turns it off.
+    pub degeneracy_threshold: f64,
 }
 
 impl Default for IcpConfig {
@@ -68,13 +78,14 @@ impl Default for IcpConfig {
             pair_target_points: 2,
             coarse_stride: 4,
             normals_up_front: false,
+            degeneracy_threshold: 0.0,
         }
     }
 }
 
 impl IcpConfig {
     /// Checks every setting: voxels finite and not negative; reach, kernel threshold and
-    /// tolerances finite and positive (tolerances may be 0); at least one iteration, 3 normal
+    /// tolerances finite and positive (tolerances and the degeneracy threshold may be 0); at least one iteration, 3 normal
     /// neighbours, one correspondence; `pair_target_points` 1 to 16; `coarse_stride` at least 1.
     /// Preparation and alignment call it, so a bad setting is an error, not a silent change.
     ///
@@ -98,6 +109,7 @@ impl IcpConfig {
         for (setting, v) in [
             ("IcpConfig::translation_tolerance", c.translation_tolerance),
             ("IcpConfig::rotation_tolerance", c.rotation_tolerance),
+            ("IcpConfig::degeneracy_threshold", c.degeneracy_threshold),
         ] {
             check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }

@@ -29,6 +29,31 @@ pub(crate) trait IcpStep {
     fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError>;
     /// `J^T W J` of the pairs (left perturbation, `[rho; phi]`).
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64>;
+    /// `(J^T W J, J^T W r)` when the step is a Gauss-Newton solve of them (`None` for a
+    /// closed-form step).
+    fn normal_equations(_pairs: &[Pair], _weights: &[f64]) -> Option<(Matrix6<f64>, Vector6<f64>)> {
+        None
+    }
+}
+
+/// The Gauss-Newton update `-H^-1 b` restricted to the directions the pairs constrain: the
+/// eigenvectors of `H` whose eigenvalue is at least `floor` (the rest get no update; `None` when
+/// none is left or the system is not finite).
+fn well_constrained_step(h: &Matrix6<f64>, b: &Vector6<f64>, floor: f64) -> Option<Vector6<f64>> {
+    if !(h.iter().all(|v| v.is_finite()) && b.iter().all(|v| v.is_finite())) {
+        return None;
+    }
+    let eig = SymmetricEigen::new(*h);
+    let mut delta = Vector6::zeros();
+    let mut kept = 0;
+    for (i, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda >= floor && lambda > 0.0 {
+            let v = eig.eigenvectors.column(i);
+            delta -= v * (v.dot(b) / lambda);
+            kept += 1;
+        }
+    }
+    (kept > 0).then_some(delta)
 }
 
 /// Jacobian of `p` moved by a left perturbation: `d(exp(d) p)/dd = [I, -[p]x]`.
@@ -115,7 +140,20 @@ fn update<S: IcpStep>(
 ) -> Result<(f64, f64), RegistrationError> {
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
-    let delta = S::step(pairs, weights)?;
+    let constrained = if config.degeneracy_threshold > 0.0 {
+        S::normal_equations(pairs, weights)
+    } else {
+        None
+    };
+    let delta = match constrained {
+        Some((h, b)) => {
+            let floor = config.degeneracy_threshold * weights.iter().sum::<f64>();
+            well_constrained_step(&h, &b, floor).ok_or(RegistrationError::Degenerate {
+                cause: Degeneracy::SingularNormalEquations,
+            })?
+        }
+        None => S::step(pairs, weights)?,
+    };
     if !delta.iter().all(|v| v.is_finite()) {
         return Err(RegistrationError::Degenerate {
             cause: Degeneracy::NonFiniteUpdate,

@@ -32,6 +32,15 @@ impl IcpStep for GaussNewtonPlane {
     }
 
     fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError> {
+        let (h, b) = Self::normal_equations(pairs, weights).unwrap_or_default();
+        h.cholesky()
+            .map(|c| -c.solve(&b))
+            .ok_or(RegistrationError::Degenerate {
+                cause: Degeneracy::SingularNormalEquations,
+            })
+    }
+
+    fn normal_equations(pairs: &[Pair], weights: &[f64]) -> Option<(Matrix6<f64>, Vector6<f64>)> {
         let mut h = Matrix6::zeros();
         let mut b = Vector6::zeros();
         for (p, w) in pairs.iter().zip(weights) {
@@ -42,11 +51,7 @@ impl IcpStep for GaussNewtonPlane {
             h += j * j.transpose() * *w;
             b += j * (Self::residual(p) * w);
         }
-        h.cholesky()
-            .map(|c| -c.solve(&b))
-            .ok_or(RegistrationError::Degenerate {
-                cause: Degeneracy::SingularNormalEquations,
-            })
+        Some((h, b))
     }
 
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {

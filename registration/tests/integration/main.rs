@@ -4,6 +4,8 @@
 
 mod common;
 
+mod degeneracy;
+
 mod loam;
 mod real_scans;
 mod voxel_hash_map;

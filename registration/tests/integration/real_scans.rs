@@ -215,6 +215,14 @@ fn bad_settings(good: IcpConfig) -> Vec<(&'static str, IcpConfig)> {
             with(|c| c.pair_target_points = 17),
         ),
         ("IcpConfig::coarse_stride", with(|c| c.coarse_stride = 0)),
+        (
+            "IcpConfig::degeneracy_threshold",
+            with(|c| c.degeneracy_threshold = -0.01),
+        ),
+        (
+            "IcpConfig::degeneracy_threshold",
+            with(|c| c.degeneracy_threshold = f64::NAN),
+        ),
     ]
 }
 
