@@ -336,7 +336,9 @@ impl<R: Registrator> Navigator<R> {
             self.path_cells.clear();
             self.blocked_at.clear();
         }
-        let status = self.localiser.update(sample);
+        let walking = (self.localiser.pose().translation.vector.xy() - target).norm()
+            > self.config.localiser.full_scan_within;
+        let status = self.localiser.update(sample, walking);
         match status {
             LocalisationStatus::Searching => {
                 self.stuck.reset();

@@ -116,6 +116,33 @@ fn bad_settings_are_rejected() {
     assert!(invalid(n.validate(), "stuck.window"));
 }
 
+/// The walking scan's voxel is off (0) or a usable size; a tiny one would make every scan's
+/// thinning fail, and the full scan be used without a word.
+#[test]
+fn bad_walking_scan_settings_are_rejected() {
+    for (voxel, within) in [
+        (f64::NAN, 1.5),
+        (-0.35, 1.5),
+        (1e-30, 1.5),
+        (0.35, f64::INFINITY),
+    ] {
+        let n = NavigatorConfig {
+            localiser: LocaliserConfig {
+                walking_scan_voxel: voxel,
+                full_scan_within: within,
+                ..LocaliserConfig::default()
+            },
+            ..NavigatorConfig::default()
+        };
+        let setting = if within.is_finite() {
+            "walking_scan_voxel"
+        } else {
+            "full_scan_within"
+        };
+        assert!(invalid(n.validate(), setting), "{voxel} {within}");
+    }
+}
+
 #[test]
 fn the_error_message_names_the_setting_and_its_value() {
     let mut l = Vlp16Config::default();
