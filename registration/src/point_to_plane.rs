@@ -19,6 +19,21 @@ pub struct PointToPlaneIcp {
 
 struct GaussNewtonPlane;
 
+/// `(J^T W J, J^T W r)` of the pairs with a non-zero weight.
+fn normal_equations(pairs: &[Pair], weights: &[f64]) -> (Matrix6<f64>, Vector6<f64>) {
+    let mut h = Matrix6::zeros();
+    let mut b = Vector6::zeros();
+    for (p, w) in pairs.iter().zip(weights) {
+        if *w == 0.0 {
+            continue;
+        }
+        let j = row(p);
+        h += j * j.transpose() * *w;
+        b += j * (GaussNewtonPlane::residual(p) * w);
+    }
+    (h, b)
+}
+
 /// `J = [n^T, (p x n)^T]` for a left perturbation of the moved point `p`.
 fn row(pair: &Pair) -> Vector6<f64> {
     let n = pair.n.unwrap_or_default();
@@ -32,7 +47,7 @@ impl IcpStep for GaussNewtonPlane {
     }
 
     fn step(pairs: &[Pair], weights: &[f64]) -> Result<Vector6<f64>, RegistrationError> {
-        let (h, b) = Self::normal_equations(pairs, weights).unwrap_or_default();
+        let (h, b) = normal_equations(pairs, weights);
         h.cholesky()
             .map(|c| -c.solve(&b))
             .ok_or(RegistrationError::Degenerate {
@@ -41,27 +56,11 @@ impl IcpStep for GaussNewtonPlane {
     }
 
     fn normal_equations(pairs: &[Pair], weights: &[f64]) -> Option<(Matrix6<f64>, Vector6<f64>)> {
-        let mut h = Matrix6::zeros();
-        let mut b = Vector6::zeros();
-        for (p, w) in pairs.iter().zip(weights) {
-            if *w == 0.0 {
-                continue;
-            }
-            let j = row(p);
-            h += j * j.transpose() * *w;
-            b += j * (Self::residual(p) * w);
-        }
-        Some((h, b))
+        Some(normal_equations(pairs, weights))
     }
 
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {
-        pairs
-            .iter()
-            .zip(weights)
-            .fold(Matrix6::zeros(), |m, (p, w)| {
-                let j = row(p);
-                m + j * j.transpose() * *w
-            })
+        normal_equations(pairs, weights).0
     }
 }
 
