@@ -61,6 +61,13 @@ pub struct IcpConfig {
     /// registration otherwise slides along the walls on noise; with a prediction from the
     /// robot's motion it keeps that instead. 0 (the default) turns it off.
     pub degeneracy_threshold: f64,
+    /// Point-to-plane: a target point pairs only when its neighbourhood is a plane, its middle
+    /// PCA eigenvalue at least this times the largest (0 to 1). A neighbourhood along a line
+    /// (one ring of a LiDAR on the floor, thinned to a voxel row) has a normal that could point
+    /// anywhere across the line; such normals turn along-the-wall motion into residuals, which
+    /// pull the scan towards the sampling pattern it was matched to. 0 (the default) keeps
+    /// every normal.
+    pub min_planarity: f64,
 }
 
 impl Default for IcpConfig {
@@ -79,13 +86,15 @@ impl Default for IcpConfig {
             coarse_stride: 4,
             normals_up_front: false,
             degeneracy_threshold: 0.0,
+            min_planarity: 0.0,
         }
     }
 }
 
 impl IcpConfig {
     /// Checks every setting: voxels finite and not negative; reach, kernel threshold and
-    /// tolerances finite and positive (tolerances and the degeneracy threshold may be 0); at
+    /// tolerances finite and positive (tolerances and the degeneracy threshold may be 0);
+    /// `min_planarity` 0 to 1; at
     /// least one iteration, 3 normal neighbours, one correspondence; `pair_target_points` 1 to
     /// 16; `coarse_stride` at least 1.
     /// Preparation and alignment call it, so a bad setting is an error, not a silent change.
@@ -122,6 +131,12 @@ impl IcpConfig {
                 "a finite and positive threshold",
             )?;
         }
+        check(
+            (0.0..=1.0).contains(&c.min_planarity),
+            "IcpConfig::min_planarity",
+            c.min_planarity,
+            "0 to 1",
+        )?;
         for (setting, v, least, expected) in [
             (
                 "IcpConfig::max_iterations",

@@ -86,6 +86,11 @@ fn correspondences(
         let Some(i) = nearest.first().map(|c| c.id as usize) else {
             continue;
         };
+        let n = target.normal(i);
+        if n.is_none() && target.has_normals() {
+            // Not on a plane (`IcpConfig::min_planarity`).
+            continue;
+        }
         let q = if nearest.len() == 1 {
             target.points[i]
         } else {
@@ -94,11 +99,7 @@ fn correspondences(
             });
             Point3::from(sum / nearest.len() as f64)
         };
-        pairs.push(Pair {
-            p,
-            q,
-            n: target.normal(i),
-        });
+        pairs.push(Pair { p, q, n });
     }
 }
 
@@ -116,11 +117,14 @@ fn coarse_correspondences(
     for s in source.iter().step_by(stride) {
         let p = pose * s;
         if let Some(i) = target.nearest_one(&p, max_distance) {
-            pairs.push(Pair {
-                p,
-                q: target.points[i],
-                n: target.normal(i),
-            });
+            let n = target.normal(i);
+            if n.is_some() || !target.has_normals() {
+                pairs.push(Pair {
+                    p,
+                    q: target.points[i],
+                    n,
+                });
+            }
         }
     }
 }

@@ -76,7 +76,7 @@ impl Registrator for PointToPlaneIcp {
         self.config.validate()?;
         let target = PreparedTarget::new(
             finite_points(cloud, self.config.target_voxel),
-            Some(self.config.normal_neighbours),
+            Some((self.config.normal_neighbours, self.config.min_planarity)),
             self.config.min_correspondences,
         )?;
         if self.config.normals_up_front {

@@ -23,7 +23,10 @@ pub struct PreparedTarget {
 /// PCA normals of the target points, computed once each on first use.
 struct NormalCache {
     k: std::num::NonZero<usize>,
-    cells: Vec<OnceCell<Vector3<f64>>>,
+    /// `IcpConfig::min_planarity`.
+    min_planarity: f64,
+    /// `None`: the neighbourhood is not plane-like enough.
+    cells: Vec<OnceCell<Option<Vector3<f64>>>>,
 }
 
 impl std::fmt::Debug for PreparedTarget {
@@ -73,11 +76,12 @@ fn spread_dimensions(points: &[Point3<f64>]) -> usize {
 }
 
 impl PreparedTarget {
-    /// Build the tree (and normals from `normal_neighbours` nearest points when asked).
+    /// Build the tree (and normals from `normals.0` nearest points, kept where the
+    /// neighbourhood's planarity reaches `normals.1`, when asked).
     /// Coincident or collinear points are refused ([`Degeneracy::DegenerateTarget`]).
     pub(crate) fn new(
         points: Vec<Point3<f64>>,
-        normal_neighbours: Option<usize>,
+        normals: Option<(usize, f64)>,
         min_points: usize,
     ) -> Result<Self, RegistrationError> {
         if points.len() < min_points {
@@ -112,8 +116,9 @@ impl PreparedTarget {
         })?;
         // Normals are computed on first use: an alignment touches only the target points that
         // are some source point's nearest neighbour, a fraction of a local map's points.
-        let normals = normal_neighbours.map(|k| NormalCache {
+        let normals = normals.map(|(k, min_planarity)| NormalCache {
             k: std::num::NonZero::new(k.max(3)).unwrap_or(std::num::NonZero::<usize>::MIN),
+            min_planarity,
             cells: (0..points.len()).map(|_| OnceCell::new()).collect(),
         });
         Ok(Self {
@@ -123,11 +128,17 @@ impl PreparedTarget {
         })
     }
 
+    /// Whether the target was prepared with normals.
+    pub(crate) fn has_normals(&self) -> bool {
+        self.normals.is_some()
+    }
+
     /// The unit normal of target point `i` (PCA of its nearest neighbours), when the target was
-    /// prepared with normals.
+    /// prepared with normals and the neighbourhood is plane-like enough.
     pub(crate) fn normal(&self, i: usize) -> Option<Vector3<f64>> {
         let cache = self.normals.as_ref()?;
-        Some(*cache.cells[i].get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k)))
+        *cache.cells[i]
+            .get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k, cache.min_planarity))
     }
 
     /// Computes every normal not computed yet, split over the machine's cores (each point's
@@ -144,9 +155,10 @@ impl PreparedTarget {
                 .map(|start| {
                     let end = (start + chunk).min(self.points.len());
                     let (points, tree, k) = (&self.points, &self.tree, cache.k);
+                    let min_planarity = cache.min_planarity;
                     let part = scope.spawn(move || {
                         (start..end)
-                            .map(|i| pca_normal(points, tree, i, k))
+                            .map(|i| pca_normal(points, tree, i, k, min_planarity))
                             .collect::<Vec<_>>()
                     });
                     (start, part)
@@ -164,14 +176,17 @@ impl PreparedTarget {
     }
 }
 
-/// The normal of `points[i]` from the PCA of its `k` nearest points in `tree`.
+/// The normal of `points[i]` from the PCA of its `k` nearest points in `tree`, unless their
+/// middle eigenvalue is below `min_planarity` times the largest (points along a line, whose
+/// normal could be any direction across it).
 #[allow(clippy::cast_precision_loss)]
 fn pca_normal(
     points: &[Point3<f64>],
     tree: &ImmutableKdTree<f32, 3>,
     i: usize,
     k: std::num::NonZero<usize>,
-) -> Vector3<f64> {
+    min_planarity: f64,
+) -> Option<Vector3<f64>> {
     let p = points[i];
     #[allow(clippy::cast_possible_truncation)]
     let nn = tree
@@ -188,7 +203,10 @@ fn pca_normal(
         m + d * d.transpose()
     });
     // Eigenvalues ascending: the first vector is the normal.
-    symmetric_eigen3(&cov).vectors.column(0).into_owned()
+    let eigen = symmetric_eigen3(&cov);
+    // Rounding can leave a plane's middle eigenvalue a hair below 0: 0 keeps every normal.
+    (eigen.values[1].max(0.0) >= min_planarity * eigen.values[2])
+        .then(|| eigen.vectors.column(0).into_owned())
 }
 
 impl PreparedTarget {
@@ -286,8 +304,8 @@ mod tests {
                 points.push(Point3::new(3.0 + jitter, a, b + 0.3 * a));
             }
         }
-        let lazy = PreparedTarget::new(points.clone(), Some(10), 3).unwrap();
-        let eager = PreparedTarget::new(points, Some(10), 3).unwrap();
+        let lazy = PreparedTarget::new(points.clone(), Some((10, 0.0)), 3).unwrap();
+        let eager = PreparedTarget::new(points, Some((10, 0.0)), 3).unwrap();
         eager.compute_all_normals();
         let cache = eager.normals.as_ref().unwrap();
         assert!(cache.cells.iter().all(|c| c.get().is_some()));
@@ -296,5 +314,35 @@ mod tests {
         }
         // A wall's normal is its axis (either sign).
         assert!(lazy.normal((20 * 40 + 20) * 3 + 1).unwrap().y.abs() > 0.99);
+    }
+
+    #[test]
+    fn only_plane_like_neighbourhoods_get_a_normal_with_min_planarity() {
+        // A floor patch, and far from it a row of points along x (one LiDAR ring thinned to
+        // a voxel row): the row's covariance has one large eigenvalue, its normal any
+        // direction across x.
+        let mut points = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                points.push(Point3::new(f64::from(i) * 0.1, f64::from(j) * 0.1, 0.0));
+            }
+        }
+        let row = points.len();
+        for i in 0..20 {
+            let wobble = 0.002 * f64::from(i % 3);
+            points.push(Point3::new(f64::from(i) * 0.25, 10.0 + wobble, 0.0));
+        }
+        let every = PreparedTarget::new(points.clone(), Some((10, 0.0)), 3).unwrap();
+        let planes = PreparedTarget::new(points, Some((10, 0.2)), 3).unwrap();
+        assert!(planes.has_normals());
+        for i in 0..row {
+            let n = planes.normal(i).expect("a floor point has a normal");
+            assert!(n.z.abs() > 0.999, "{n:?}");
+            assert_eq!(every.normal(i), planes.normal(i));
+        }
+        for i in row..row + 20 {
+            assert!(every.normal(i).is_some());
+            assert_eq!(planes.normal(i), None, "row point {i}");
+        }
     }
 }

@@ -81,9 +81,9 @@ pub struct GraphSlamConfig {
     /// a look-alike loop cannot stretch. [`EdgeInformation::FixedAndRegistration`] lets each
     /// edge go as soft as its registration was weak: where registration slipped along a corridor
     /// of blank walls, a loop closed later then moves those keyframes instead of bending the
-    /// rest of the map (on the simulated blank-corridor lap, LiDAR-only, ATE 0.12 m after the
-    /// loop against 0.40 m with the fixed sigmas). The price: a chain soft along a corridor
-    /// is soft along one of identical rooms too, and with
+    /// rest of the map (on the simulated blank-corridor lap, LiDAR-only with trackers that
+    /// slip there, ATE 0.12 m after the loop against 0.40 m with the fixed sigmas). The price:
+    /// a chain soft along a corridor is soft along one of identical rooms too, and with
     /// [`loop_max_drift_rate`](Self::loop_max_drift_rate) off, graduated non-convexity then
     /// keeps a consistent set of look-alike loops a few rooms long (it weighs every one out
     /// with the fixed sigmas). Keep the drift gate on when you choose it.

@@ -16,8 +16,18 @@ pub fn target_scan() -> PointCloud {
     read_ply(here("../slam-core/tests/data/hdl32e_pair_target.ply")).unwrap()
 }
 
+/// `small_gicp`'s reference `target_T_source` for the HDL-32E pair.
 pub fn reference() -> Pose3 {
-    let txt = std::fs::read_to_string(here("tests/data/T_target_source.txt")).unwrap();
+    reference_from("tests/data/T_target_source.txt")
+}
+
+/// `fast_gicp`'s reference for the same pair (0.23 degrees and 1.9 cm from `small_gicp`'s).
+pub fn fast_gicp_reference() -> Pose3 {
+    reference_from("tests/data/fast_gicp_T_target_source.txt")
+}
+
+fn reference_from(path: &str) -> Pose3 {
+    let txt = std::fs::read_to_string(here(path)).unwrap();
     let v: Vec<f64> = txt.split_whitespace().map(|s| s.parse().unwrap()).collect();
     let m = Matrix4::from_row_slice(&v);
     Pose3::from_parts(
