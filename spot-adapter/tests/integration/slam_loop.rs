@@ -84,8 +84,8 @@ fn loam_slam_meets_the_accuracy_targets() {
 }
 
 /// Scans cast while walking (12 cm per sweep), deskewed by the engine with the odometry's
-/// velocity, meet the same targets; without deskewing the same lap drifts 0.34 % over 10-50 m
-/// segments (ATE 4.6 cm), beyond the 0.2 % target.
+/// velocity, meet the same targets; without deskewing the same lap drifts 0.39 % over 10-50 m
+/// segments (ATE 5.1 cm), beyond the 0.2 % target.
 #[test]
 fn deskewed_scans_meet_the_accuracy_targets() {
     let drift = meets_the_accuracy_targets(point_to_plane_slam(slam_config()).unwrap(), true);
