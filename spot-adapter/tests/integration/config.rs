@@ -153,3 +153,30 @@ fn the_error_message_names_the_setting_and_its_value() {
         "{message}"
     );
 }
+
+/// A bad tracker setting handed to `point_to_plane_slam_with` is refused up front, named, and
+/// not left for every scan to fail on.
+#[test]
+fn a_bad_tracker_setting_is_refused_when_the_engine_is_built() {
+    use spot_adapter::pipelines::{point_to_plane_slam_with, point_to_plane_tracker, slam_config};
+    for (setting, value) in [
+        ("IcpConfig::min_planarity", 1.5),
+        ("IcpConfig::min_planarity", f64::NAN),
+        ("IcpConfig::max_correspondence_distance", -1.0),
+    ] {
+        let mut tracker = point_to_plane_tracker();
+        if setting == "IcpConfig::min_planarity" {
+            tracker.config.min_planarity = value;
+        } else {
+            tracker.config.max_correspondence_distance = value;
+        }
+        match point_to_plane_slam_with(slam_config(), tracker) {
+            Err(e) => {
+                assert_eq!(e.setting, setting);
+                assert!(e.value.to_bits() == value.to_bits(), "{e:?}");
+            }
+            Ok(_) => panic!("{setting} = {value} accepted"),
+        }
+    }
+    assert!(point_to_plane_slam_with(slam_config(), point_to_plane_tracker()).is_ok());
+}
