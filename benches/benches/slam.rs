@@ -12,12 +12,16 @@
 //! own cost per scan, as criterion's repeated samples give it for short functions.
 //!
 //! `cargo bench -p spot-nav-benches --bench slam` (about 6 minutes; `SLAM_BENCH_SEEDS=1,3`,
-//! `SLAM_BENCH_SETUPS=loam` and `SLAM_BENCH_REPEATS=5` pick runs; 3 laps by default)
+//! `SLAM_BENCH_SETUPS=loam` and `SLAM_BENCH_REPEATS=5` pick runs; 3 laps by default). The
+//! setup `p2plane-every-normal` (not run by default) is point-to-plane with trackers that keep
+//! every PCA normal (`min_planarity` 0 instead of `PLANE_LIKE`), the ablation of that setting.
 
 use slam_core::io::StampedPose;
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, SlamReport};
 use spot_adapter::eval::TrajectoryEvaluation;
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, slam_config};
+use spot_adapter::pipelines::{
+    loam_slam, point_to_plane_slam, point_to_plane_slam_with, point_to_plane_tracker, slam_config,
+};
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// One lap: the engine's report and its trajectory.
@@ -132,9 +136,16 @@ fn main() {
                 let Ok(input) = simulate() else { break };
                 let done = match setup.as_str() {
                     "p2plane" => point_to_plane_slam(slam_config()).map(|s| lap(s, input)),
+                    "p2plane-every-normal" => {
+                        let mut tracker = point_to_plane_tracker();
+                        tracker.config.min_planarity = 0.0;
+                        point_to_plane_slam_with(slam_config(), tracker).map(|s| lap(s, input))
+                    }
                     "loam" => loam_slam(slam_config()).map(|s| lap(s, input)),
                     other => {
-                        eprintln!("slam bench: unknown setup {other:?} (p2plane, loam)");
+                        eprintln!(
+                            "slam bench: unknown setup {other:?} (p2plane, p2plane-every-normal, loam)"
+                        );
                         break;
                     }
                 };
