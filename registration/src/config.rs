@@ -94,9 +94,8 @@ impl Default for IcpConfig {
 impl IcpConfig {
     /// Checks every setting: voxels finite and not negative; reach, kernel threshold and
     /// tolerances finite and positive (tolerances and the degeneracy threshold may be 0);
-    /// `min_planarity` 0 to 1; at
-    /// least one iteration, 3 normal neighbours, one correspondence; `pair_target_points` 1 to
-    /// 16; `coarse_stride` at least 1.
+    /// `min_planarity` 0 to 1; at least one iteration, 3 normal neighbours, one correspondence;
+    /// `pair_target_points` 1 to 16; `coarse_stride` at least 1.
     /// Preparation and alignment call it, so a bad setting is an error, not a silent change.
     ///
     /// # Errors
