@@ -383,6 +383,7 @@ fn plane_like_normals_hold_on_real_scans() {
         ..IcpConfig::default()
     });
     let (rot, trans) = error(&truth, &run(&halves, &source, &target, &Pose3::identity()));
+    eprintln!("plane-like, halves: {rot:.3} deg, {:.2} mm", trans * 1e3);
     assert!(rot < 0.05 && trans < 0.005, "halves: {rot} deg, {trans} m");
 
     let (frames, poses) = crate::common::os1_128();
@@ -391,6 +392,10 @@ fn plane_like_normals_hold_on_real_scans() {
         let reference = poses[k].inverse() * poses[k + 1];
         let estimate = run(&icp, &frames[k + 1], &frames[k], &Pose3::identity());
         let (rot, trans) = error(&reference, &estimate);
+        eprintln!(
+            "plane-like, OS1-128 step {k}: {rot:.3} deg, {:.2} cm",
+            trans * 1e2
+        );
         assert!(rot < 0.2 && trans < 0.05, "step {k}: {rot} deg, {trans} m");
     }
 
@@ -405,6 +410,10 @@ fn plane_like_normals_hold_on_real_scans() {
         let estimate = run(&wide, &source, &target, &initial);
         for reference in [reference(), crate::common::fast_gicp_reference()] {
             let (rot, trans) = error(&reference, &estimate);
+            eprintln!(
+                "plane-like, HDL-32E pair: {rot:.3} deg, {:.2} cm",
+                trans * 1e2
+            );
             assert!(rot < 0.35 && trans < 0.035, "pair: {rot} deg, {trans} m");
         }
     }
