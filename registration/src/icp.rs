@@ -86,11 +86,9 @@ fn correspondences(
         let Some(i) = nearest.first().map(|c| c.id as usize) else {
             continue;
         };
-        let n = target.normal(i);
-        if n.is_none() && target.has_normals() {
-            // Not on a plane (`IcpConfig::min_planarity`).
+        let Some(n) = target.pairing_normal(i) else {
             continue;
-        }
+        };
         let q = if nearest.len() == 1 {
             target.points[i]
         } else {
@@ -116,15 +114,15 @@ fn coarse_correspondences(
     pairs.clear();
     for s in source.iter().step_by(stride) {
         let p = pose * s;
-        if let Some(i) = target.nearest_one(&p, max_distance) {
-            let n = target.normal(i);
-            if n.is_some() || !target.has_normals() {
-                pairs.push(Pair {
-                    p,
-                    q: target.points[i],
-                    n,
-                });
-            }
+        let Some(i) = target.nearest_one(&p, max_distance) else {
+            continue;
+        };
+        if let Some(n) = target.pairing_normal(i) {
+            pairs.push(Pair {
+                p,
+                q: target.points[i],
+                n,
+            });
         }
     }
 }

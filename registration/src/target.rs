@@ -128,9 +128,15 @@ impl PreparedTarget {
         })
     }
 
-    /// Whether the target was prepared with normals.
-    pub(crate) fn has_normals(&self) -> bool {
-        self.normals.is_some()
+    /// Whether target point `i` may pair, and with which normal: `Some(None)` for a target
+    /// prepared without normals (point-to-point), `Some(Some(n))` for a point with a normal,
+    /// `None` for a point whose neighbourhood is not plane-like (`IcpConfig::min_planarity`).
+    #[allow(clippy::option_option)] // The outer option is "may pair", the inner one the normal.
+    pub(crate) fn pairing_normal(&self, i: usize) -> Option<Option<Vector3<f64>>> {
+        if self.normals.is_none() {
+            return Some(None);
+        }
+        self.normal(i).map(Some)
     }
 
     /// The unit normal of target point `i` (PCA of its nearest neighbours), when the target was
@@ -334,7 +340,6 @@ mod tests {
         }
         let every = PreparedTarget::new(points.clone(), Some((10, 0.0)), 3).unwrap();
         let planes = PreparedTarget::new(points, Some((10, 0.2)), 3).unwrap();
-        assert!(planes.has_normals());
         for i in 0..row {
             let n = planes.normal(i).expect("a floor point has a normal");
             assert!(n.z.abs() > 0.999, "{n:?}");
@@ -343,6 +348,7 @@ mod tests {
         for i in row..row + 20 {
             assert!(every.normal(i).is_some());
             assert_eq!(planes.normal(i), None, "row point {i}");
+            assert_eq!(planes.pairing_normal(i), None, "row point {i}");
         }
     }
 }
