@@ -6,7 +6,7 @@
 //! with ground truth, ATE, drift and loop end-point error; writes the map (PLY, PCD), the
 //! trajectory (TUM), the pose graph (g2o) and the occupancy grid (PNG, ROS map) with `--out`.
 //!
-//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--out DIR]`
+//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR]`
 
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
@@ -19,8 +19,10 @@ use nalgebra::{Translation3, Vector2};
 use posegraph::g2o::{G2oGraph, write_g2o};
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{
-    GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3, quaternion_from_xyzw,
+    EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
+    quaternion_from_xyzw,
 };
+use spot_adapter::AdapterError;
 use spot_adapter::nav::{NavigationMap, NavigatorConfig};
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_slam, scan_context_places, scan_to_scan_registrator, slam_config,
@@ -47,6 +49,15 @@ enum TimeUnitArg {
     SAbsolute,
     /// Nanoseconds on the stamp's clock.
     NsAbsolute,
+}
+
+/// The information of odometry edges, as `--odometry-information` gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum OdometryInformation {
+    /// Fixed 1 cm / 0.2° sigmas.
+    Fixed,
+    /// The fixed sigmas' covariance plus the registration's own.
+    Registration,
 }
 
 /// Graph-SLAM on one simulated lap of a generated building, or on a recording.
@@ -77,7 +88,8 @@ struct Args {
     /// Bags: take the odometry from /tf, from this frame to the body frame.
     #[arg(long, value_name = "FRAME", conflicts_with = "no_odometry")]
     odom_frame: Option<String>,
-    /// Ignore the recording's odometry: LiDAR-only.
+    /// Ignore the odometry (the recording's, or the simulated legs'): LiDAR-only, scan-to-scan
+    /// odometry with a constant-velocity guess.
     #[arg(long)]
     no_odometry: bool,
     /// Bags: the body frame (default: the odometry's child frame).
@@ -117,8 +129,28 @@ struct Args {
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
     registration: Registration,
     /// Simulate scans cast while walking (motion distortion, 12 cm per sweep).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "recording")]
     skewed: bool,
+    /// Simulate a blank north corridor: plain walls and shut doors, where LiDAR odometry has
+    /// little to hold on to along the corridor.
+    #[arg(long, conflicts_with = "recording")]
+    blank_corridor: bool,
+    /// The simulated LiDAR's largest range (metres; default 100).
+    #[arg(
+        long,
+        value_name = "M",
+        conflicts_with = "recording",
+        allow_negative_numbers = true
+    )]
+    lidar_range: Option<f64>,
+    /// How stiff the odometry edges are: fixed sigmas (the default), or fixed sigmas softened
+    /// where the registration was weak (see `EdgeInformation::FixedAndRegistration`).
+    #[arg(long, value_enum, value_name = "KIND", default_value_t = OdometryInformation::Fixed)]
+    odometry_information: OdometryInformation,
+    /// The drift a loop may correct, as a fraction of the distance walked between its two
+    /// keyframes (default 0.02; raise it for a front end that drifts more).
+    #[arg(long, value_name = "RATE", allow_negative_numbers = true)]
+    loop_drift_rate: Option<f64>,
     /// Turn off the engine's deskewing of scans with per-point times.
     #[arg(long)]
     no_deskew: bool,
@@ -189,6 +221,16 @@ fn slam(args: &Args) -> Result<()> {
     if args.no_deskew {
         config.deskew = false;
     }
+    if let Some(rate) = args.loop_drift_rate {
+        config.loop_max_drift_rate = rate;
+    }
+    if args.odometry_information == OdometryInformation::Registration {
+        config.odometry_information = EdgeInformation::FixedAndRegistration {
+            translation_sigma: 0.01,
+            rotation_sigma: 0.2f64.to_radians(),
+            scale: 1.0,
+        };
+    }
     if let Some(path) = &args.recording {
         let source = open_recording(path, &source_config(args))?;
         out!("{}", source.description)?;
@@ -224,11 +266,27 @@ fn slam(args: &Args) -> Result<()> {
     } else {
         let mut sim_config = SimulationConfig::with_seed(args.seed);
         sim_config.motion_distortion = args.skewed;
+        sim_config.building.blank_corridor = args.blank_corridor;
+        if let Some(range) = args.lidar_range {
+            sim_config.lidar.max_range = range;
+        }
         let sim = SimulatedSpot::corridor_loop(&sim_config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
-        let samples = sim.map(Ok::<Sample, Infallible>);
-        backend(args, config, samples, body_t_lidar, Some(&truth))
+        if args.no_odometry {
+            out!(
+                "odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess"
+            )?;
+            let samples = ScanToScanOdometry::new(
+                scan_to_scan_registrator(),
+                sim.map(Ok::<Sample, AdapterError>),
+                ScanToScanConfig::default(),
+            );
+            backend(args, config, samples, body_t_lidar, Some(&truth))
+        } else {
+            let samples = sim.map(Ok::<Sample, Infallible>);
+            backend(args, config, samples, body_t_lidar, Some(&truth))
+        }
     }
 }
 

@@ -90,6 +90,11 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--registration",
             "--skewed",
             "--no-deskew",
+            "--no-odometry",
+            "--blank-corridor",
+            "--lidar-range",
+            "--odometry-information",
+            "--loop-drift-rate",
             "--out",
         ],
     ),
@@ -225,6 +230,39 @@ fn simulate_rejects_a_malformed_seed() {
 #[test]
 fn slam_rejects_a_malformed_seed() {
     rejected("slam", &["--seed", "1.5"], "--seed");
+}
+
+#[test]
+fn slam_refuses_simulator_options_with_a_recording() {
+    rejected("slam", &["scans", "--blank-corridor"], "--blank-corridor");
+    rejected("slam", &["scans", "--lidar-range", "25"], "--lidar-range");
+}
+
+/// `slam args` fails as a job (status 1, one line) naming `setting`, before it maps anything.
+fn slam_fails_naming(args: &[&str], setting: &str) {
+    let out = run("slam", args);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains(setting),
+        "{args:?} does not name {setting}: {stderr}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?} mapped: {}",
+        text(&out.stdout)
+    );
+}
+
+#[test]
+fn slam_refuses_a_bad_lidar_range_or_drift_rate() {
+    for range in ["-5", "0", "nan", "inf"] {
+        slam_fails_naming(&["--lidar-range", range], "max_range");
+    }
+    for rate in ["-1", "nan"] {
+        slam_fails_naming(&["--loop-drift-rate", rate], "loop_max_drift_rate");
+    }
 }
 
 #[test]
