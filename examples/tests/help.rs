@@ -236,6 +236,7 @@ fn slam_rejects_a_malformed_seed() {
 fn slam_refuses_simulator_options_with_a_recording() {
     rejected("slam", &["scans", "--blank-corridor"], "--blank-corridor");
     rejected("slam", &["scans", "--lidar-range", "25"], "--lidar-range");
+    rejected("slam", &["scans", "--skewed"], "--skewed");
 }
 
 /// `slam args` fails as a job (status 1, one line) naming `setting`, before it maps anything.
