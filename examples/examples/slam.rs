@@ -17,6 +17,7 @@ use clap::{Parser, ValueEnum};
 use gridmap::{UnknownCells, inflate};
 use nalgebra::{Translation3, Vector2};
 use posegraph::g2o::{G2oGraph, write_g2o};
+use registration::PointToPlaneIcp;
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{
     EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
@@ -224,10 +225,18 @@ fn slam(args: &Args) -> Result<()> {
     if let Some(rate) = args.loop_drift_rate {
         config.loop_max_drift_rate = rate;
     }
-    if args.odometry_information == OdometryInformation::Registration {
+    // The engine's own fixed sigmas, with the registration's covariance added to them.
+    if let (
+        OdometryInformation::Registration,
+        EdgeInformation::Fixed {
+            translation_sigma,
+            rotation_sigma,
+        },
+    ) = (args.odometry_information, config.odometry_information)
+    {
         config.odometry_information = EdgeInformation::FixedAndRegistration {
-            translation_sigma: 0.01,
-            rotation_sigma: 0.2f64.to_radians(),
+            translation_sigma,
+            rotation_sigma,
             scale: 1.0,
         };
     }
@@ -237,14 +246,7 @@ fn slam(args: &Args) -> Result<()> {
         let samples: Box<dyn SampleSource> = if source.has_odometry && !args.no_odometry {
             source.samples
         } else {
-            out!(
-                "odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess"
-            )?;
-            Box::new(ScanToScanOdometry::new(
-                scan_to_scan_registrator(),
-                source.samples,
-                ScanToScanConfig::default(),
-            ))
+            Box::new(lidar_only(source.samples)?)
         };
         // Reading (and a LiDAR-only source's scan-to-scan registration) runs on a thread of
         // its own, a few scans ahead of the engine.
@@ -274,20 +276,27 @@ fn slam(args: &Args) -> Result<()> {
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
         if args.no_odometry {
-            out!(
-                "odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess"
-            )?;
-            let samples = ScanToScanOdometry::new(
-                scan_to_scan_registrator(),
-                sim.map(Ok::<Sample, AdapterError>),
-                ScanToScanConfig::default(),
-            );
+            let samples = lidar_only(sim.map(Ok::<Sample, AdapterError>))?;
             backend(args, config, samples, body_t_lidar, Some(&truth))
         } else {
             let samples = sim.map(Ok::<Sample, Infallible>);
             backend(args, config, samples, body_t_lidar, Some(&truth))
         }
     }
+}
+
+/// `samples` with their odometry replaced by scan-to-scan registration (LiDAR-only), said on
+/// stdout.
+fn lidar_only<I>(samples: I) -> Result<ScanToScanOdometry<PointToPlaneIcp, I>>
+where
+    I: Iterator<Item = Result<Sample, AdapterError>>,
+{
+    out!("odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess")?;
+    Ok(ScanToScanOdometry::new(
+        scan_to_scan_registrator(),
+        samples,
+        ScanToScanConfig::default(),
+    ))
 }
 
 /// The engine `--registration` chooses, run on `samples`.
