@@ -89,7 +89,7 @@ fn row(laps: &[Lap], sim: &SimulatedSpot) -> Result<String, String> {
         100.0 * e.loop_end_point_error,
         e.segments
             .map_or_else(|| "-".into(), |s| format!("{:.3} %", 100.0 * s.translation)),
-        report.odometry_fallbacks,
+        report.fallbacks(),
         times(report),
         times(&best),
         loop_max(report),

@@ -142,7 +142,14 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
     let samples = sim.map(Ok::<_, std::convert::Infallible>);
-    let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, Some(&truth), "mapping")?;
+    let mapping = map_and_evaluate(
+        &mut slam,
+        samples,
+        &body_t_lidar,
+        Some(&truth),
+        "mapping",
+        false,
+    )?;
     let e = mapping.evaluation.context("the lap has a ground truth")?;
     let report = slam.report();
     out!(

@@ -17,20 +17,16 @@ use clap::{Parser, ValueEnum};
 use gridmap::{UnknownCells, inflate};
 use nalgebra::{Translation3, Vector2};
 use posegraph::g2o::{G2oGraph, write_g2o};
-use registration::PointToPlaneIcp;
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{
     EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
     quaternion_from_xyzw,
 };
-use spot_adapter::AdapterError;
 use spot_adapter::nav::{NavigationMap, NavigatorConfig};
-use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_slam, scan_context_places, scan_to_scan_registrator, slam_config,
-};
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::record::{
     BagConfig, OdometrySource, PointCloud2Config, ReadAhead, ReturnFilter, SampleSource,
-    ScanToScanConfig, ScanToScanOdometry, SourceConfig, TimeUnit, open_recording,
+    SourceConfig, TimeUnit, open_recording,
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -66,8 +62,8 @@ enum OdometryInformation {
 /// PATH is a ROS 1 bag (.bag), a ROS 2 bag (.mcap, or its folder with metadata.yaml), a KITTI
 /// sequence (velodyne/*.bin, times.txt, calib.txt, poses.txt as ground truth), a folder of PCD
 /// or PLY scans (names that are numbers are stamps), or a spot-nav recording (index.txt). What
-/// it holds is printed first. A recording without odometry runs LiDAR-only (scan-to-scan
-/// odometry with a constant-velocity guess). Prints scans, keyframes, loop closures, per-scan
+/// it holds is printed first. A recording without odometry runs LiDAR-only (every scan
+/// registered against the local map from a constant-velocity guess). Prints scans, keyframes, loop closures, per-scan
 /// times and, when the ground truth is known, ATE, drift and loop end-point error. With `--out`
 /// it writes the map (`map.ply`, `map.pcd`), the body trajectory (`trajectory.tum`), the pose
 /// graph (`graph.g2o`) and the occupancy grid (`grid.png`, `map.yaml` + `map.pgm`), all after
@@ -89,8 +85,8 @@ struct Args {
     /// Bags: take the odometry from /tf, from this frame to the body frame.
     #[arg(long, value_name = "FRAME", conflicts_with = "no_odometry")]
     odom_frame: Option<String>,
-    /// Ignore the odometry (the recording's, or the simulated legs'): LiDAR-only, scan-to-scan
-    /// odometry with a constant-velocity guess.
+    /// Ignore the odometry (the recording's, or the simulated legs'): LiDAR-only, every scan
+    /// registered against the local map from a constant-velocity guess.
     #[arg(long)]
     no_odometry: bool,
     /// Bags: the body frame (default: the odometry's child frame).
@@ -243,13 +239,12 @@ fn slam(args: &Args) -> Result<()> {
     if let Some(path) = &args.recording {
         let source = open_recording(path, &source_config(args))?;
         out!("{}", source.description)?;
-        let samples: Box<dyn SampleSource> = if source.has_odometry && !args.no_odometry {
-            source.samples
-        } else {
-            Box::new(lidar_only(source.samples)?)
-        };
-        // Reading (and a LiDAR-only source's scan-to-scan registration) runs on a thread of
-        // its own, a few scans ahead of the engine.
+        let lidar_only = !source.has_odometry || args.no_odometry;
+        if lidar_only {
+            out!("odometry    none: LiDAR-only, every scan registered against the local map")?;
+        }
+        let samples = source.samples;
+        // Reading runs on a thread of its own, a few scans ahead of the engine.
         let mut samples = ReadAhead::new(samples, READ_AHEAD);
         backend(
             args,
@@ -257,6 +252,7 @@ fn slam(args: &Args) -> Result<()> {
             &mut samples,
             source.body_t_lidar,
             source.ground_truth.as_deref(),
+            lidar_only,
         )?;
         let dropped = samples.dropped_points();
         out!(
@@ -276,27 +272,18 @@ fn slam(args: &Args) -> Result<()> {
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
         if args.no_odometry {
-            let samples = lidar_only(sim.map(Ok::<Sample, AdapterError>))?;
-            backend(args, config, samples, body_t_lidar, Some(&truth))
-        } else {
-            let samples = sim.map(Ok::<Sample, Infallible>);
-            backend(args, config, samples, body_t_lidar, Some(&truth))
+            out!("odometry    none: LiDAR-only, every scan registered against the local map")?;
         }
+        let samples = sim.map(Ok::<Sample, Infallible>);
+        backend(
+            args,
+            config,
+            samples,
+            body_t_lidar,
+            Some(&truth),
+            args.no_odometry,
+        )
     }
-}
-
-/// `samples` with their odometry replaced by scan-to-scan registration (LiDAR-only), said on
-/// stdout.
-fn lidar_only<I>(samples: I) -> Result<ScanToScanOdometry<PointToPlaneIcp, I>>
-where
-    I: Iterator<Item = Result<Sample, AdapterError>>,
-{
-    out!("odometry    none: LiDAR-only, scan-to-scan odometry with a constant-velocity guess")?;
-    Ok(ScanToScanOdometry::new(
-        scan_to_scan_registrator(),
-        samples,
-        ScanToScanConfig::default(),
-    ))
 }
 
 /// The engine `--registration` chooses, run on `samples`.
@@ -306,6 +293,7 @@ fn backend<I, E>(
     samples: I,
     body_t_lidar: Pose3,
     truth: Option<&[StampedPose]>,
+    lidar_only: bool,
 ) -> Result<()>
 where
     I: ExactSizeIterator<Item = Result<Sample, E>>,
@@ -322,7 +310,8 @@ where
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
-            let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
+            let mapping =
+                map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label, lidar_only)?;
             report(&slam, &mapping, args)
         }
         Registration::Loam => {
@@ -330,7 +319,8 @@ where
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
-            let mapping = map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label)?;
+            let mapping =
+                map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label, lidar_only)?;
             report(&slam, &mapping, args)
         }
     }
@@ -361,7 +351,7 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         report.place_loops_closed,
         report.loops_beyond_drift,
         report.loops_weighted_out,
-        report.odometry_fallbacks,
+        report.fallbacks(),
         report.odometry_faults
     )?;
     let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);

@@ -24,7 +24,8 @@ pub struct Mapping {
 }
 
 /// Feeds every sample to `slam` (progress labelled `label` on stderr, a line for each skipped
-/// scan), then evaluates the body trajectory (`body_t_lidar`: the LiDAR mounting) against `truth`
+/// scan; with `lidar_only` without their odometry, so that the engine tracks the scans by
+/// registration alone), then evaluates the body trajectory (`body_t_lidar`: the LiDAR mounting) against `truth`
 /// (`world_T_body`) when given.
 ///
 /// # Errors
@@ -36,6 +37,7 @@ pub fn map_and_evaluate<R, C, O, I, E>(
     body_t_lidar: &Pose3,
     truth: Option<&[StampedPose]>,
     label: &str,
+    lidar_only: bool,
 ) -> Result<Mapping>
 where
     R: MapRegistrator,
@@ -48,7 +50,12 @@ where
     let started = Instant::now();
     for (n, sample) in (1u64..).zip(samples) {
         let sample = sample.map_err(Into::into)?;
-        if let ScanOutcome::Skipped(reason) = slam.process(&sample.scan_input()) {
+        let input = if lidar_only {
+            sample.lidar_only_input()
+        } else {
+            sample.scan_input()
+        };
+        if let ScanOutcome::Skipped(reason) = slam.process(&input) {
             progress.note(&format!("scan {n} skipped: {reason:?}"));
         }
         progress.update(

@@ -92,6 +92,36 @@ impl Default for IcpConfig {
 }
 
 impl IcpConfig {
+    /// These settings with the correspondence reach and the kernel's threshold of `reach` (a
+    /// kernel without a threshold stays as it is).
+    ///
+    /// # Errors
+    /// [`RegistrationError::InvalidConfig`] for a `reach` that is not finite and positive.
+    pub fn within(&self, reach: &slam_core::Reach) -> Result<Self, RegistrationError> {
+        check(
+            reach.distance.is_finite() && reach.distance > 0.0,
+            "Reach::distance",
+            reach.distance,
+            POSITIVE,
+        )?;
+        check(
+            reach.kernel.is_finite() && reach.kernel > 0.0,
+            "Reach::kernel",
+            reach.kernel,
+            POSITIVE,
+        )?;
+        let kernel = match self.kernel {
+            IcpKernel::None => IcpKernel::None,
+            IcpKernel::Huber { .. } => IcpKernel::Huber { k: reach.kernel },
+            IcpKernel::Tukey { .. } => IcpKernel::Tukey { k: reach.kernel },
+        };
+        Ok(Self {
+            max_correspondence_distance: reach.distance,
+            kernel,
+            ..*self
+        })
+    }
+
     /// Checks every setting: voxels finite and not negative; reach, kernel threshold and
     /// tolerances finite and positive (tolerances and the degeneracy threshold may be 0);
     /// `min_planarity` 0 to 1; at least one iteration, 3 normal neighbours, one correspondence;

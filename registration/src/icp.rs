@@ -240,6 +240,8 @@ pub(crate) fn align<S: IcpStep>(
             break;
         }
     }
+    // Composed step after step from the caller's guess: keep the quaternion unit.
+    pose.rotation.renormalize();
     // Report at the final pose.
     correspondences(source, target, &pose, &mut cache, &mut pairs);
     if pairs.len() < config.min_correspondences {

@@ -4,8 +4,8 @@
 
 use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator,
-    pose3_is_finite, se3_exp,
+    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError,
+    Registrator, pose3_is_finite, se3_exp,
 };
 
 use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
@@ -435,82 +435,116 @@ impl Registrator for LoamRegistrator {
         target: &Self::Target,
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError> {
-        let config = &self.config;
-        config.validate()?;
-        if !pose3_is_finite(initial) {
-            return Err(RegistrationError::NonFiniteInitialGuess);
+        align_loam(&self.config, source, target, initial)
+    }
+
+    /// The reach widens the neighbour search (its farthest neighbour within `reach.distance`
+    /// instead of [`LoamConfig::max_neighbour_distance`], if larger) and starts the Tukey
+    /// threshold at `reach.kernel`; the final threshold stays [`LoamConfig::tukey_threshold`].
+    fn align_within(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        if !reach.is_valid() {
+            return Err(RegistrationError::InvalidConfig {
+                setting: "Reach::distance",
+                value: reach.distance.min(reach.kernel),
+                expected: "finite and positive, with a finite and positive kernel",
+            });
         }
-        let mut matcher = Matcher::new(config, target, source);
-        let mut pose = *initial;
-        let mut k = config.initial_tukey_threshold.max(config.tukey_threshold);
-        let (mut converged, mut iterations) = (false, 0);
-        let mut pairs = Vec::new();
-        // The pose the correspondences were found at: lines and planes are refitted only when
-        // the pose has moved since by more than `rematch_motion`.
-        let mut matched_at: Option<Pose3> = None;
-        let too_few = |found| RegistrationError::TooFewCorrespondences {
-            found,
-            required: config.min_correspondences,
+        let config = LoamConfig {
+            max_neighbour_distance: self.config.max_neighbour_distance.max(reach.distance),
+            initial_tukey_threshold: reach.kernel,
+            ..self.config
         };
-        while iterations < config.max_iterations {
-            iterations += 1;
-            if matched_at.is_none_or(|m| motion(&m, &pose) > config.rematch_motion) {
-                matcher.all(source, &pose, &mut pairs);
-                matched_at = Some(pose);
-            }
-            let (h, b, used, _) = normal_equations(&pairs, &pose, k);
-            if used < config.min_correspondences {
-                return Err(too_few(used));
-            }
-            let Some(delta) = h.cholesky().map(|c| -c.solve(&b)) else {
-                return Err(RegistrationError::Degenerate {
-                    cause: Degeneracy::SingularNormalEquations,
-                });
-            };
-            if !delta.iter().all(|v| v.is_finite()) {
-                return Err(RegistrationError::Degenerate {
-                    cause: Degeneracy::NonFiniteUpdate,
-                });
-            }
-            pose = se3_exp(&delta) * pose;
-            let (dt, dr) = (
-                delta.fixed_rows::<3>(0).norm(),
-                delta.fixed_rows::<3>(3).norm(),
-            );
-            // Coarse to fine: a wide threshold pulls the pose in, then it shrinks to the final
-            // one, which alone decides convergence.
-            if k > config.tukey_threshold {
-                if dt < 100.0 * config.translation_tolerance
-                    && dr < 100.0 * config.rotation_tolerance
-                {
-                    k = (k * 0.5).max(config.tukey_threshold);
-                }
-            } else if dt < config.translation_tolerance && dr < config.rotation_tolerance {
-                // The correspondences were found within `rematch_motion` of this pose.
-                converged = true;
-                break;
-            }
-        }
-        // Report at the final pose, on correspondences found near it.
+        align_loam(&config, source, target, initial)
+    }
+}
+
+/// LOAM's alignment with `config`.
+fn align_loam(
+    config: &LoamConfig,
+    source: &LoamFeatures,
+    target: &LoamTarget,
+    initial: &Pose3,
+) -> Result<Alignment, RegistrationError> {
+    config.validate()?;
+    if !pose3_is_finite(initial) {
+        return Err(RegistrationError::NonFiniteInitialGuess);
+    }
+    let mut matcher = Matcher::new(config, target, source);
+    let mut pose = *initial;
+    let mut k = config.initial_tukey_threshold.max(config.tukey_threshold);
+    let (mut converged, mut iterations) = (false, 0);
+    let mut pairs = Vec::new();
+    // The pose the correspondences were found at: lines and planes are refitted only when
+    // the pose has moved since by more than `rematch_motion`.
+    let mut matched_at: Option<Pose3> = None;
+    let too_few = |found| RegistrationError::TooFewCorrespondences {
+        found,
+        required: config.min_correspondences,
+    };
+    while iterations < config.max_iterations {
+        iterations += 1;
         if matched_at.is_none_or(|m| motion(&m, &pose) > config.rematch_motion) {
             matcher.all(source, &pose, &mut pairs);
+            matched_at = Some(pose);
         }
-        let (information, _, inliers, sq) = normal_equations(&pairs, &pose, k);
-        if inliers < config.min_correspondences {
-            return Err(too_few(inliers));
+        let (h, b, used, _) = normal_equations(&pairs, &pose, k);
+        if used < config.min_correspondences {
+            return Err(too_few(used));
         }
-        #[allow(clippy::cast_precision_loss)]
-        Ok(Alignment {
-            pose,
-            converged,
-            iterations,
-            inliers,
-            inlier_ratio: inliers as f64 / source.len().max(1) as f64,
-            rmse: (sq / inliers as f64).sqrt(),
-            min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
-            information,
-        })
+        let Some(delta) = h.cholesky().map(|c| -c.solve(&b)) else {
+            return Err(RegistrationError::Degenerate {
+                cause: Degeneracy::SingularNormalEquations,
+            });
+        };
+        if !delta.iter().all(|v| v.is_finite()) {
+            return Err(RegistrationError::Degenerate {
+                cause: Degeneracy::NonFiniteUpdate,
+            });
+        }
+        pose = se3_exp(&delta) * pose;
+        let (dt, dr) = (
+            delta.fixed_rows::<3>(0).norm(),
+            delta.fixed_rows::<3>(3).norm(),
+        );
+        // Coarse to fine: a wide threshold pulls the pose in, then it shrinks to the final
+        // one, which alone decides convergence.
+        if k > config.tukey_threshold {
+            if dt < 100.0 * config.translation_tolerance && dr < 100.0 * config.rotation_tolerance {
+                k = (k * 0.5).max(config.tukey_threshold);
+            }
+        } else if dt < config.translation_tolerance && dr < config.rotation_tolerance {
+            // The correspondences were found within `rematch_motion` of this pose.
+            converged = true;
+            break;
+        }
     }
+    // Composed step after step from the caller's guess: keep the quaternion unit.
+    pose.rotation.renormalize();
+    // Report at the final pose, on correspondences found near it.
+    if matched_at.is_none_or(|m| motion(&m, &pose) > config.rematch_motion) {
+        matcher.all(source, &pose, &mut pairs);
+    }
+    let (information, _, inliers, sq) = normal_equations(&pairs, &pose, k);
+    if inliers < config.min_correspondences {
+        return Err(too_few(inliers));
+    }
+    #[allow(clippy::cast_precision_loss)]
+    Ok(Alignment {
+        pose,
+        converged,
+        iterations,
+        inliers,
+        inlier_ratio: inliers as f64 / source.len().max(1) as f64,
+        rmse: (sq / inliers as f64).sqrt(),
+        min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
+        information,
+    })
 }
 
 /// How far `b` is from `a`: translation plus rotation seen at 10 m (metres).

@@ -2,7 +2,7 @@
 
 use nalgebra::{Matrix6, Point3, Vector6};
 use slam_core::{
-    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator,
+    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError, Registrator,
 };
 
 use crate::config::IcpConfig;
@@ -92,6 +92,16 @@ impl Registrator for PointToPlaneIcp {
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError> {
         align::<GaussNewtonPlane>(&self.config, 1, source, target, initial)
+    }
+
+    fn align_within(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        align::<GaussNewtonPlane>(&self.config.within(reach)?, 1, source, target, initial)
     }
 }
 

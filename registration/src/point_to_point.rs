@@ -3,8 +3,8 @@
 
 use nalgebra::{Matrix6, Point3, Vector6};
 use slam_core::{
-    Alignment, MapRegistrator, PointCloud, Pose3, RegistrationError, Registrator, WeightedPair,
-    fit_weighted_rigid_transform, se3_log,
+    Alignment, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError, Registrator,
+    WeightedPair, fit_weighted_rigid_transform, se3_log,
 };
 
 use crate::config::IcpConfig;
@@ -73,6 +73,22 @@ impl Registrator for PointToPointIcp {
     ) -> Result<Alignment, RegistrationError> {
         align::<Svd>(
             &self.config,
+            self.config.pair_target_points,
+            source,
+            target,
+            initial,
+        )
+    }
+
+    fn align_within(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        align::<Svd>(
+            &self.config.within(reach)?,
             self.config.pair_target_points,
             source,
             target,

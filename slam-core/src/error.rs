@@ -456,3 +456,21 @@ pub struct InvalidSlamConfig {
     /// The valid range, in words.
     pub expected: &'static str,
 }
+
+/// [`InvalidSlamConfig`] for `setting` unless `ok`.
+pub(crate) fn check_slam(
+    ok: bool,
+    setting: &'static str,
+    value: f64,
+    expected: &'static str,
+) -> Result<(), InvalidSlamConfig> {
+    if ok {
+        Ok(())
+    } else {
+        Err(InvalidSlamConfig {
+            setting,
+            value,
+            expected,
+        })
+    }
+}

@@ -40,6 +40,7 @@ pub mod io;
 pub mod pose_graph;
 pub mod robust_kernel;
 pub mod slam;
+pub mod tracking;
 pub mod traits;
 mod voxel;
 
@@ -59,4 +60,4 @@ pub use slam::{
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
-pub use traits::registrator::{Alignment, MapRegistrator, Registrator};
+pub use traits::registrator::{Alignment, MapRegistrator, Reach, Registrator};

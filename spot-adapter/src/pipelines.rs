@@ -109,22 +109,6 @@ pub fn point_to_plane_localiser() -> PointToPlaneIcp {
     icp
 }
 
-/// Point-to-plane ICP for scan-to-scan odometry of a source without any
-/// ([`ScanToScanOdometry`](crate::record::ScanToScanOdometry)): from a constant-velocity guess
-/// a few centimetres off, Tukey 20 cm, pairs within 1 m, plane-like target neighbourhoods only
-/// ([`PLANE_LIKE`]).
-#[must_use]
-pub fn scan_to_scan_registrator() -> PointToPlaneIcp {
-    PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.2 },
-            min_planarity: PLANE_LIKE,
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    }
-}
-
 /// Point-to-plane odometry ([`point_to_plane_tracker`]) against the local map, and
 /// point-to-plane loop refinement (Tukey 10 cm, pairs within 1 m), with `config` (usually
 /// [`slam_config`]).

@@ -1,7 +1,9 @@
 //! Settings of the Graph-SLAM engine, with the thesis' values as defaults.
 
 use crate::error::InvalidSlamConfig;
+use crate::error::check_slam as check;
 use crate::robust_kernel::RobustKernel;
+use crate::tracking::TrackerConfig;
 
 /// How an edge's information matrix is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,16 +48,14 @@ pub struct GraphSlamConfig {
     pub keyframe_rotation: f64,
     /// Keyframes in the local map that scans are registered against (thesis: n = 40).
     pub local_map_keyframes: usize,
-    /// A registration result that moves the predicted pose by more than this (metres) is
-    /// rejected and the odometry prediction kept instead (a diverged alignment).
-    pub max_odometry_correction: f64,
-    /// An odometry step that ends further than this (metres) from the constant-velocity
-    /// extrapolation of the last two scans is suspect (a jump, a reset): the keyframe is then
-    /// registered from both guesses and the better fit kept; when the extrapolation's wins the
-    /// odometry step is counted as a fault ([`SlamReport::odometry_faults`](super::SlamReport)).
-    /// Default 0.5 m: a walking robot's step between scans differs from the last one by
-    /// centimetres.
-    pub odometry_fault_distance: f64,
+    /// How keyframes (and, without odometry, every scan) are registered against the local
+    /// map: the adaptive reach, the checks a registration must pass, and the retries. An
+    /// odometry step that ends further than [`TrackerConfig::arbitration_distance`] (0.5 m) from
+    /// the constant-velocity extrapolation of the last two scans is suspect (a jump, a reset):
+    /// the keyframe is then registered from both guesses and the better fit kept; when the
+    /// extrapolation's wins the step is counted as a fault
+    /// ([`SlamReport::odometry_faults`](super::SlamReport)).
+    pub tracker: TrackerConfig,
     /// Loop candidates lie within this distance of the new keyframe (thesis: 0.5 m).
     pub loop_search_radius: f64,
     /// The loop target is made of the candidate and this many keyframes on each side (thesis: 20).
@@ -114,8 +114,7 @@ impl Default for GraphSlamConfig {
             keyframe_distance: 0.20,
             keyframe_rotation: 10f64.to_radians(),
             local_map_keyframes: 40,
-            max_odometry_correction: 0.5,
-            odometry_fault_distance: 0.5,
+            tracker: TrackerConfig::default(),
             loop_search_radius: 0.5,
             loop_neighbours: 20,
             loop_max_mean_squared_error: 0.01,
@@ -133,24 +132,6 @@ impl Default for GraphSlamConfig {
             deskew: true,
             inline_loop_closure: true,
         }
-    }
-}
-
-/// [`InvalidSlamConfig`] for `setting` unless `ok`.
-fn check(
-    ok: bool,
-    setting: &'static str,
-    value: f64,
-    expected: &'static str,
-) -> Result<(), InvalidSlamConfig> {
-    if ok {
-        Ok(())
-    } else {
-        Err(InvalidSlamConfig {
-            setting,
-            value,
-            expected,
-        })
     }
 }
 
@@ -243,22 +224,13 @@ impl GraphSlamConfig {
                 "finite and not negative",
             )?;
         }
-        for (setting, v) in [
-            (
-                "GraphSlamConfig::max_odometry_correction",
-                self.max_odometry_correction,
-            ),
-            (
-                "GraphSlamConfig::odometry_fault_distance",
-                self.odometry_fault_distance,
-            ),
-            (
-                "GraphSlamConfig::map_voxel_size",
-                f64::from(self.map_voxel_size),
-            ),
-        ] {
-            check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
-        }
+        let voxel = f64::from(self.map_voxel_size);
+        check(
+            voxel.is_finite() && voxel > 0.0,
+            "GraphSlamConfig::map_voxel_size",
+            voxel,
+            "finite and positive",
+        )?;
         check(
             self.local_map_keyframes >= 1,
             "GraphSlamConfig::local_map_keyframes",
@@ -277,6 +249,7 @@ impl GraphSlamConfig {
                 "a kernel parameter finite and positive",
             )?;
         }
+        self.tracker.validate()?;
         self.odometry_information.validate(Fields {
             translation_sigma: "GraphSlamConfig::odometry_information::translation_sigma",
             rotation_sigma: "GraphSlamConfig::odometry_information::rotation_sigma",

@@ -14,17 +14,20 @@ use crate::error::{CloudError, InvalidSlamConfig, OptimizeError};
 use crate::geometry::{Pose3, pose3_is_finite, se3_adjoint, se3_exp, se3_log};
 use crate::io::StampedPose;
 use crate::pose_graph::{GraphPose, PoseGraph};
+use crate::tracking::{Tracker, scan_extent};
 use crate::traits::optimizer::Optimizer;
 use crate::traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
-use crate::traits::registrator::{Alignment, MapRegistrator};
+use crate::traits::registrator::MapRegistrator;
 
 /// One LiDAR scan with the robot's odometry at the same instant (the `spot-adapter` sample).
 #[derive(Clone, Copy, Debug)]
 pub struct ScanInput<'a> {
     /// Seconds; must increase from scan to scan.
     pub stamp: f64,
-    /// The robot's odometry: body pose in its odometry frame.
-    pub odom_t_body: Pose3,
+    /// The robot's odometry: body pose in its odometry frame; `None` without odometry
+    /// (LiDAR-only): the engine then registers every scan against its local map from a
+    /// constant-velocity extrapolation of the last two.
+    pub odom_t_body: Option<Pose3>,
     /// The LiDAR's mounting: LiDAR pose in the body frame.
     pub body_t_lidar: Pose3,
     /// Points in the LiDAR frame.
@@ -34,7 +37,8 @@ pub struct ScanInput<'a> {
 /// A keyframe: a node of the graph with what the engine keeps of its scan.
 struct Keyframe<S, C> {
     stamp: f64,
-    odom_t_lidar: Pose3,
+    /// The odometry at the keyframe, `None` for a LiDAR-only scan.
+    odom_t_lidar: Option<Pose3>,
     /// Prepared for the odometry/refinement registrator.
     source: S,
     /// Prepared for the coarse loop registrator.
@@ -44,6 +48,16 @@ struct Keyframe<S, C> {
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     walked: f64,
+}
+
+/// A scan made ready for the odometry.
+struct Prepared<S> {
+    /// Deskewed, finite points (LiDAR frame).
+    cloud: PointCloud,
+    /// Prepared for the odometry registrator.
+    source: S,
+    /// How far the scan reaches ([`scan_extent`]).
+    extent: f64,
 }
 
 /// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the
@@ -93,6 +107,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     loop_coarse: C,
     loop_refine: R,
     optimizer: O,
+    /// Registers keyframes (and, LiDAR-only, every scan) against the local map.
+    tracker: Tracker,
     graph: PoseGraph<Pose3>,
     keyframes: Vec<Keyframe<R::Source, C::Source>>,
     local_map: Option<LocalMap<R::Target>>,
@@ -128,6 +144,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     ) -> Result<Self, InvalidSlamConfig> {
         config.validate()?;
         Ok(Self {
+            tracker: Tracker::new(config.tracker)?,
             config,
             odometry,
             loop_coarse,
@@ -182,6 +199,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     #[must_use]
     pub fn report(&self) -> &SlamReport {
         &self.report
+    }
+
+    /// The odometry's tracker: its reach and health (also in [`SlamReport::tracking`]).
+    #[must_use]
+    pub fn tracker(&self) -> &Tracker {
+        &self.tracker
     }
 
     /// Number of keyframes.
@@ -279,38 +302,68 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if !scan.stamp.is_finite() || scan.stamp <= self.last_stamp {
             return self.skip(SkipReason::OutOfOrderStamp, started);
         }
-        if !pose3_is_finite(&scan.odom_t_body) || !pose3_is_finite(&scan.body_t_lidar) {
+        if scan.odom_t_body.is_some_and(|o| !pose3_is_finite(&o))
+            || !pose3_is_finite(&scan.body_t_lidar)
+        {
             return self.skip(SkipReason::NonFiniteOdometry, started);
         }
-        let odom_t_lidar = scan.odom_t_body * scan.body_t_lidar;
-        // Constant velocity over the sweep, from the odometry since the previous scan.
+        let odom_t_lidar = scan.odom_t_body.map(|o| o * scan.body_t_lidar);
         // Only a sweep whose points have different times is skewed.
-        let swept = scan.cloud.time().is_some_and(|t| {
-            t.iter()
-                .any(|&x| x.to_bits() != t.first().map_or(0, |f| f.to_bits()))
-        });
-        let velocity = self
-            .last_odometry
-            .replace(StampedPose {
-                stamp: scan.stamp,
-                pose: odom_t_lidar,
-            })
-            .and_then(|last| {
-                let dt = scan.stamp - last.stamp;
-                (self.config.deskew && swept && dt > 0.0 && dt <= 1.0)
-                    .then(|| se3_log(&(last.pose.inverse() * odom_t_lidar)) / dt)
+        let swept = self.config.deskew
+            && scan.cloud.time().is_some_and(|t| {
+                t.iter()
+                    .any(|&x| x.to_bits() != t.first().map_or(0, |f| f.to_bits()))
             });
+        // Constant velocity over the sweep, from the odometry since the previous scan.
+        let odometry_velocity = if let Some(now) = odom_t_lidar {
+            self.last_odometry
+                .replace(StampedPose {
+                    stamp: scan.stamp,
+                    pose: now,
+                })
+                .and_then(|last| {
+                    let dt = scan.stamp - last.stamp;
+                    (swept && dt > 0.0 && dt <= 1.0)
+                        .then(|| se3_log(&(last.pose.inverse() * now)) / dt)
+                })
+        } else {
+            self.last_odometry = None;
+            None
+        };
         let Some(last) = self.keyframes.len().checked_sub(1) else {
-            if self.config.deskew && velocity.is_none() && swept {
+            if swept && odom_t_lidar.is_some() && odometry_velocity.is_none() {
                 self.last_stamp = scan.stamp;
                 return self.skip(SkipReason::AwaitingVelocity, started);
             }
-            // The first keyframe defines the map frame: the odometry frame at the first scan.
-            let outcome = self.add_keyframe(scan, velocity, odom_t_lidar, odom_t_lidar, started);
-            return outcome;
+            // The first keyframe defines the map frame: the odometry frame at the first scan,
+            // or without odometry the body frame there.
+            let pose = odom_t_lidar.unwrap_or(scan.body_t_lidar);
+            let prepared = match self.prepare(scan, odometry_velocity, started) {
+                Ok(p) => p,
+                Err(skipped) => return skipped,
+            };
+            return self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, started);
         };
-        let kf = &self.keyframes[last];
-        let delta = kf.odom_t_lidar.inverse() * odom_t_lidar;
+        match (odom_t_lidar, self.keyframes[last].odom_t_lidar) {
+            (Some(now), Some(then)) => {
+                self.odometry_step(scan, now, then, last, odometry_velocity, started)
+            }
+            _ => self.lidar_only_step(scan, odom_t_lidar, last, swept, started),
+        }
+    }
+
+    /// A scan with odometry: predicted from the odometry since the last keyframe; registered
+    /// only once it moved far enough for a new keyframe.
+    fn odometry_step(
+        &mut self,
+        scan: &ScanInput<'_>,
+        odom_t_lidar: Pose3,
+        keyframe_odom_t_lidar: Pose3,
+        last: usize,
+        velocity: Option<Vector6<f64>>,
+        started: Instant,
+    ) -> ScanOutcome {
+        let delta = keyframe_odom_t_lidar.inverse() * odom_t_lidar;
         let predicted = self.keyframe_pose(last) * delta;
         let moved = delta.translation.vector.norm() >= self.config.keyframe_distance
             || delta.rotation.angle() >= self.config.keyframe_rotation;
@@ -322,9 +375,81 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 keyframe_t_lidar: delta,
             });
             self.record_scan_time(started);
-            return ScanOutcome::Tracked;
+            return ScanOutcome::Tracked { registered: false };
         }
-        self.add_keyframe(scan, velocity, odom_t_lidar, predicted, started)
+        let prior = self.motion_prior(scan.stamp);
+        let suspect = prior.is_some_and(|(p, _)| {
+            (p.inverse() * predicted).translation.vector.norm()
+                > self.config.tracker.arbitration_distance
+        });
+        // A suspect odometry step would deskew with its jump as the velocity: take the
+        // extrapolation's instead.
+        let velocity = if suspect {
+            velocity.and(prior.and_then(|(_, v)| v))
+        } else {
+            velocity
+        };
+        let prepared = match self.prepare(scan, velocity, started) {
+            Ok(p) => p,
+            Err(skipped) => return skipped,
+        };
+        // The extrapolation arbitrates only a suspect odometry step, so that clean input runs
+        // exactly as without the check.
+        let mut guesses = vec![predicted];
+        guesses.extend(prior.filter(|_| suspect).map(|(guess, _)| guess));
+        let (pose, reg_info) = self.register(&prepared, &guesses);
+        self.add_keyframe(
+            scan,
+            prepared,
+            Some(odom_t_lidar),
+            pose,
+            reg_info.as_ref(),
+            started,
+        )
+    }
+
+    /// A scan without odometry: registered against the local map from the constant-velocity
+    /// extrapolation, deskewed with that velocity; a keyframe once it moved far enough.
+    fn lidar_only_step(
+        &mut self,
+        scan: &ScanInput<'_>,
+        odom_t_lidar: Option<Pose3>,
+        last: usize,
+        swept: bool,
+        started: Instant,
+    ) -> ScanOutcome {
+        let (predicted, velocity) = self
+            .motion_prior(scan.stamp)
+            .unwrap_or_else(|| (self.keyframe_pose(last), None));
+        let prepared = match self.prepare(scan, velocity.filter(|_| swept), started) {
+            Ok(p) => p,
+            Err(skipped) => return skipped,
+        };
+        let (pose, reg_info) = self.register(&prepared, &[predicted]);
+        let mut delta = self.keyframe_pose(last).inverse() * pose;
+        delta.rotation.renormalize();
+        let moved = delta.translation.vector.norm() >= self.config.keyframe_distance
+            || delta.rotation.angle() >= self.config.keyframe_rotation;
+        if moved || !pose3_is_finite(&delta) {
+            return self.add_keyframe(
+                scan,
+                prepared,
+                odom_t_lidar,
+                pose,
+                reg_info.as_ref(),
+                started,
+            );
+        }
+        self.last_stamp = scan.stamp;
+        self.scan_poses.push(ScanPose {
+            stamp: scan.stamp,
+            keyframe: last,
+            keyframe_t_lidar: delta,
+        });
+        self.record_scan_time(started);
+        ScanOutcome::Tracked {
+            registered: reg_info.is_some(),
+        }
     }
 
     fn information(
@@ -467,35 +592,44 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Ok(())
     }
 
-    /// `source` aligned to the local map from `guess`: the result if it converged to a finite
-    /// pose within [`GraphSlamConfig::max_odometry_correction`] of the guess.
-    fn register(&self, source: &R::Source, guess: &Pose3) -> Option<Alignment> {
-        let map = self.local_map.as_ref()?;
-        let a = self.odometry.align(source, &map.target, guess).ok()?;
-        let shift = (a.pose.translation.vector - guess.translation.vector).norm();
-        (a.converged && pose3_is_finite(&a.pose) && shift <= self.config.max_odometry_correction)
-            .then_some(a)
-    }
-
-    /// Whether the registration from the motion prior (`prior`) contradicts the one from the
-    /// odometry's guess (`odometry`) and fits better: they ended further apart than
-    /// [`GraphSlamConfig::odometry_fault_distance`] and `prior` has the larger inlier ratio (the
-    /// lower RMS error on a tie). Two registrations that end together do not contradict the
-    /// odometry, whichever scored higher.
-    fn contradicts(&self, prior: &Alignment, odometry: &Alignment) -> bool {
-        let apart = (prior.pose.translation.vector - odometry.pose.translation.vector).norm();
-        let better = match prior.inlier_ratio.total_cmp(&odometry.inlier_ratio) {
-            std::cmp::Ordering::Greater => true,
-            std::cmp::Ordering::Equal => prior.rmse < odometry.rmse,
-            std::cmp::Ordering::Less => false,
-        };
-        apart > self.config.odometry_fault_distance && better
+    /// The pose of a scan and its registration's information: registered against the local
+    /// map from `guesses` (the prediction first) by the tracker; the prediction, counted as a
+    /// fallback, when it cannot be (no map, or the registration is not taken). An alternative
+    /// guess that wins counts as an odometry fault.
+    fn register(
+        &mut self,
+        prepared: &Prepared<R::Source>,
+        guesses: &[Pose3],
+    ) -> (Pose3, Option<Matrix6<f64>>) {
+        let has_map = self.ensure_local_map();
+        let target = self
+            .local_map
+            .as_ref()
+            .filter(|_| has_map)
+            .map(|m| &m.target);
+        let outcome = self.tracker.track(
+            &self.odometry,
+            &prepared.source,
+            target,
+            guesses,
+            prepared.extent,
+        );
+        self.report.tracking = *self.tracker.health();
+        if outcome.tracked() && outcome.guess > 0 {
+            self.report.odometry_faults += 1;
+        }
+        // Scan poses are chained on each other without odometry: keep their quaternions unit,
+        // or rounding compounds scan after scan.
+        let mut pose = outcome.pose;
+        pose.rotation.renormalize();
+        (pose, outcome.alignment.map(|a| a.information))
     }
 
     /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted
     /// scans, with that velocity (LiDAR-frame twist per second); the last scan's pose held, and
     /// no velocity, when there is only one or the scans are more than a second apart. `None`
-    /// before the first scan.
+    /// before the first scan. Read from the scans' keyframes, so a loop closure that moved them
+    /// moves the extrapolation too.
     fn motion_prior(&self, stamp: f64) -> Option<(Pose3, Option<Vector6<f64>>)> {
         let at = |s: &ScanPose| self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar;
         let (last, earlier) = self.scan_poses.split_last()?;
@@ -510,75 +644,61 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Some((pose, velocity))
     }
 
-    /// The pose of a new keyframe (`source`) and its registration's information: registered
-    /// from the odometry's `predicted` pose, and from `prior` too when given (a suspect odometry
-    /// step), the better fit kept when they disagree; `predicted` when neither registers.
-    /// Counts fallbacks and odometry faults.
-    fn register_keyframe(
-        &mut self,
-        source: &R::Source,
-        predicted: Pose3,
-        prior: Option<Pose3>,
-    ) -> (Pose3, Option<Matrix6<f64>>) {
-        let from_odometry = self.register(source, &predicted);
-        let from_prior = prior.and_then(|guess| self.register(source, &guess));
-        let (chosen, fault) = match (from_odometry, from_prior) {
-            (Some(o), Some(p)) => {
-                if self.contradicts(&p, &o) {
-                    (Some(p), true)
-                } else {
-                    (Some(o), false)
-                }
-            }
-            (None, Some(p)) => (Some(p), true),
-            (o, None) => (o, false),
-        };
-        if fault {
-            self.report.odometry_faults += 1;
-        }
-        if let Some(a) = chosen {
-            (a.pose, Some(a.information))
-        } else {
-            self.report.odometry_fallbacks += 1;
-            (predicted, None)
-        }
-    }
-
-    fn add_keyframe(
+    /// A scan made ready: deskewed with `velocity` (when given), non-finite points dropped,
+    /// prepared for the odometry; the skip outcome (counted) when too few points are left or
+    /// the registrator refuses it.
+    fn prepare(
         &mut self,
         scan: &ScanInput<'_>,
         velocity: Option<Vector6<f64>>,
-        odom_t_lidar: Pose3,
-        predicted: Pose3,
         started: Instant,
-    ) -> ScanOutcome {
-        let prior = self.motion_prior(scan.stamp);
-        let suspect = prior.is_some_and(|(p, _)| {
-            (p.inverse() * predicted).translation.vector.norm()
-                > self.config.odometry_fault_distance
-        });
-        // A suspect odometry step would deskew with its jump as the velocity: take the
-        // extrapolation's instead.
-        let velocity = if suspect {
-            velocity.and(prior.and_then(|(_, v)| v))
-        } else {
-            velocity
-        };
+    ) -> Result<Prepared<R::Source>, ScanOutcome> {
         let mut cloud = velocity
             .and_then(|v| deskew(scan.cloud, &v))
             .unwrap_or_else(|| scan.cloud.clone());
         let dropped = cloud.remove_non_finite();
         if cloud.len() < self.config.min_scan_points {
-            return self.skip(SkipReason::TooFewPoints, started);
+            return Err(self.skip(SkipReason::TooFewPoints, started));
         }
+        let Ok(source) = self.odometry.prepare_source(&cloud) else {
+            return Err(self.skip(SkipReason::PreparationFailed, started));
+        };
         self.report.dropped_points += dropped;
-        let (Ok(source), Ok(coarse)) = (
-            self.odometry.prepare_source(&cloud),
-            self.loop_coarse.prepare_source(&cloud),
-        ) else {
+        Ok(Prepared {
+            extent: scan_extent(&cloud),
+            cloud,
+            source,
+        })
+    }
+
+    /// Adds `prepared` as a keyframe at `pose` (with the registration's information `reg_info`
+    /// for its odometry edge), queues its loop candidate and runs a loop-closure step when
+    /// inline.
+    fn add_keyframe(
+        &mut self,
+        scan: &ScanInput<'_>,
+        prepared: Prepared<R::Source>,
+        odom_t_lidar: Option<Pose3>,
+        pose: Pose3,
+        reg_info: Option<&Matrix6<f64>>,
+        started: Instant,
+    ) -> ScanOutcome {
+        let Prepared { cloud, source, .. } = prepared;
+        let Ok(coarse) = self.loop_coarse.prepare_source(&cloud) else {
             return self.skip(SkipReason::PreparationFailed, started);
         };
         let index = self.keyframes.len();
+        let id = index as u64;
+        let edge = if index == 0 {
+            None
+        } else {
+            let step = self.keyframe_pose(index - 1).inverse() * pose;
+            let info = Self::information(self.config.odometry_information, reg_info, &pose);
+            Some((step, info))
+        };
+        if self.insert_node(id, pose, edge.as_ref()).is_err() {
+            return self.skip(SkipReason::NonFinitePose, started);
+        }
         // Appearance first (before this keyframe joins the recognizer); a scan the recognizer
         // refuses is counted, and the keyframe goes on without a place match.
         let look_alikes = match self
@@ -596,28 +716,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let map_cloud = cloud
             .voxel_downsample(self.config.map_voxel_size)
             .unwrap_or(cloud);
-
-        // The extrapolation arbitrates only a suspect odometry step, so that clean input runs
-        // exactly as without the check.
-        let (pose, reg_info) = if index > 0 && self.ensure_local_map() {
-            let arbiter = prior.filter(|_| suspect).map(|(guess, _)| guess);
-            self.register_keyframe(&source, predicted, arbiter)
-        } else {
-            (predicted, None)
-        };
-
-        let id = index as u64;
-        let edge = if index == 0 {
-            None
-        } else {
-            let step = self.keyframe_pose(index - 1).inverse() * pose;
-            let info =
-                Self::information(self.config.odometry_information, reg_info.as_ref(), &pose);
-            Some((step, info))
-        };
-        if self.insert_node(id, pose, edge.as_ref()).is_err() {
-            return self.skip(SkipReason::NonFinitePose, started);
-        }
         let walked = match index {
             0 => 0.0,
             _ => {

@@ -5,7 +5,7 @@
 //! has moved [`GraphSlamConfig::keyframe_distance`] from the last keyframe, register the scan
 //! against a local map of the last [`GraphSlamConfig::local_map_keyframes`] keyframes and add a
 //! node. An odometry step far from the constant-velocity extrapolation of the last two scans
-//! ([`GraphSlamConfig::odometry_fault_distance`]) is registered from both guesses and the better
+//! ([`TrackerConfig::arbitration_distance`](crate::tracking::TrackerConfig::arbitration_distance)) is registered from both guesses and the better
 //! fit kept; [`SlamReport::odometry_faults`] counts the steps it overruled. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
 //! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
 //! optimises the graph. Keyframe scans with a per-point `time` channel are deskewed first, with

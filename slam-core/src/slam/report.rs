@@ -22,6 +22,8 @@ pub enum SkipReason {
     NonFinitePose,
 }
 
+use crate::tracking::TrackingHealth;
+
 /// What happened to one scan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ScanOutcome {
@@ -32,8 +34,13 @@ pub enum ScanOutcome {
         /// Whether the registration was used (false: the odometry prediction was kept).
         registered: bool,
     },
-    /// Not far enough from the last keyframe: the pose was predicted from odometry.
-    Tracked,
+    /// Not far enough from the last keyframe for a new one: the pose rides on the last
+    /// keyframe.
+    Tracked {
+        /// Whether the scan was registered (without odometry; false: the odometry's or the
+        /// constant-velocity prediction was kept).
+        registered: bool,
+    },
     /// The scan was skipped.
     Skipped(SkipReason),
 }
@@ -81,10 +88,11 @@ pub struct SlamReport {
     pub skipped_awaiting_velocity: usize,
     /// Non-finite points dropped from otherwise usable scans.
     pub dropped_points: usize,
-    /// Keyframes where the registration was rejected and odometry kept.
-    pub odometry_fallbacks: usize,
+    /// How the odometry's registrations went: scans tracked, recovered on a second try, fallbacks
+    /// to the prediction by reason, losses of track (see [`TrackingHealth`]).
+    pub tracking: TrackingHealth,
     /// Keyframes whose odometry step the registration contradicted: the step ended more than
-    /// [`GraphSlamConfig::odometry_fault_distance`](super::GraphSlamConfig) from the
+    /// [`TrackerConfig::arbitration_distance`](crate::tracking::TrackerConfig) from the
     /// constant-velocity extrapolation, and the scan registered from the extrapolation fitted
     /// better than from the odometry's guess (or only it registered), so that pose was kept.
     pub odometry_faults: usize,
@@ -120,6 +128,12 @@ pub struct SlamReport {
 }
 
 impl SlamReport {
+    /// Scans whose registration was not taken (the prediction kept), for any reason.
+    #[must_use]
+    pub fn fallbacks(&self) -> usize {
+        self.tracking.fallbacks.total()
+    }
+
     /// Most timings kept in [`SlamReport::scan_ms`] and [`SlamReport::loop_ms`]: 65,536 (3.6 h of
     /// scans at 5 Hz). The statistics below are over the kept ones.
     pub const TIMES_KEPT: usize = 1 << 16;

@@ -29,12 +29,36 @@ pub struct Alignment {
     pub min_eigenvalue_ratio: f64,
 }
 
+/// How far a tracker lets one alignment look for correspondences: it widens the reach after its
+/// motion prediction has been far off (a sudden turn) and narrows it when the prediction is good,
+/// where a wide reach would pair points with the wrong surfaces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Reach {
+    /// Points farther apart than this (metres) are not paired.
+    pub distance: f64,
+    /// Scale of the robust kernel (metres): the backend's kernel threshold (Tukey's `k`,
+    /// Huber's `k`) for this alignment. Residuals well beyond it stop counting.
+    pub kernel: f64,
+}
+
+impl Reach {
+    /// Whether both lengths are finite and positive.
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        self.distance.is_finite()
+            && self.distance > 0.0
+            && self.kernel.is_finite()
+            && self.kernel > 0.0
+    }
+}
+
 /// A registration backend. Preparing a cloud (k-d tree, normals, features) is separate from
 /// aligning, so that a target can be prepared once and aligned against many times.
 ///
 /// ```
 /// use nalgebra::{Matrix6, Point3, Vector3};
-/// use slam_core::{Alignment, PointCloud, Pose3, Registrator, RegistrationError};
+/// use slam_core::{Alignment, PointCloud, Pose3, Reach, Registrator, RegistrationError};
 ///
 /// /// Aligns centroids only: a toy backend that shows the contract.
 /// struct CentroidAligner;
@@ -47,6 +71,11 @@ pub struct Alignment {
 ///     }
 ///     fn prepare_target(&self, c: &PointCloud) -> Result<Self::Target, RegistrationError> {
 ///         c.centroid().ok_or(RegistrationError::TooFewPoints { what: "target", points: 0, required: 1 })
+///     }
+///     /// Centroids pair no points: there is no reach to limit.
+///     fn align_within(&self, s: &Self::Source, t: &Self::Target, initial: &Pose3, _: &Reach)
+///         -> Result<Alignment, RegistrationError> {
+///         self.align(s, t, initial)
 ///     }
 ///     fn align(&self, s: &Self::Source, t: &Self::Target, _initial: &Pose3)
 ///         -> Result<Alignment, RegistrationError> {
@@ -93,6 +122,21 @@ pub trait Registrator {
         source: &Self::Source,
         target: &Self::Target,
         initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError>;
+
+    /// As [`Registrator::align`], with the correspondence reach and the robust kernel's scale
+    /// of `reach` in place of the backend's configured ones (a tracker's adaptive reach; see
+    /// [`Tracker`](crate::tracking::Tracker)). Everything else is as configured.
+    ///
+    /// # Errors
+    /// As [`Registrator::align`], and [`RegistrationError::InvalidConfig`] for a `reach` that
+    /// is not finite and positive.
+    fn align_within(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+        reach: &Reach,
     ) -> Result<Alignment, RegistrationError>;
 }
 

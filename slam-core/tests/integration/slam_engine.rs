@@ -11,10 +11,11 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::io::StampedPose;
+use slam_core::tracking::{ReachConfig, TrackerConfig};
 use slam_core::{
     Alignment, EdgeInformation, FactorizationFailure, GraphPose, GraphSlam, GraphSlamConfig,
     MapRegistrator, OptimizationReport, OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph,
-    RegistrationError, Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy,
+    Reach, RegistrationError, Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy,
     se3_exp, se3_left_jacobian, se3_log,
 };
 
@@ -50,6 +51,27 @@ impl Registrator for BruteIcp {
         t: &Prepared,
         initial: &Pose3,
     ) -> Result<Alignment, RegistrationError> {
+        Self::align_reaching(s, t, initial, self.max_distance)
+    }
+    fn align_within(
+        &self,
+        s: &Prepared,
+        t: &Prepared,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        Self::align_reaching(s, t, initial, reach.distance)
+    }
+}
+
+impl BruteIcp {
+    /// Brute-force nearest-point ICP pairing points at most `max_distance` apart.
+    fn align_reaching(
+        s: &Prepared,
+        t: &Prepared,
+        initial: &Pose3,
+        max_distance: f64,
+    ) -> Result<Alignment, RegistrationError> {
         let mut pose = *initial;
         let mut converged = false;
         let (mut inliers, mut sq) = (0, 0.0);
@@ -64,7 +86,7 @@ impl Registrator for BruteIcp {
                             t.0.iter()
                                 .map(|c| (c, (c - q).norm_squared()))
                                 .min_by(|a, b| a.1.total_cmp(&b.1))?;
-                        (d2 < self.max_distance * self.max_distance).then_some((q, *best))
+                        (d2 < max_distance * max_distance).then_some((q, *best))
                     })
                     .collect();
             if pairs.len() < 10 {
@@ -334,7 +356,7 @@ fn loop_closure_removes_odometry_drift() {
         let cloud = scan(&world, gt);
         let outcome = slam.process(&ScanInput {
             stamp: k as f64 * 0.2,
-            odom_t_body: *od,
+            odom_t_body: Some(*od),
             body_t_lidar,
             cloud: &cloud,
         });
@@ -349,7 +371,7 @@ fn loop_closure_removes_odometry_drift() {
     assert_eq!(
         slam.process(&ScanInput {
             stamp: 0.0,
-            odom_t_body: far,
+            odom_t_body: Some(far),
             body_t_lidar,
             cloud: &empty
         }),
@@ -359,7 +381,7 @@ fn loop_closure_removes_odometry_drift() {
     assert!(matches!(
         slam.process(&ScanInput {
             stamp: 1e6,
-            odom_t_body: nan,
+            odom_t_body: Some(nan),
             body_t_lidar,
             cloud: &empty
         }),
@@ -368,7 +390,7 @@ fn loop_closure_removes_odometry_drift() {
     assert!(matches!(
         slam.process(&ScanInput {
             stamp: 1e6 + 1.0,
-            odom_t_body: far,
+            odom_t_body: Some(far),
             body_t_lidar,
             cloud: &empty
         }),
@@ -379,7 +401,9 @@ fn loop_closure_removes_odometry_drift() {
     assert!(keyframes > 80, "{keyframes} keyframes");
     eprintln!(
         "loops {} of {}, fallbacks {}",
-        report.loops_closed, report.loops_attempted, report.odometry_fallbacks
+        report.loops_closed,
+        report.loops_attempted,
+        report.fallbacks()
     );
     assert!(report.loops_closed >= 1, "{report:?}");
     // The map frame is the odometry frame at the first scan, which is the ground truth's here.
@@ -495,6 +519,15 @@ impl Registrator for InPlaceIcp {
     ) -> Result<Alignment, RegistrationError> {
         self.0.align(s, &t.union, initial)
     }
+    fn align_within(
+        &self,
+        s: &Prepared,
+        t: &InPlaceMap,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        self.0.align_within(s, &t.union, initial, reach)
+    }
 }
 
 impl MapRegistrator for InPlaceIcp {
@@ -567,7 +600,7 @@ fn local_map_slid_in_place_equals_rebuilt() {
         let cloud = scan(&world, &truth[k]);
         let input = ScanInput {
             stamp: k as f64 * 0.2,
-            odom_t_body: odom,
+            odom_t_body: Some(odom),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
         };
@@ -578,7 +611,7 @@ fn local_map_slid_in_place_equals_rebuilt() {
         );
     }
     assert!(in_place.keyframe_count() > 12, "the window slid");
-    assert_eq!(rebuilt.report().odometry_fallbacks, 0);
+    assert_eq!(rebuilt.report().fallbacks(), 0);
     assert_eq!(rebuilt.scan_trajectory(), in_place.scan_trajectory());
 }
 
@@ -627,7 +660,7 @@ fn lap_with_odometry_jump(
         let cloud = scan(&world, gt);
         slam.process(&ScanInput {
             stamp: k as f64 * 0.2,
-            odom_t_body: odom,
+            odom_t_body: Some(odom),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
         });
@@ -696,7 +729,7 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 8] = [
+    let cases: [(GraphSlamConfig, &str); 9] = [
         (
             GraphSlamConfig {
                 loop_max_drift_rate: f64::NAN,
@@ -727,10 +760,26 @@ fn bad_settings_are_refused_by_name() {
         ),
         (
             GraphSlamConfig {
-                odometry_fault_distance: 0.0,
+                tracker: TrackerConfig {
+                    arbitration_distance: 0.0,
+                    ..TrackerConfig::default()
+                },
                 ..GraphSlamConfig::default()
             },
-            "GraphSlamConfig::odometry_fault_distance",
+            "TrackerConfig::arbitration_distance",
+        ),
+        (
+            GraphSlamConfig {
+                tracker: TrackerConfig {
+                    reach: ReachConfig {
+                        max: f64::NAN,
+                        ..ReachConfig::default()
+                    },
+                    ..TrackerConfig::default()
+                },
+                ..GraphSlamConfig::default()
+            },
+            "ReachConfig::max",
         ),
         (
             GraphSlamConfig {
@@ -769,7 +818,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
         let cloud = scan(&world, gt);
         slam.process(&ScanInput {
             stamp: k as f64 * 0.2,
-            odom_t_body: *gt,
+            odom_t_body: Some(*gt),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
         });
@@ -782,7 +831,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
     );
     let input = |k: usize, odom: Pose3| ScanInput {
         stamp: k as f64 * 0.2,
-        odom_t_body: odom,
+        odom_t_body: Some(odom),
         body_t_lidar: Pose3::identity(),
         cloud: &far,
     };

@@ -5,7 +5,8 @@
 //! robot, or reports it lost.
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
-use slam_core::{Alignment, Pose3, Registrator};
+use slam_core::tracking::{ReachConfig, Tracker, TrackerConfig, scan_extent};
+use slam_core::{Pose3, Registrator};
 
 use crate::error::AdapterError;
 use crate::robot::Sample;
@@ -28,12 +29,16 @@ pub struct LocaliserConfig {
     /// Drift of the odometry per metre walked that a correction may undo, 0.05 (Spot's is about
     /// 2 %: two and a half times that).
     pub odometry_drift: f64,
-    /// A registration counts only with at least this share of the scan's points matched, 0.5;
-    /// a correction larger than the odometry's drift (see [`Self::correction_floor`]) only when
-    /// the registration converged too. One within the drift is taken unconverged: beside a box
-    /// a fine map's registration can swap pairs back and forth within millimetres of the truth
-    /// for all its iterations.
-    pub min_inlier_ratio: f64,
+    /// How each scan is registered against the map (the tracker the SLAM engine's odometry
+    /// uses too), with [`LocaliserConfig::tracker_defaults`]: a registration counts only with at
+    /// least half of the scan's points matched (`min_inlier_ratio` 0.5); a coarse stage at a
+    /// wider reach only once the odometry's predictions have been off by more than 17 cm
+    /// (a third of the smallest reach, 0.5 m); no retries (the wide search below is the
+    /// localiser's own). A correction larger than the odometry's drift (see
+    /// [`Self::correction_floor`]) is taken only when the registration converged too; one within
+    /// the drift is taken unconverged: beside a box a fine map's registration can swap pairs
+    /// back and forth within millimetres of the truth for all its iterations.
+    pub tracker: TrackerConfig,
     /// Consecutive scans whose large corrections agree (within 5 cm and 0.02 rad, once carried
     /// by the odometry) before the correction is taken, 3.
     pub confirm_after: usize,
@@ -69,7 +74,7 @@ impl Default for LocaliserConfig {
             max_correction_angle: 0.1,
             correction_floor: 0.05,
             odometry_drift: 0.05,
-            min_inlier_ratio: 0.5,
+            tracker: Self::tracker_defaults(),
             confirm_after: 3,
             lost_after: 5,
             search_radius: 1.0,
@@ -85,6 +90,23 @@ impl Default for LocaliserConfig {
 }
 
 impl LocaliserConfig {
+    /// The tracker settings of [`LocaliserConfig::default`] (see [`LocaliserConfig::tracker`]).
+    #[must_use]
+    pub fn tracker_defaults() -> TrackerConfig {
+        TrackerConfig {
+            reach: ReachConfig {
+                initial: 0.5,
+                ..ReachConfig::default()
+            },
+            min_inlier_ratio: 0.5,
+            // The localiser decides on large corrections itself (confirmation, wide search).
+            max_translation_correction: 1e3,
+            max_rotation_correction: std::f64::consts::PI,
+            retry: false,
+            ..TrackerConfig::default()
+        }
+    }
+
     /// Every setting finite and positive, the ratios at most 1, the counts at least 1; the
     /// walking voxel 0 (off) or 1 cm to 10 m, the full-scan distance finite and not negative.
     ///
@@ -120,16 +142,16 @@ impl LocaliserConfig {
                 "finite and not negative",
             ));
         }
-        for (setting, value) in [
-            ("min_inlier_ratio", self.min_inlier_ratio),
-            (
+        let ratio = self.relocalise_min_inlier_ratio;
+        if !(ratio > 0.0 && ratio <= 1.0) {
+            return Err(AdapterError::invalid(
                 "relocalise_min_inlier_ratio",
-                self.relocalise_min_inlier_ratio,
-            ),
-        ] {
-            if !(value > 0.0 && value <= 1.0) {
-                return Err(AdapterError::invalid(setting, value, "within (0, 1]"));
-            }
+                ratio,
+                "within (0, 1]",
+            ));
+        }
+        if let Err(e) = self.tracker.validate() {
+            return Err(AdapterError::invalid(e.setting, e.value, e.expected));
         }
         for (setting, value) in [
             ("confirm_after", self.confirm_after),
@@ -215,6 +237,7 @@ impl Candidate {
 pub(crate) struct Localiser<R: Registrator> {
     config: LocaliserConfig,
     registrator: R,
+    tracker: Tracker,
     map: R::Target,
     map_t_body: Pose3,
     last_odom_t_body: Option<Pose3>,
@@ -225,22 +248,27 @@ pub(crate) struct Localiser<R: Registrator> {
 }
 
 impl<R: Registrator> Localiser<R> {
+    /// # Errors
+    /// [`AdapterError::InvalidConfig`] for bad tracker settings.
     pub(crate) fn new(
         registrator: R,
         map: R::Target,
         map_t_body: Pose3,
         config: LocaliserConfig,
-    ) -> Self {
-        Self {
+    ) -> Result<Self, AdapterError> {
+        let tracker = Tracker::new(config.tracker)
+            .map_err(|e| AdapterError::invalid(e.setting, e.value, e.expected))?;
+        Ok(Self {
             config,
             registrator,
+            tracker,
             map,
             map_t_body,
             last_odom_t_body: None,
             walked_since_correction: 0.0,
             candidate: None,
             health: LocalisationHealth::default(),
-        }
+        })
     }
 
     pub(crate) fn pose(&self) -> Pose3 {
@@ -249,11 +277,6 @@ impl<R: Registrator> Localiser<R> {
 
     pub(crate) fn health(&self) -> LocalisationHealth {
         self.health
-    }
-
-    /// Whether `a` matched enough of the scan to count.
-    fn good(&self, a: &Alignment) -> bool {
-        a.inlier_ratio >= self.config.min_inlier_ratio
     }
 
     /// Predict from the odometry, correct by registering `sample`'s scan (thinned to
@@ -277,17 +300,24 @@ impl<R: Registrator> Localiser<R> {
             return self.failed();
         };
         let guess = self.map_t_body * sample.body_t_lidar;
-        let aligned = self.registrator.align(&source, &self.map, &guess);
-        if let Ok(a) = &aligned {
-            self.health.converged = a.converged;
-            self.health.inlier_ratio = a.inlier_ratio;
-            self.health.min_eigenvalue_ratio = a.min_eigenvalue_ratio;
-        } else {
-            self.health.converged = false;
+        let extent = scan_extent(&sample.cloud);
+        let outcome = self.tracker.track(
+            &self.registrator,
+            &source,
+            Some(&self.map),
+            &[guess],
+            extent,
+        );
+        match outcome.alignment.as_ref().or(outcome.refused.as_ref()) {
+            Some(a) => {
+                self.health.converged = a.converged;
+                self.health.inlier_ratio = a.inlier_ratio;
+                self.health.min_eigenvalue_ratio = a.min_eigenvalue_ratio;
+            }
+            None => self.health.converged = false,
         }
-        let Some((corrected, converged)) = aligned
-            .ok()
-            .filter(|a| self.good(a))
+        let Some((corrected, converged)) = outcome
+            .alignment
             .map(|a| (a.pose * sample.body_t_lidar.inverse(), a.converged))
         else {
             return self.failed_with(sample, &source);

@@ -285,7 +285,7 @@ impl<R: Registrator> Navigator<R> {
             .map_err(AdapterError::NavigationGrid)?;
         let static_planning = planning.clone();
         Ok(Self {
-            localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone()),
+            localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone())?,
             stuck: StuckMonitor::new(config.stuck.clone()),
             map: navigation.clone(),
             live,

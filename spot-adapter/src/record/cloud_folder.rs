@@ -13,8 +13,8 @@
 //! is given by argument (identity by default). A per-point time is taken in seconds since the
 //! scan's start, or in nanoseconds (Ouster's PCDs) when that is what fits one scan period.
 //! Without odometry every `odom_T_body` is the
-//! identity: wrap the samples in [`ScanToScanOdometry`](crate::record::ScanToScanOdometry)
-//! for a LiDAR-only run.
+//! identity: feed them to the engine with
+//! [`Sample::lidar_only_input`](crate::robot::Sample::lidar_only_input) for a LiDAR-only run.
 
 use std::fs;
 use std::path::{Path, PathBuf};

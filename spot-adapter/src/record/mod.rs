@@ -10,7 +10,9 @@
 //!
 //! Every reader removes no-return points (exact zeros, points inside a minimum range) and
 //! non-finite ones, and counts them ([`ReturnFilter`], [`DroppedPoints`]). A source without
-//! odometry gets it from its scans with [`ScanToScanOdometry`].
+//! odometry says so ([`OpenedSource::has_odometry`]): feed its samples to the engine with
+//! [`Sample::lidar_only_input`](crate::robot::Sample::lidar_only_input), which tracks them by
+//! registration alone.
 //!
 //! A cloud as a driver publishes it (Ouster's convention: integer nanoseconds under `t`, a
 //! no-return at the origin), decoded:
@@ -59,7 +61,6 @@ mod bounded_file;
 mod cloud_folder;
 mod frame_tree;
 mod kitti;
-mod lidar_only;
 mod mcap_file;
 mod no_return;
 mod point_cloud2;
@@ -76,7 +77,6 @@ pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
 pub use frame_tree::{FrameTree, PoseSeries};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
-pub use lidar_only::{ScanToScanConfig, ScanToScanOdometry};
 pub use no_return::{DroppedPoints, PointKind, ReturnFilter};
 pub use point_cloud2::{
     CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,

@@ -1,5 +1,5 @@
 //! Any sample source read on a thread of its own, a few samples ahead of the engine, so reading
-//! (decompressing chunks, decoding clouds, or a LiDAR-only source's scan-to-scan registration)
+//! (decompressing chunks, decoding clouds)
 //! runs beside the engine instead of before each of its scans. The queue is bounded, so memory
 //! stays that of `depth` samples whatever the recording's length.
 

@@ -16,7 +16,6 @@ use crate::record::cloud_folder::{
     CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder,
 };
 use crate::record::kitti::{KittiOdometry, KittiSequence};
-use crate::record::lidar_only::ScanToScanOdometry;
 use crate::record::no_return::{DroppedPoints, ReturnFilter};
 use crate::record::recording::Recording;
 use crate::robot::Sample;
@@ -37,17 +36,6 @@ impl SampleSource for BagSamples {
 impl SampleSource for CloudFolderSamples {
     fn dropped_points(&self) -> DroppedPoints {
         CloudFolderSamples::dropped_points(self)
-    }
-}
-
-impl<R, I> SampleSource for ScanToScanOdometry<R, I>
-where
-    R: slam_core::Registrator + Send,
-    R::Target: Send,
-    I: SampleSource,
-{
-    fn dropped_points(&self) -> DroppedPoints {
-        self.inner().dropped_points()
     }
 }
 
@@ -186,7 +174,8 @@ pub struct OpenedSource {
     pub description: String,
     /// The LiDAR mounting.
     pub body_t_lidar: Pose3,
-    /// Whether the samples carry odometry; without, wrap them in [`ScanToScanOdometry`].
+    /// Whether the samples carry odometry; without, their `odom_T_body` is the identity: feed
+    /// them with [`Sample::lidar_only_input`](crate::robot::Sample::lidar_only_input).
     pub has_odometry: bool,
     /// `world_T_body` per scan when the recording has ground truth.
     pub ground_truth: Option<Vec<StampedPose>>,

@@ -25,9 +25,19 @@ impl Sample {
     pub fn scan_input(&self) -> ScanInput<'_> {
         ScanInput {
             stamp: self.stamp,
-            odom_t_body: self.odom_t_body,
+            odom_t_body: Some(self.odom_t_body),
             body_t_lidar: self.body_t_lidar,
             cloud: &self.cloud,
+        }
+    }
+
+    /// The sample as the engine's input without its odometry: the engine tracks the scan by
+    /// registration alone (for a source with no odometry, or to leave the robot's out).
+    #[must_use]
+    pub fn lidar_only_input(&self) -> ScanInput<'_> {
+        ScanInput {
+            odom_t_body: None,
+            ..self.scan_input()
         }
     }
 

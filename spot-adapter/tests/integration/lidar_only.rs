@@ -1,5 +1,6 @@
 //! Sources without odometry: a folder of scans and a simulated lap with its odometry removed,
-//! run LiDAR-only through scan-to-scan odometry, checked against the true motion; cloud folders
+//! run LiDAR-only (every scan registered against the engine's local map), checked against the
+//! true motion; cloud folders
 //! with a TUM odometry file; no-return points in KITTI scans.
 
 #![allow(clippy::unwrap_used, clippy::panic, clippy::float_cmp)]
@@ -9,12 +10,9 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Point3, Translation3, UnitQuaternion};
 use slam_core::io::{StampedPose, write_kitti_bin, write_tum};
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::AdapterError;
 use spot_adapter::eval::{DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error};
-use spot_adapter::pipelines::{point_to_plane_slam, scan_to_scan_registrator, slam_config};
-use spot_adapter::record::{
-    RecordingKind, ScanToScanConfig, ScanToScanOdometry, SourceConfig, open_recording,
-};
+use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
+use spot_adapter::record::{RecordingKind, SourceConfig, open_recording};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
@@ -45,19 +43,22 @@ fn a_static_scan_folder_runs_lidar_only_without_drifting() {
     let source = open_recording(&dir, &SourceConfig::default()).unwrap();
     assert_eq!(source.kind, RecordingKind::CloudFolder);
     assert!(!source.has_odometry);
-    let samples = ScanToScanOdometry::new(
-        scan_to_scan_registrator(),
-        source.samples,
-        ScanToScanConfig::default(),
-    );
+    let samples = source.samples;
     assert_eq!(samples.len(), 10);
+    let mut slam = point_to_plane_slam(slam_config()).unwrap();
     for (i, s) in samples.enumerate() {
         let s = s.unwrap();
         assert!((s.stamp - (100.0 + 0.1 * i as f64)).abs() < 1e-9);
-        let t = s.odom_t_body.translation.vector.norm();
-        assert!(t < 1e-3, "scan {i}: {t} m from the start");
-        assert!(s.odom_t_body.rotation.angle() < 1e-4);
+        slam.process(&s.lidar_only_input());
     }
+    let trajectory = slam.scan_trajectory();
+    assert_eq!(trajectory.len(), 10);
+    for (i, p) in trajectory.iter().enumerate() {
+        let t = p.pose.translation.vector.norm();
+        assert!(t < 1e-3, "scan {i}: {t} m from the start");
+        assert!(p.pose.rotation.angle() < 1e-4);
+    }
+    assert_eq!(slam.report().fallbacks(), 0, "{:?}", slam.report().tracking);
 }
 
 #[test]
@@ -65,19 +66,10 @@ fn a_lap_without_odometry_is_tracked_from_its_scans() {
     let sim = SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(2)).unwrap();
     let truth = sim.ground_truth();
     let body_t_lidar = sim.body_t_lidar();
-    // The robot's odometry thrown away: every odom_T_body the identity.
-    let blind = sim.take(80).map(|mut s: Sample| {
-        s.odom_t_body = Pose3::identity();
-        Ok::<_, AdapterError>(s)
-    });
     let mut slam = point_to_plane_slam(slam_config()).unwrap();
-    let mut odometry = ScanToScanOdometry::new(
-        scan_to_scan_registrator(),
-        blind,
-        ScanToScanConfig::default(),
-    );
-    for s in &mut odometry {
-        slam.process(&s.unwrap().scan_input());
+    // The robot's odometry left out.
+    for s in sim.take(80) {
+        slam.process(&s.lidar_only_input());
     }
     let estimate: Vec<StampedPose> = slam
         .scan_trajectory()
@@ -95,11 +87,8 @@ fn a_lap_without_odometry_is_tracked_from_its_scans() {
         slam.keyframe_count()
     );
     assert!(ate.rmse < 0.10, "ATE {} m", ate.rmse);
-    assert!(
-        odometry.fallbacks() <= 2,
-        "{} fallbacks",
-        odometry.fallbacks()
-    );
+    let report = slam.report();
+    assert_eq!(report.fallbacks(), 0, "{:?}", report.tracking);
 }
 
 fn pose(x: f64, yaw: f64) -> Pose3 {

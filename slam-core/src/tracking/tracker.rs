@@ -1,0 +1,471 @@
+//! The tracker: register a scan from its predictions, coarse to fine, check the result, and
+//! fall back with a reason.
+
+use nalgebra::{Translation3, UnitQuaternion, Vector3};
+
+use super::health::{FallbackReason, TrackingHealth};
+use super::reach::{AdaptiveReach, ReachConfig, point_displacement};
+use crate::error::check_slam as check;
+use crate::error::{InvalidSlamConfig, RegistrationError};
+use crate::geometry::{Pose3, pose3_is_finite};
+use crate::traits::registrator::{Alignment, Reach, Registrator};
+
+/// Settings of a [`Tracker`]. Lengths in metres, angles in radians.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct TrackerConfig {
+    /// The adaptive reach of the coarse stage.
+    pub reach: ReachConfig,
+    /// The coarse stage's robust kernel as a share of its reach, 1/3: wide enough that the
+    /// pairs of a turned scan still pull, narrow enough that the wrong surfaces do not.
+    pub coarse_kernel: f64,
+    /// A registration that matched less than this share of the scan's points is not taken,
+    /// 0.3 (a scan registered where it belongs matches most of what the target saw too).
+    pub min_inlier_ratio: f64,
+    /// Nor one that moved the prediction farther than this, 2 m ...
+    pub max_translation_correction: f64,
+    /// ... or turned it more than this, 1.05 rad (60°).
+    pub max_rotation_correction: f64,
+    /// When the caller gives other guesses than its prediction (an odometry step it doubts), a
+    /// registration from one of them is taken instead of the prediction's only when the two
+    /// ended farther apart than this (0.5 m) and it matched a larger share of the scan (a lower
+    /// RMS error on a tie).
+    pub arbitration_distance: f64,
+    /// Whether a scan that registers from no guess is tried again, at the widest reach and at
+    /// the headings below, true. Off for a caller with a search of its own.
+    pub retry: bool,
+    /// A registration that matched less than this share of what registrations have typically
+    /// matched lately (a running mean of the shares taken) is suspect, 0.75, and tried again as
+    /// a failed one is, the best fit kept: a turned scan can converge to a wrong pose that still
+    /// matches a third of its points (measured: 0.3-0.45 there, 0.75-0.97 where right).
+    pub suspect_ratio: f64,
+    /// Headings either side of the prediction tried when no guess registers (radians; 0.35 rad,
+    /// 20°, so guesses at ±20°, ±40° and ±60° with the default `retry_turns` of 3): a sudden
+    /// turn that no reach recovers from the prediction is recovered from the nearest of these.
+    pub retry_turn_step: f64,
+    /// Headings tried on each side, 3 (0 turns the heading retries off).
+    pub retry_turns: usize,
+    /// Fallbacks in a row after which tracking counts as lost, 3.
+    pub lost_after: usize,
+}
+
+impl Default for TrackerConfig {
+    fn default() -> Self {
+        Self {
+            reach: ReachConfig::default(),
+            coarse_kernel: 1.0 / 3.0,
+            min_inlier_ratio: 0.3,
+            max_translation_correction: 2.0,
+            max_rotation_correction: 60f64.to_radians(),
+            arbitration_distance: 0.5,
+            retry: true,
+            suspect_ratio: 0.75,
+            retry_turn_step: 20f64.to_radians(),
+            retry_turns: 3,
+            lost_after: 3,
+        }
+    }
+}
+
+impl TrackerConfig {
+    /// Every setting in range: the reach's ([`ReachConfig::validate`]); the coarse kernel and
+    /// the inlier ratio in (0, 1]; the correction limits, the arbitration distance and the turn
+    /// step finite and positive; `lost_after` at least 1.
+    ///
+    /// # Errors
+    /// [`InvalidSlamConfig`] naming the first bad setting.
+    #[allow(clippy::cast_precision_loss)]
+    pub fn validate(&self) -> Result<(), InvalidSlamConfig> {
+        self.reach.validate()?;
+        for (setting, v) in [
+            ("TrackerConfig::coarse_kernel", self.coarse_kernel),
+            ("TrackerConfig::min_inlier_ratio", self.min_inlier_ratio),
+            ("TrackerConfig::suspect_ratio", self.suspect_ratio),
+        ] {
+            check(v > 0.0 && v <= 1.0, setting, v, "within (0, 1]")?;
+        }
+        for (setting, v) in [
+            (
+                "TrackerConfig::max_translation_correction",
+                self.max_translation_correction,
+            ),
+            (
+                "TrackerConfig::max_rotation_correction",
+                self.max_rotation_correction,
+            ),
+            (
+                "TrackerConfig::arbitration_distance",
+                self.arbitration_distance,
+            ),
+            ("TrackerConfig::retry_turn_step", self.retry_turn_step),
+        ] {
+            check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
+        }
+        check(
+            self.lost_after >= 1,
+            "TrackerConfig::lost_after",
+            self.lost_after as f64,
+            "at least 1",
+        )
+    }
+}
+
+/// What [`Tracker::track`] decided for one scan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackOutcome {
+    /// The registered pose, or the prediction (the first guess) on a fallback.
+    pub pose: Pose3,
+    /// The registration taken; `None` on a fallback.
+    pub alignment: Option<Alignment>,
+    /// On a fallback, the prediction's registration that a check refused (too few inliers, too
+    /// large a correction), for diagnosis; `None` when it never got that far, or when tracked.
+    pub refused: Option<Alignment>,
+    /// Why the prediction was kept; `None` when the scan was tracked.
+    pub fallback: Option<FallbackReason>,
+    /// Which guess the pose was registered from (0: the prediction).
+    pub guess: usize,
+    /// Whether it took a second try (another guess, the widest reach, or a turned heading).
+    pub recovered: bool,
+}
+
+impl TrackOutcome {
+    /// Whether the scan was registered and taken.
+    #[must_use]
+    pub fn tracked(&self) -> bool {
+        self.fallback.is_none()
+    }
+}
+
+/// A registration from one guess, or why it was refused (with the alignment a check refused).
+type Attempt = Result<Alignment, (FallbackReason, Option<Box<Alignment>>)>;
+
+/// Predict, register coarse to fine with an adaptive reach, check, fall back with a reason.
+///
+/// Generic over any [`Registrator`]: its configured alignment is the fine stage; the coarse
+/// stage is [`Registrator::align_within`] at the reach three RMS prediction errors give
+/// ([`AdaptiveReach`]), run only while that reach exceeds [`ReachConfig::min`].
+///
+/// ```
+/// use nalgebra::{Matrix6, Point3};
+/// use slam_core::tracking::{Tracker, TrackerConfig};
+/// use slam_core::{Alignment, PointCloud, Pose3, Reach, Registrator, RegistrationError};
+///
+/// /// A registrator that always finds `answer`.
+/// struct Oracle { answer: Pose3 }
+/// impl Registrator for Oracle {
+///     type Source = ();
+///     type Target = ();
+///     fn prepare_source(&self, _: &PointCloud) -> Result<(), RegistrationError> { Ok(()) }
+///     fn prepare_target(&self, _: &PointCloud) -> Result<(), RegistrationError> { Ok(()) }
+///     fn align(&self, _: &(), _: &(), _: &Pose3) -> Result<Alignment, RegistrationError> {
+///         Ok(Alignment { pose: self.answer, converged: true, iterations: 1, inliers: 90,
+///             inlier_ratio: 0.9, rmse: 0.01, information: Matrix6::identity(),
+///             min_eigenvalue_ratio: 1.0 })
+///     }
+///     fn align_within(&self, s: &(), t: &(), g: &Pose3, _: &Reach)
+///         -> Result<Alignment, RegistrationError> { self.align(s, t, g) }
+/// }
+///
+/// let mut tracker = Tracker::new(TrackerConfig::default())?;
+/// let answer = Pose3::translation(1.0, 0.0, 0.0);
+/// let prediction = Pose3::translation(0.9, 0.0, 0.0);
+/// let outcome = tracker.track(&Oracle { answer }, &(), Some(&()), &[prediction], 10.0);
+/// assert!(outcome.tracked());
+/// assert_eq!(outcome.pose, answer);
+/// assert_eq!(tracker.health().tracked, 1);
+/// # Ok::<(), slam_core::InvalidSlamConfig>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Tracker {
+    config: TrackerConfig,
+    reach: AdaptiveReach,
+    health: TrackingHealth,
+    /// Running mean of the matched shares of the registrations taken (`None` before one).
+    typical_inlier_ratio: Option<f64>,
+}
+
+/// The reason a registration error gives for falling back.
+fn reason_of(error: &RegistrationError) -> FallbackReason {
+    match error {
+        RegistrationError::TooFewCorrespondences { .. } => FallbackReason::TooFewCorrespondences,
+        RegistrationError::Degenerate { .. } | RegistrationError::RigidFit(_) => {
+            FallbackReason::Degenerate
+        }
+        _ => FallbackReason::RegistrationError,
+    }
+}
+
+/// `guess` turned by `angle` about the vertical through its position.
+fn turned(guess: &Pose3, angle: f64) -> Pose3 {
+    let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle);
+    Pose3::from_parts(
+        Translation3::from(guess.translation.vector),
+        turn * guess.rotation,
+    )
+}
+
+/// Whether `a` fits better than `b`: a larger matched share, a lower RMS error on a tie.
+fn fits_better(a: &Alignment, b: &Alignment) -> bool {
+    match a.inlier_ratio.total_cmp(&b.inlier_ratio) {
+        std::cmp::Ordering::Greater => true,
+        std::cmp::Ordering::Equal => a.rmse < b.rmse,
+        std::cmp::Ordering::Less => false,
+    }
+}
+
+impl Tracker {
+    /// A tracker with `config`.
+    ///
+    /// # Errors
+    /// [`InvalidSlamConfig`] naming the first bad setting ([`TrackerConfig::validate`]).
+    pub fn new(config: TrackerConfig) -> Result<Self, InvalidSlamConfig> {
+        config.validate()?;
+        Ok(Self {
+            reach: AdaptiveReach::new(config.reach)?,
+            config,
+            health: TrackingHealth::default(),
+            typical_inlier_ratio: None,
+        })
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn config(&self) -> &TrackerConfig {
+        &self.config
+    }
+
+    /// The counts so far.
+    #[must_use]
+    pub fn health(&self) -> &TrackingHealth {
+        &self.health
+    }
+
+    /// The coarse stage's reach for the next scan (metres).
+    #[must_use]
+    pub fn reach(&self) -> f64 {
+        self.reach.current()
+    }
+
+    /// Whether the last [`TrackerConfig::lost_after`] scans or more all fell back.
+    #[must_use]
+    pub fn is_lost(&self) -> bool {
+        self.health.consecutive_fallbacks >= self.config.lost_after
+    }
+
+    /// Forgets the recent prediction errors (the reach starts over at
+    /// [`ReachConfig::initial`]), e.g. after a relocalisation.
+    pub fn reset_reach(&mut self) {
+        self.reach.reset();
+    }
+
+    /// Registers `source` against `target` from `guesses` and decides its pose.
+    ///
+    /// `guesses[0]` is the prediction (the robot's odometry, a gyro, or a constant-velocity
+    /// extrapolation); any others are alternatives the caller doubts it against (each is
+    /// registered too, see [`TrackerConfig::arbitration_distance`]). `extent` is how far the
+    /// scan reaches (metres, [`scan_extent`](super::scan_extent)): the range at which a rotation
+    /// error is measured. When no guess registers, the prediction is tried once more at the
+    /// widest reach and turned either side ([`TrackerConfig::retry_turns`]); when that fails
+    /// too, the prediction is kept and the reason counted. `target` `None` (no map yet) is
+    /// counted as [`FallbackReason::NoTarget`].
+    ///
+    /// # Panics
+    /// Never; an empty `guesses` is a fallback at the identity with
+    /// [`FallbackReason::RegistrationError`].
+    pub fn track<R: Registrator>(
+        &mut self,
+        registrator: &R,
+        source: &R::Source,
+        target: Option<&R::Target>,
+        guesses: &[Pose3],
+        extent: f64,
+    ) -> TrackOutcome {
+        let Some(&prediction) = guesses.first() else {
+            return self.fall_back(Pose3::identity(), FallbackReason::RegistrationError);
+        };
+        let Some(target) = target else {
+            return self.fall_back(prediction, FallbackReason::NoTarget);
+        };
+        let extent = if extent.is_finite() && extent > 0.0 {
+            extent
+        } else {
+            0.0
+        };
+        let reach = self.reach.current();
+        self.health.last_reach = if reach > self.config.reach.min {
+            reach
+        } else {
+            0.0
+        };
+        let attempts: Vec<Attempt> = guesses
+            .iter()
+            .map(|g| self.attempt(registrator, source, target, g, reach))
+            .collect();
+        let chosen = self.arbitrate(&attempts);
+        let (index, alignment, recovered) = match chosen {
+            Some((i, a)) if self.suspect(&a) => {
+                match self.retry(registrator, source, target, &prediction) {
+                    Some(b) if fits_better(&b, &a) => (0, b, true),
+                    _ => (i, a, false),
+                }
+            }
+            Some((i, a)) => (i, a, false),
+            None => {
+                let (first, refused) = attempts
+                    .into_iter()
+                    .next()
+                    .and_then(Result::err)
+                    .unwrap_or((FallbackReason::RegistrationError, None));
+                let retried = self
+                    .config
+                    .retry
+                    .then(|| self.retry(registrator, source, target, &prediction))
+                    .flatten();
+                if let Some(a) = retried {
+                    (0, a, true)
+                } else {
+                    self.reach.record(f64::INFINITY);
+                    let mut outcome = self.fall_back(prediction, first);
+                    outcome.refused = refused.map(|a| *a);
+                    return outcome;
+                }
+            }
+        };
+        let error = point_displacement(&(prediction.inverse() * alignment.pose), extent);
+        self.reach.record(error);
+        self.typical_inlier_ratio = Some(match self.typical_inlier_ratio {
+            Some(m) => 0.9 * m + 0.1 * alignment.inlier_ratio,
+            None => alignment.inlier_ratio,
+        });
+        self.health.tracked += 1;
+        self.health.recovered += usize::from(recovered);
+        self.health.consecutive_fallbacks = 0;
+        TrackOutcome {
+            pose: alignment.pose,
+            alignment: Some(alignment),
+            refused: None,
+            fallback: None,
+            guess: index,
+            recovered,
+        }
+    }
+
+    /// Whether `a` matched much less of its scan than registrations lately have (when retries
+    /// are on).
+    fn suspect(&self, a: &Alignment) -> bool {
+        self.config.retry
+            && self
+                .typical_inlier_ratio
+                .is_some_and(|m| a.inlier_ratio < self.config.suspect_ratio * m)
+    }
+
+    /// The prediction kept, with `reason` counted.
+    fn fall_back(&mut self, prediction: Pose3, reason: FallbackReason) -> TrackOutcome {
+        self.health.fallbacks.add(reason);
+        self.health.consecutive_fallbacks += 1;
+        if self.health.consecutive_fallbacks == self.config.lost_after {
+            self.health.losses += 1;
+        }
+        TrackOutcome {
+            pose: prediction,
+            alignment: None,
+            refused: None,
+            fallback: Some(reason),
+            guess: 0,
+            recovered: false,
+        }
+    }
+
+    /// The prediction's registration unless another guess's ended more than the arbitration
+    /// distance away and fits better (the best such); the best other when the prediction's
+    /// failed.
+    fn arbitrate(&self, attempts: &[Attempt]) -> Option<(usize, Alignment)> {
+        let mut best: Option<(usize, &Alignment)> = None;
+        for (i, a) in attempts.iter().enumerate() {
+            let Ok(a) = a else { continue };
+            best = match best {
+                None => Some((i, a)),
+                Some((j, b)) => {
+                    let apart = (a.pose.translation.vector - b.pose.translation.vector).norm();
+                    if apart > self.config.arbitration_distance && fits_better(a, b) {
+                        Some((i, a))
+                    } else {
+                        Some((j, b))
+                    }
+                }
+            };
+        }
+        best.map(|(i, a)| (i, a.clone()))
+    }
+
+    /// The best registration of the prediction at the widest reach and turned either side, if
+    /// any is taken.
+    fn retry<R: Registrator>(
+        &self,
+        registrator: &R,
+        source: &R::Source,
+        target: &R::Target,
+        prediction: &Pose3,
+    ) -> Option<Alignment> {
+        let widest = self.config.reach.max;
+        let step = self.config.retry_turn_step;
+        let turns = (1..=self.config.retry_turns).flat_map(|k| {
+            #[allow(clippy::cast_precision_loss)]
+            let a = k as f64 * step;
+            [a, -a]
+        });
+        let mut best: Option<Alignment> = None;
+        for angle in std::iter::once(0.0).chain(turns) {
+            let guess = turned(prediction, angle);
+            if let Ok(a) = self.attempt(registrator, source, target, &guess, widest)
+                && best.as_ref().is_none_or(|b| fits_better(&a, b))
+            {
+                best = Some(a);
+            }
+        }
+        best
+    }
+
+    /// Coarse (when the reach is above its minimum) then fine registration from `guess`,
+    /// checked.
+    fn attempt<R: Registrator>(
+        &self,
+        registrator: &R,
+        source: &R::Source,
+        target: &R::Target,
+        guess: &Pose3,
+        reach: f64,
+    ) -> Attempt {
+        let start = if reach > self.config.reach.min {
+            let wide = Reach {
+                distance: reach,
+                kernel: reach * self.config.coarse_kernel,
+            };
+            registrator
+                .align_within(source, target, guess, &wide)
+                .map_err(|e| (reason_of(&e), None))?
+                .pose
+        } else {
+            *guess
+        };
+        if !pose3_is_finite(&start) {
+            return Err((FallbackReason::NonFinitePose, None));
+        }
+        let a = registrator
+            .align(source, target, &start)
+            .map_err(|e| (reason_of(&e), None))?;
+        if !pose3_is_finite(&a.pose) {
+            return Err((FallbackReason::NonFinitePose, None));
+        }
+        if a.inlier_ratio < self.config.min_inlier_ratio {
+            return Err((FallbackReason::TooFewInliers, Some(Box::new(a))));
+        }
+        let correction = guess.inverse() * a.pose;
+        if correction.translation.vector.norm() > self.config.max_translation_correction
+            || correction.rotation.angle() > self.config.max_rotation_correction
+        {
+            return Err((FallbackReason::CorrectionTooLarge, Some(Box::new(a))));
+        }
+        Ok(a)
+    }
+}
