@@ -25,8 +25,8 @@ use slam_core::{
 use spot_adapter::nav::{NavigationMap, NavigatorConfig};
 use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::record::{
-    BagConfig, OdometrySource, PointCloud2Config, ReadAhead, ReturnFilter, SampleSource,
-    SourceConfig, TimeUnit, open_recording,
+    BagConfig, ImuSource, OdometrySource, PointCloud2Config, ReadAhead, ReturnFilter,
+    SampleSource, SourceConfig, TimeUnit, open_recording,
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -95,6 +95,13 @@ struct Args {
     /// Bags: the LiDAR frame (default: the clouds' `frame_id`).
     #[arg(long, value_name = "FRAME")]
     lidar_frame: Option<String>,
+    /// Bags: the `sensor_msgs/Imu` topic whose gyro gives each scan the body's orientation
+    /// (default: the only one, when its frame is joined to the body frame).
+    #[arg(long, value_name = "TOPIC", conflicts_with = "no_imu")]
+    imu_topic: Option<String>,
+    /// Bags: read no IMU.
+    #[arg(long)]
+    no_imu: bool,
     /// Scan folders: the LiDAR pose in the body frame, `tx,ty,tz,qx,qy,qz,qw` (default
     /// identity).
     #[arg(long, value_name = "POSE", value_parser = parse_pose, allow_negative_numbers = true)]
@@ -188,6 +195,11 @@ fn source_config(args: &Args) -> SourceConfig {
             odometry,
             base_frame: args.base_frame.clone(),
             lidar_frame: args.lidar_frame.clone(),
+            imu: match (&args.imu_topic, args.no_imu) {
+                (_, true) => ImuSource::None,
+                (Some(t), _) => ImuSource::Topic(t.clone()),
+                _ => ImuSource::Auto,
+            },
             cloud: PointCloud2Config {
                 returns: ReturnFilter {
                     min_range: args.min_range,

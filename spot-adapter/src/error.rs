@@ -113,6 +113,46 @@ pub enum AdapterError {
         /// The rosbag crate's reason.
         source: rosbag::Error,
     },
+    /// A bag's body frame is not joined to its LiDAR frame by fixed transforms (`/tf_static`), so
+    /// the LiDAR's mounting is unknown.
+    #[error(
+        "{path}: no fixed transform joins the body frame {body_frame:?} ({body_from}) to the LiDAR \
+         frame {lidar_frame:?}; {frames}; pass --no-odometry to run LiDAR-only, --base-frame F \
+         for a body frame joined to {lidar_frame:?} (--base-frame {lidar_frame} takes the \
+         odometry as the LiDAR's own), or another odometry with --odom-topic T or --odom-frame F"
+    )]
+    UnlinkedLidar {
+        /// The bag.
+        path: PathBuf,
+        /// The body frame.
+        body_frame: String,
+        /// Where the body frame came from ("the child frame of odometry topic /odom", "the base
+        /// frame given").
+        body_from: String,
+        /// The LiDAR frame.
+        lidar_frame: String,
+        /// The frames the bag has (boxed: the error enum stays small).
+        frames: Box<crate::record::BagFrames>,
+    },
+    /// The IMU topic asked for is in a frame not joined to the body frame by fixed transforms
+    /// (`/tf_static`), so its mounting is unknown.
+    #[error(
+        "{path}: IMU topic {topic}: no fixed transform joins its frame {imu_frame:?} to the body \
+         frame {body_frame:?}; {frames}; pass --no-imu, or --base-frame F for a body frame \
+         joined to both {imu_frame:?} and the LiDAR frame"
+    )]
+    UnlinkedImu {
+        /// The bag.
+        path: PathBuf,
+        /// The IMU topic.
+        topic: String,
+        /// Its readings' frame.
+        imu_frame: String,
+        /// The body frame.
+        body_frame: String,
+        /// The frames the bag has (boxed: the error enum stays small).
+        frames: Box<crate::record::BagFrames>,
+    },
     /// A route's start or goal lies inside an obstacle or outside the building.
     #[error("{which} ({x:.2}, {y:.2}) m is not free floor")]
     BlockedEndpoint {

@@ -196,6 +196,7 @@ impl SpotClient {
             body_t_lidar,
             cloud: scan.cloud,
             ground_truth: None,
+            gyro_orientation: None,
         })
     }
 }

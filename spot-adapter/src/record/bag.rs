@@ -1,7 +1,14 @@
 //! A ROS 1 or ROS 2 (MCAP) bag as a source of [`Sample`](crate::robot::Sample)s: the clouds of one
 //! `sensor_msgs/PointCloud2` topic, each with `odom_T_body` at its stamp (from a
 //! `nav_msgs/Odometry` topic, or from the `/tf` tree between an odometry frame and the body
-//! frame) and `body_T_lidar` from `/tf_static`.
+//! frame), `body_T_lidar` from `/tf_static`, and the body's orientation integrated from a
+//! `sensor_msgs/Imu` topic's gyro when there is one ([`ImuSource`]).
+//!
+//! An odometry is only taken by default when it reaches the clouds: an odometry topic whose child
+//! frame is empty or not joined to the LiDAR frame by any transform (a simulator's ground truth
+//! recorded beside real scans) is left out, and the summary's notes say so; asked for by name, a
+//! body frame not joined to the LiDAR frame by fixed transforms is an error that lists the
+//! frames the bag has ([`BagFrames`]).
 //!
 //! [`Bag::open`] reads the bag once, streaming, to find its topics, counts, duration, frames,
 //! the first cloud's layout and the fixed transforms, and checks every message it will need, so
@@ -12,12 +19,16 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use nalgebra::UnitQuaternion;
 use slam_core::Pose3;
 
 use crate::error::{AdapterError, MessageError};
 use crate::record::bag_file::{BagFormat, BagMessages, RawMessage, TopicInfo};
+use crate::record::bag_frames::BagFrames;
+use crate::record::bag_imu::{ImuChoice, ImuSource, ImuSummary};
 use crate::record::bag_samples::BagSamples;
 use crate::record::frame_tree::FrameTree;
+use crate::record::imu::GyroIntegrator;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
 use crate::record::ros_messages::{
     Header, ImuReading, Odometry, PointCloud2, RosMessageType, decode_tf_message,
@@ -28,7 +39,10 @@ use crate::record::wire::WireReader;
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub enum OdometrySource {
     /// The only `nav_msgs/Odometry` topic, else the `/tf` transform from `odom` to its moving
-    /// child, else none.
+    /// child, else none. An odometry whose body frame (the topic's child frame, the moving
+    /// child) is empty or joined to the clouds' frame by no transform is left out, and the
+    /// summary's notes say why (unless a LiDAR frame is given: then a body frame not joined to
+    /// it is an error).
     #[default]
     Auto,
     /// This `nav_msgs/Odometry` topic.
@@ -54,6 +68,8 @@ pub struct BagConfig {
     pub base_frame: Option<String>,
     /// The LiDAR frame; `None` takes the clouds' `frame_id`.
     pub lidar_frame: Option<String>,
+    /// Where the samples' gyro orientation comes from.
+    pub imu: ImuSource,
     /// How clouds are decoded.
     pub cloud: PointCloud2Config,
 }
@@ -112,6 +128,11 @@ pub struct BagSummary {
     pub clouds: usize,
     /// Clouds stamped before the first or after the last odometry (left out).
     pub clouds_outside_odometry: usize,
+    /// The IMU whose gyro gives the samples' orientation, when one does.
+    pub imu: Option<ImuSummary>,
+    /// What the bag has that is not used, and why, one line each (an odometry or IMU topic whose
+    /// frame is not joined to the clouds' or the body's).
+    pub notes: Vec<String>,
 }
 
 impl fmt::Display for BagSummary {
@@ -139,6 +160,20 @@ impl fmt::Display for BagSummary {
             ResolvedOdometry::None => "none (LiDAR-only)".into(),
         };
         writeln!(f, "odometry    {odometry}")?;
+        match &self.imu {
+            Some(imu) => writeln!(f, "imu         {imu}")?,
+            None if self
+                .topics
+                .iter()
+                .any(|t| t.info.message_type == Some(RosMessageType::Imu)) =>
+            {
+                writeln!(f, "imu         none")?;
+            }
+            None => {}
+        }
+        for note in &self.notes {
+            writeln!(f, "note        {note}")?;
+        }
         let t = self.body_t_lidar.translation.vector;
         write!(
             f,
@@ -187,6 +222,51 @@ fn bad(path: &Path, message: String) -> AdapterError {
         path: path.to_path_buf(),
         message,
     }
+}
+
+/// The topics of type `kind`.
+fn of_type(s: &Survey, kind: RosMessageType) -> Vec<&str> {
+    s.topics
+        .values()
+        .filter(|x| x.info.message_type == Some(kind))
+        .map(|x| x.info.name.as_str())
+        .collect()
+}
+
+/// `name, type, name, type...` of every topic.
+fn listing(topics: &BTreeMap<String, TopicSummary>) -> String {
+    topics
+        .values()
+        .map(|t| format!("{} ({})", t.info.name, t.info.type_name))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Check that the bag has topic `name` and that it carries `kind`.
+pub(super) fn check_topic_type(
+    path: &Path,
+    topics: &BTreeMap<String, TopicSummary>,
+    name: &str,
+    kind: RosMessageType,
+) -> Result<(), AdapterError> {
+    let Some(topic) = topics.get(name) else {
+        return Err(bad(
+            path,
+            format!("no topic {name}; the bag has {}", listing(topics)),
+        ));
+    };
+    if topic.info.message_type != Some(kind) {
+        return Err(message_error(
+            path,
+            name,
+            0,
+            MessageError::UnknownType {
+                found: topic.info.type_name.clone(),
+                expected: kind.name(),
+            },
+        ));
+    }
+    Ok(())
 }
 
 /// Whether `topic` is a tf topic, and whether the static one.
@@ -239,6 +319,46 @@ struct Survey {
     odometry: BTreeMap<String, (f64, f64, String, String)>,
     /// Per cloud topic: stamps, and the first cloud's frame.
     clouds: BTreeMap<String, (Vec<f64>, String)>,
+    /// Per IMU topic: its readings integrated with an identity mounting (to count and span
+    /// them; only the last reading is kept).
+    imu: BTreeMap<String, GyroIntegrator>,
+}
+
+impl Survey {
+    /// The frames the bag names.
+    fn frames(&self) -> BagFrames {
+        let has = |kind| self.topics.keys().any(|t| tf_kind(t) == Some(kind));
+        let pairs = |edges: Vec<(&str, &str)>| {
+            let mut out: Vec<(String, String)> = edges
+                .into_iter()
+                .map(|(p, c)| (p.to_owned(), c.to_owned()))
+                .collect();
+            out.sort();
+            out
+        };
+        BagFrames {
+            has_tf: has(false),
+            tf: pairs(self.moving.moving_edges().collect()),
+            has_tf_static: has(true),
+            tf_static: pairs(self.fixed.fixed_edges().map(|(p, c, _)| (p, c)).collect()),
+            odometry: self
+                .odometry
+                .iter()
+                .map(|(topic, (_, _, frame, child))| (topic.clone(), frame.clone(), child.clone()))
+                .collect(),
+            imu: self
+                .imu
+                .iter()
+                .map(|(topic, gyro)| (topic.clone(), gyro.frame().to_owned()))
+                .collect(),
+        }
+    }
+}
+
+/// The odometry decided on, and a note for each one left out.
+struct OdometryChoice {
+    odometry: ResolvedOdometry,
+    notes: Vec<String>,
 }
 
 impl Bag {
@@ -317,109 +437,119 @@ impl Bag {
                     e.0 = e.0.min(o.header.stamp);
                     e.1 = e.1.max(o.header.stamp);
                 }
+                Some(Decoded::Imu(reading)) => {
+                    let gyro = s.imu.entry(name.clone()).or_insert_with(|| {
+                        GyroIntegrator::new(&reading.frame_id, UnitQuaternion::identity())
+                    });
+                    gyro.push(&reading);
+                    if let Some(last) = gyro.last_stamp() {
+                        gyro.prune_before(last);
+                    }
+                }
                 _ => {}
             }
         }
         Ok(s)
     }
 
-    #[allow(clippy::too_many_lines)]
     fn resolve(
         path: &Path,
         format: BagFormat,
         mut s: Survey,
         config: &BagConfig,
     ) -> Result<Self, AdapterError> {
-        let of_type = |t: RosMessageType| -> Vec<&str> {
-            s.topics
-                .values()
-                .filter(|x| x.info.message_type == Some(t))
-                .map(|x| x.info.name.as_str())
-                .collect()
-        };
-        let listing = || {
-            s.topics
-                .values()
-                .map(|t| format!("{} ({})", t.info.name, t.info.type_name))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let cloud_topic = match &config.cloud_topic {
-            Some(t) => {
-                let Some(topic) = s.topics.get(t) else {
-                    return Err(bad(
-                        path,
-                        format!("no topic {t}; the bag has {}", listing()),
-                    ));
-                };
-                if topic.info.message_type != Some(RosMessageType::PointCloud2) {
-                    return Err(message_error(
-                        path,
-                        t,
-                        0,
-                        MessageError::UnknownType {
-                            found: topic.info.type_name.clone(),
-                            expected: RosMessageType::PointCloud2.name(),
-                        },
-                    ));
-                }
-                t.clone()
-            }
-            None => match of_type(RosMessageType::PointCloud2).as_slice() {
-                [one] => (*one).to_owned(),
-                [] => {
-                    return Err(bad(
-                        path,
-                        format!(
-                            "no sensor_msgs/PointCloud2 topic; the bag has {}",
-                            listing()
-                        ),
-                    ));
-                }
-                many => {
-                    return Err(bad(
-                        path,
-                        format!("several cloud topics ({}): choose one", many.join(", ")),
-                    ));
-                }
-            },
-        };
-        let odometry = match &config.odometry {
-            OdometrySource::Topic(t) => {
-                let Some(topic) = s.topics.get(t) else {
-                    return Err(bad(
-                        path,
-                        format!("no topic {t}; the bag has {}", listing()),
-                    ));
-                };
-                if topic.info.message_type != Some(RosMessageType::Odometry) {
-                    return Err(message_error(
-                        path,
-                        t,
-                        0,
-                        MessageError::UnknownType {
-                            found: topic.info.type_name.clone(),
-                            expected: RosMessageType::Odometry.name(),
-                        },
-                    ));
-                }
-                ResolvedOdometry::Topic(t.clone())
-            }
-            OdometrySource::Tf { odom_frame } => ResolvedOdometry::Tf {
-                odom_frame: odom_frame.clone(),
-            },
-            OdometrySource::None => ResolvedOdometry::None,
-            OdometrySource::Auto => match of_type(RosMessageType::Odometry).as_slice() {
-                [one] => ResolvedOdometry::Topic((*one).to_owned()),
-                _ if !s.moving.moving_children("odom").is_empty() => ResolvedOdometry::Tf {
-                    odom_frame: "odom".into(),
-                },
-                _ => ResolvedOdometry::None,
-            },
-        };
+        let cloud_topic = Self::cloud_topic(path, &s, config)?;
         let (stamps, cloud_frame) = s.clouds.remove(&cloud_topic).unwrap_or_default();
         let lidar_frame = config.lidar_frame.clone().unwrap_or(cloud_frame);
-        let (base_frame, span) = match &odometry {
+        // Moving and fixed edges together: what joins two frames at all.
+        let mut tree = s.moving.clone();
+        for (parent, child, pose) in s.fixed.fixed_edges() {
+            tree.set_fixed(parent, child, pose);
+        }
+        let frames = s.frames();
+        let choice = Self::odometry(path, &s, config, &tree, &lidar_frame)?;
+        let odometry = choice.odometry;
+        let (base_frame, span) =
+            Self::body_frame(path, &s, config, &tree, &odometry, &stamps, &lidar_frame)?;
+        let body_t_lidar =
+            Self::mounting(&s.fixed, &base_frame, &lidar_frame).ok_or_else(|| {
+                AdapterError::UnlinkedLidar {
+                    path: path.to_path_buf(),
+                    body_from: match (&config.base_frame, &odometry) {
+                        (Some(_), _) => "the base frame given".into(),
+                        (None, ResolvedOdometry::Topic(t)) => {
+                            format!("the child frame of odometry topic {t}")
+                        }
+                        (None, ResolvedOdometry::Tf { odom_frame }) => {
+                            format!("the moving child of {odom_frame:?} in /tf")
+                        }
+                        (None, ResolvedOdometry::None) => "the LiDAR frame".into(),
+                    },
+                    body_frame: base_frame.clone(),
+                    lidar_frame: lidar_frame.clone(),
+                    frames: Box::new(frames.clone()),
+                }
+            })?;
+        let delivered: Vec<f64> = stamps
+            .iter()
+            .copied()
+            .filter(|&t| t >= span.0 && t <= span.1)
+            .collect();
+        let (imu, imu_note) = ImuChoice {
+            path,
+            topics: &s.topics,
+            gyros: &s.imu,
+            fixed: &s.fixed,
+            base_frame: &base_frame,
+            clouds: &delivered,
+            frames: &frames,
+        }
+        .resolve(&config.imu)?;
+        // The first cloud decides the layout and the time unit.
+        let mut decoder = PointCloud2Decoder::new(config.cloud);
+        let layout = Self::first_layout(path, format, &cloud_topic, &mut decoder)?;
+        let (first, last) = s
+            .topics
+            .values()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
+                (a.min(t.first), b.max(t.last))
+            });
+        let summary = BagSummary {
+            path: path.to_path_buf(),
+            format,
+            topics: s.topics.into_values().collect(),
+            duration: if last >= first { last - first } else { 0.0 },
+            cloud_topic,
+            layout,
+            odometry,
+            base_frame,
+            lidar_frame,
+            body_t_lidar,
+            clouds: delivered.len(),
+            clouds_outside_odometry: stamps.len() - delivered.len(),
+            imu,
+            notes: choice.notes.into_iter().chain(imu_note).collect(),
+        };
+        Ok(Self {
+            summary,
+            fixed: s.fixed,
+            span,
+            decoder,
+        })
+    }
+
+    /// The body frame (the one given, else the odometry's child, else the LiDAR frame) and the
+    /// stamps between which its odometry is known.
+    fn body_frame(
+        path: &Path,
+        s: &Survey,
+        config: &BagConfig,
+        tree: &FrameTree,
+        odometry: &ResolvedOdometry,
+        stamps: &[f64],
+        lidar_frame: &str,
+    ) -> Result<(String, (f64, f64)), AdapterError> {
+        Ok(match odometry {
             ResolvedOdometry::Topic(t) => {
                 let (first, last, _, child) = s.odometry.get(t).cloned().unwrap_or_default();
                 (config.base_frame.clone().unwrap_or(child), (first, last))
@@ -441,11 +571,6 @@ impl Bag {
                         }
                     },
                 };
-                // Moving and fixed edges together make the odometry chain.
-                let mut tree = s.moving.clone();
-                for (parent, child, pose) in s.fixed.fixed_edges() {
-                    tree.set_fixed(parent, child, pose);
-                }
                 let span = tree.known_span(odom_frame, &base).ok_or_else(|| {
                     message_error(
                         path,
@@ -464,62 +589,127 @@ impl Bag {
                 config
                     .base_frame
                     .clone()
-                    .unwrap_or_else(|| lidar_frame.clone()),
+                    .unwrap_or_else(|| lidar_frame.to_owned()),
                 (f64::NEG_INFINITY, f64::INFINITY),
             ),
-        };
-        let body_t_lidar = if base_frame == lidar_frame {
-            Pose3::identity()
-        } else {
-            s.fixed
-                .lookup(&base_frame, &lidar_frame, 0.0)
-                .filter(|_| s.fixed.is_fixed_between(&base_frame, &lidar_frame))
-                .ok_or_else(|| {
-                    message_error(
-                        path,
-                        "/tf_static",
-                        0,
-                        MessageError::MissingTransform {
-                            parent: base_frame.clone(),
-                            child: lidar_frame.clone(),
-                            stamp: stamps.first().copied().unwrap_or(0.0),
-                        },
-                    )
-                })?
-        };
-        let clouds = stamps
-            .iter()
-            .filter(|&&t| t >= span.0 && t <= span.1)
-            .count();
-        // The first cloud decides the layout and the time unit.
-        let mut decoder = PointCloud2Decoder::new(config.cloud);
-        let layout = Self::first_layout(path, format, &cloud_topic, &mut decoder)?;
-        let (first, last) = s
-            .topics
-            .values()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
-                (a.min(t.first), b.max(t.last))
-            });
-        let summary = BagSummary {
-            path: path.to_path_buf(),
-            format,
-            topics: s.topics.into_values().collect(),
-            duration: if last >= first { last - first } else { 0.0 },
-            cloud_topic,
-            layout,
-            odometry,
-            base_frame,
-            lidar_frame,
-            body_t_lidar,
-            clouds,
-            clouds_outside_odometry: stamps.len() - clouds,
-        };
-        Ok(Self {
-            summary,
-            fixed: s.fixed,
-            span,
-            decoder,
         })
+    }
+
+    /// `body_T_lidar` from the fixed transforms; `None` when they do not join the two frames.
+    fn mounting(fixed: &FrameTree, base_frame: &str, lidar_frame: &str) -> Option<Pose3> {
+        if base_frame == lidar_frame {
+            return Some(Pose3::identity());
+        }
+        fixed
+            .lookup(base_frame, lidar_frame, 0.0)
+            .filter(|_| fixed.is_fixed_between(base_frame, lidar_frame))
+    }
+
+    /// The cloud topic: the one asked for, else the only one.
+    fn cloud_topic(path: &Path, s: &Survey, config: &BagConfig) -> Result<String, AdapterError> {
+        if let Some(t) = &config.cloud_topic {
+            check_topic_type(path, &s.topics, t, RosMessageType::PointCloud2)?;
+            return Ok(t.clone());
+        }
+        match of_type(s, RosMessageType::PointCloud2).as_slice() {
+            [one] => Ok((*one).to_owned()),
+            [] => Err(bad(
+                path,
+                format!(
+                    "no sensor_msgs/PointCloud2 topic; the bag has {}",
+                    listing(&s.topics)
+                ),
+            )),
+            many => Err(bad(
+                path,
+                format!("several cloud topics ({}): choose one", many.join(", ")),
+            )),
+        }
+    }
+
+    /// The odometry: the one asked for, else (`Auto`) the only odometry topic when its child
+    /// frame reaches the LiDAR frame in `tree`, else `/tf` from `odom` unless its only moving
+    /// child does not reach it, else none; what is left out gets a note.
+    fn odometry(
+        path: &Path,
+        s: &Survey,
+        config: &BagConfig,
+        tree: &FrameTree,
+        lidar_frame: &str,
+    ) -> Result<OdometryChoice, AdapterError> {
+        let chosen = |odometry| OdometryChoice {
+            odometry,
+            notes: Vec::new(),
+        };
+        match &config.odometry {
+            OdometrySource::Topic(t) => {
+                check_topic_type(path, &s.topics, t, RosMessageType::Odometry)?;
+                return Ok(chosen(ResolvedOdometry::Topic(t.clone())));
+            }
+            OdometrySource::Tf { odom_frame } => {
+                return Ok(chosen(ResolvedOdometry::Tf {
+                    odom_frame: odom_frame.clone(),
+                }));
+            }
+            OdometrySource::None => return Ok(chosen(ResolvedOdometry::None)),
+            OdometrySource::Auto => {}
+        }
+        // Whether a body frame reaches the clouds' through any transform. A LiDAR frame given is
+        // the user's word: the odometry is then taken as found, and a body frame that does not
+        // reach it is an error, not a reason to drop the odometry.
+        let reaches = |frame: &str| {
+            config.lidar_frame.is_some()
+                || (!frame.is_empty() && tree.is_joined(frame, lidar_frame))
+        };
+        let unlinked = |what: String, frame: &str| {
+            format!(
+                "{what} ignored: child frame {frame:?} is not linked to the cloud frame {lidar_frame:?}"
+            )
+        };
+        // What was left out, and what to pass to use it.
+        let mut left_out = Vec::new();
+        match of_type(s, RosMessageType::Odometry).as_slice() {
+            [one] => {
+                let child = s.odometry.get(*one).map_or("", |o| o.3.as_str());
+                if reaches(child) {
+                    return Ok(chosen(ResolvedOdometry::Topic((*one).to_owned())));
+                }
+                left_out.push((
+                    unlinked(format!("odometry topic {one}"), child),
+                    format!("--odom-topic {one} --base-frame F to use it"),
+                ));
+            }
+            [] => {}
+            many => left_out.push((
+                format!(
+                    "several nav_msgs/Odometry topics ({}), none taken",
+                    many.join(", ")
+                ),
+                "--odom-topic T to use one".to_owned(),
+            )),
+        }
+        let odometry = match s.moving.moving_children("odom").as_slice() {
+            [] => ResolvedOdometry::None,
+            [one] if !reaches(one) => {
+                left_out.push((
+                    unlinked("/tf from \"odom\"".to_owned(), one),
+                    "--odom-frame odom --base-frame F to use it".to_owned(),
+                ));
+                ResolvedOdometry::None
+            }
+            _ => ResolvedOdometry::Tf {
+                odom_frame: "odom".into(),
+            },
+        };
+        let instead = match &odometry {
+            ResolvedOdometry::None => "running LiDAR-only",
+            _ => "using /tf from \"odom\" instead",
+        };
+        let notes = left_out
+            .into_iter()
+            .map(|(what, hint)| format!("{what}; {instead} (pass {hint})"))
+            .collect();
+        Ok(OdometryChoice { odometry, notes })
     }
 
     /// Decode the first cloud of `topic` (stopping there), deciding the time unit when it can.

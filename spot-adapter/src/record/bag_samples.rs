@@ -1,7 +1,8 @@
 //! A bag's samples read one message at a time: clouds decoded when their message comes, held
-//! until the odometry after their stamp has been read, then given with `odom_T_body`
-//! interpolated at the stamp and the fixed `body_T_lidar`. Moving transforms and odometry older
-//! than the oldest waiting cloud are forgotten, so memory does not grow with the bag.
+//! until the odometry (and, with an IMU, the gyro reading) after their stamp has been read, then
+//! given with `odom_T_body` interpolated at the stamp, the fixed `body_T_lidar` and the gyro's
+//! orientation there. Moving transforms, odometry and gyro readings older than the oldest
+//! waiting cloud are forgotten, so memory does not grow with the bag.
 
 use std::collections::{HashMap, VecDeque};
 
@@ -13,6 +14,7 @@ use crate::record::bag::{
 };
 use crate::record::bag_file::{BagMessages, RawMessage};
 use crate::record::frame_tree::{FrameTree, PoseSeries};
+use crate::record::imu::GyroIntegrator;
 use crate::record::no_return::DroppedPoints;
 use crate::record::ros_messages::{ImuReading, RosMessageType};
 use crate::robot::Sample;
@@ -30,6 +32,10 @@ pub struct BagSamples {
     dropped: DroppedPoints,
     imu: Vec<ImuReading>,
     imu_before_last: Vec<ImuReading>,
+    /// The IMU topic's gyro integrated, when the summary names one.
+    gyro: Option<GyroIntegrator>,
+    /// Every message has been read.
+    exhausted: bool,
     left: usize,
     done: bool,
 }
@@ -42,7 +48,13 @@ enum OdometryAt {
 
 impl BagSamples {
     pub(super) fn new(bag: Bag, messages: BagMessages) -> Self {
+        let gyro = bag
+            .summary
+            .imu
+            .as_ref()
+            .map(|imu| GyroIntegrator::new(&imu.frame, imu.body_r_imu));
         Self {
+            gyro,
             messages,
             tree: bag.fixed.clone(),
             left: bag.summary.clouds,
@@ -53,8 +65,22 @@ impl BagSamples {
             dropped: DroppedPoints::default(),
             imu: Vec::new(),
             imu_before_last: Vec::new(),
+            exhausted: false,
             done: false,
         }
+    }
+
+    /// Whether the gyro orientation at `stamp` is known, or will never be: no IMU, a stamp
+    /// outside its readings, a reading at or after it read, or the bag read to its end.
+    fn gyro_ready(&self, stamp: f64) -> bool {
+        let (Some(gyro), Some(imu)) = (&self.gyro, &self.bag.summary.imu) else {
+            return true;
+        };
+        self.exhausted
+            || imu
+                .span
+                .is_none_or(|(first, last)| stamp < first || stamp > last)
+            || gyro.last_stamp().is_some_and(|t| t >= stamp)
     }
 
     /// Points removed from the clouds delivered so far.
@@ -126,6 +152,7 @@ impl BagSamples {
             return Ok(());
         }
         let odometry_topic = matches!(&summary.odometry, ResolvedOdometry::Topic(t) if t == name);
+        let imu_topic = summary.imu.as_ref().is_some_and(|imu| imu.topic == *name);
         let tf = tf_kind(name).is_some();
         if !(odometry_topic || tf || msg.topic.message_type == Some(RosMessageType::Imu)) {
             return Ok(());
@@ -144,10 +171,37 @@ impl BagSamples {
                     );
                 }
             }
-            Some(Decoded::Imu(reading)) => self.imu.push(reading),
+            Some(Decoded::Imu(reading)) => {
+                if let Some(gyro) = self.gyro.as_mut().filter(|_| imu_topic) {
+                    gyro.push(&reading);
+                }
+                self.imu.push(reading);
+            }
             _ => {}
         }
         Ok(())
+    }
+
+    /// The first waiting cloud as a sample, with `odom_T_body` at its stamp.
+    fn deliver(&mut self, odom_t_body: Pose3) -> Option<Sample> {
+        let (_, stamp, cloud) = self.pending.pop_front()?;
+        let gyro_orientation = self.gyro.as_mut().and_then(|g| g.sample_orientation(stamp));
+        // The next cloud's stamp (or this one's) bounds what is still needed.
+        let keep_from = self.pending.front().map_or(stamp, |p| p.1.min(stamp));
+        self.odometry.prune_before(keep_from);
+        self.tree.prune_before(keep_from);
+        if let Some(gyro) = self.gyro.as_mut() {
+            gyro.prune_before(keep_from);
+        }
+        self.imu_before_last = std::mem::take(&mut self.imu);
+        Some(Sample {
+            stamp,
+            odom_t_body,
+            body_t_lidar: self.bag.summary.body_t_lidar,
+            cloud,
+            ground_truth: None,
+            gyro_orientation,
+        })
     }
 
     fn next_sample(&mut self) -> Result<Option<Sample>, AdapterError> {
@@ -161,39 +215,32 @@ impl BagSamples {
                         e,
                     )
                 })?;
-                if let OdometryAt::Known(odom_t_body) = known {
-                    let Some((_, _, cloud)) = self.pending.pop_front() else {
-                        continue;
-                    };
-                    // The next cloud's stamp (or this one's) bounds what is still needed.
-                    let keep_from = self.pending.front().map_or(stamp, |p| p.1.min(stamp));
-                    self.odometry.prune_before(keep_from);
-                    self.tree.prune_before(keep_from);
-                    self.imu_before_last = std::mem::take(&mut self.imu);
-                    return Ok(Some(Sample {
-                        stamp,
-                        odom_t_body,
-                        body_t_lidar: self.bag.summary.body_t_lidar,
-                        cloud,
-                        ground_truth: None,
-                    }));
+                match known {
+                    OdometryAt::Known(odom_t_body) if self.gyro_ready(stamp) => {
+                        return Ok(self.deliver(odom_t_body));
+                    }
+                    OdometryAt::NotYet if self.exhausted => {
+                        let summary = &self.bag.summary;
+                        return Err(message_error(
+                            &summary.path,
+                            &summary.cloud_topic,
+                            index,
+                            MessageError::MissingTransform {
+                                parent: "odometry".into(),
+                                child: summary.base_frame.clone(),
+                                stamp,
+                            },
+                        ));
+                    }
+                    _ => {}
                 }
             }
-            let Some(msg) = self.messages.next() else {
-                if let Some(&(index, stamp, _)) = self.pending.front() {
-                    let summary = &self.bag.summary;
-                    return Err(message_error(
-                        &summary.path,
-                        &summary.cloud_topic,
-                        index,
-                        MessageError::MissingTransform {
-                            parent: "odometry".into(),
-                            child: summary.base_frame.clone(),
-                            stamp,
-                        },
-                    ));
-                }
+            if self.exhausted {
                 return Ok(None);
+            }
+            let Some(msg) = self.messages.next() else {
+                self.exhausted = true;
+                continue;
             };
             self.take(&msg?)?;
         }

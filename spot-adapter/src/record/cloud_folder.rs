@@ -257,6 +257,7 @@ impl Iterator for CloudFolderSamples {
             body_t_lidar: f.body_t_lidar,
             cloud,
             ground_truth: None,
+            gyro_orientation: None,
         }))
     }
 

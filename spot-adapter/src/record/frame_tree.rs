@@ -169,6 +169,13 @@ impl FrameTree {
         Some(a_t_parent.inverse() * a_t_child)
     }
 
+    /// Whether a chain of edges (fixed or moving, whatever the stamps they cover) joins `a` and
+    /// `b`; a frame is joined to itself.
+    #[must_use]
+    pub fn is_joined(&self, a: &str, b: &str) -> bool {
+        a == b || self.joined(a, b).is_some()
+    }
+
     /// Whether `parent` and `child` are joined by fixed edges only.
     #[must_use]
     pub fn is_fixed_between(&self, parent: &str, child: &str) -> bool {
@@ -202,6 +209,14 @@ impl FrameTree {
                 Edge::Fixed(p) => Some((parent.as_str(), child.as_str(), *p)),
                 Edge::Moving(_) => None,
             })
+    }
+
+    /// The moving edges: (parent, child).
+    pub fn moving_edges(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.edges
+            .iter()
+            .filter(|(_, (_, edge))| matches!(edge, Edge::Moving(_)))
+            .map(|(child, (parent, _))| (parent.as_str(), child.as_str()))
     }
 
     /// Forget moving poses not needed from `stamp` on.
@@ -259,6 +274,12 @@ mod tests {
         assert!((back * mid).translation.vector.norm() < 1e-12);
         assert!(tree.lookup("odom", "base_link", 2.5).is_none());
         assert!(tree.lookup("odom", "camera", 1.5).is_none());
+        assert!(tree.is_joined("lidar", "odom") && tree.is_joined("camera", "camera"));
+        assert!(!tree.is_joined("odom", "camera"));
+        assert_eq!(
+            tree.moving_edges().collect::<Vec<_>>(),
+            vec![("odom", "base_link")]
+        );
         tree.prune_before(1.8);
         assert_eq!(tree.known_span("odom", "lidar"), Some((1.0, 2.0)));
         assert!(tree.is_fixed_between("lidar", "base_link"));

@@ -182,6 +182,7 @@ impl KittiSequence {
                     body_t_lidar: self.body_t_lidar,
                     cloud,
                     ground_truth: gt,
+                    gyro_orientation: None,
                 }),
         )
     }

@@ -6,7 +6,7 @@
 //! - folders of PCD or PLY scans with an optional TUM odometry file ([`CloudFolder`]);
 //! - ROS 1 bags and ROS 2 bags in MCAP ([`Bag`]): `sensor_msgs/PointCloud2` in any field
 //!   layout ([`PointCloud2Decoder`]), `nav_msgs/Odometry`, `tf2_msgs/TFMessage`,
-//!   `sensor_msgs/Imu`.
+//!   `sensor_msgs/Imu` (its gyro integrated into the body's orientation, [`GyroIntegrator`]).
 //!
 //! Every reader removes no-return points (exact zeros, points inside a minimum range) and
 //! non-finite ones, and counts them ([`ReturnFilter`], [`DroppedPoints`]). A source without
@@ -56,10 +56,13 @@
 
 mod bag;
 mod bag_file;
+mod bag_frames;
+mod bag_imu;
 mod bag_samples;
 mod bounded_file;
 mod cloud_folder;
 mod frame_tree;
+mod imu;
 mod kitti;
 mod mcap_file;
 mod no_return;
@@ -72,10 +75,13 @@ mod wire;
 
 pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
 pub use bag_file::{BagFormat, TopicInfo};
+pub use bag_frames::BagFrames;
+pub use bag_imu::{ImuSource, ImuSummary};
 pub use bag_samples::BagSamples;
 pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
 pub use frame_tree::{FrameTree, PoseSeries};
+pub use imu::{GyroCounts, GyroIntegrator, GyroStep, MAX_GYRO_GAP};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
 pub use no_return::{DroppedPoints, PointKind, ReturnFilter};
 pub use point_cloud2::{

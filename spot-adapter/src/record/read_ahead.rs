@@ -161,6 +161,7 @@ mod tests {
                     .collect(),
             ),
             ground_truth: None,
+            gyro_orientation: None,
         }
     }
 

@@ -602,6 +602,7 @@ impl Iterator for RecordingSamples {
                     body_t_lidar: self.body_t_lidar,
                     cloud,
                     ground_truth: entry.ground_truth,
+                    gyro_orientation: None,
                 }),
         )
     }

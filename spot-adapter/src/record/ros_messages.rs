@@ -232,7 +232,8 @@ pub(crate) fn decode_tf_message(
     Ok(out)
 }
 
-/// `sensor_msgs/Imu`, kept for later use (the engine does not fuse it yet).
+/// `sensor_msgs/Imu`: its angular velocity gives the samples' gyro orientation
+/// ([`GyroIntegrator`](crate::record::GyroIntegrator)); the rest is decoded for later use.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImuReading {
     /// Seconds.

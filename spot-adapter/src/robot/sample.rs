@@ -1,6 +1,7 @@
 //! `Sample`: one LiDAR scan with the robot's odometry and the sensor's mounting, as every source
 //! (live robot, simulator, recording) delivers it to the SLAM engine.
 
+use nalgebra::UnitQuaternion;
 use slam_core::{PointCloud, Pose3, ScanInput};
 
 /// One scan and what the robot knew when it was taken.
@@ -17,10 +18,16 @@ pub struct Sample {
     /// Ground truth `world_T_body` when the source knows it (simulator, recordings with ground
     /// truth, KITTI poses). For evaluation only: never feed it to the estimator.
     pub ground_truth: Option<Pose3>,
+    /// The body's orientation at `stamp` integrated from a gyro since the start of the recording
+    /// (`start_R_body`): it drifts, but its change between two samples is the body's rotation
+    /// between them. `None` when the source has no IMU, outside the IMU's readings, and for the
+    /// first sample after a gap in them (so that two consecutive samples that both have one are
+    /// joined by integrated readings). Bags: see [`GyroIntegrator`](crate::record::GyroIntegrator).
+    pub gyro_orientation: Option<UnitQuaternion<f64>>,
 }
 
 impl Sample {
-    /// The sample as the Graph-SLAM engine's input (ground truth left out).
+    /// The sample as the Graph-SLAM engine's input (ground truth and gyro left out).
     #[must_use]
     pub fn scan_input(&self) -> ScanInput<'_> {
         ScanInput {

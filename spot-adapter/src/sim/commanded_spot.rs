@@ -155,6 +155,7 @@ impl CommandedSpot {
                 .lidar
                 .scan_at_rest(&self.building, &world_t_lidar, &mut self.noise),
             ground_truth: Some(world_t_body),
+            gyro_orientation: None,
         }
     }
 

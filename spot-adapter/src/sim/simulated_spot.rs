@@ -235,6 +235,7 @@ impl Iterator for SimulatedSpot {
             body_t_lidar: self.body_t_lidar,
             cloud,
             ground_truth: Some(world_t_body),
+            gyro_orientation: None,
         })
     }
 

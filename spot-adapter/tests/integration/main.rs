@@ -6,6 +6,8 @@
 mod common;
 
 mod aliasing;
+mod bag_frames;
+mod bag_gyro;
 mod bags;
 mod bounded_work;
 mod building;
