@@ -9,7 +9,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 use spot_adapter::sim::{
-    Building, BuildingConfig, Route, SimRng, SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
+    Building, BuildingConfig, LidarConfig, Route, SimRng, SimulatedSpot, SimulationConfig,
+    SpinningLidar,
 };
 
 fn sim(c: &mut Criterion) {
@@ -18,7 +19,7 @@ fn sim(c: &mut Criterion) {
         eprintln!("building generation failed: {e}");
         std::process::exit(1)
     });
-    let lidar = Vlp16::new(Vlp16Config::default()).unwrap_or_else(|e| {
+    let lidar = SpinningLidar::new(LidarConfig::default()).unwrap_or_else(|e| {
         eprintln!("lidar model failed: {e}");
         std::process::exit(1)
     });
