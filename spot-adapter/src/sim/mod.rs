@@ -1,7 +1,7 @@
 //! The test world (cargo feature `sim`, on by default): a procedurally generated building, ray
 //! casting, a spinning LiDAR model (a VLP-16 by default, an Ouster OS1-128 or any ring layout),
 //! Spot's drifting leg odometry, routes, and two simulated Spots: one that moves along a route
-//! fixed in advance ([`SimulatedSpot`], an iterator of samples with ground truth; Spot's gentle
+//! fixed in advance ([`SimulatedSpot`], an iterator of samples with ground truth; Spot's
 //! walk, Spot turning at corners at its full yaw rate, or a person carrying the LiDAR, see
 //! [`MotionProfile`]) and one driven by motion commands ([`CommandedSpot`], a
 //! [`Robot`](crate::robot::Robot)). [`CloudFolderWriter`] writes a run as a folder of scans

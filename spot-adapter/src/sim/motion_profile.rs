@@ -1,4 +1,4 @@
-//! How the simulated sensor moves along its route: Spot's gentle walk, Spot turning at corners
+//! How the simulated sensor moves along its route: Spot's walk, Spot turning at corners
 //! at its full yaw rate, or a person carrying the LiDAR.
 
 use crate::error::AdapterError;
@@ -10,14 +10,18 @@ use crate::sim::setting_checks::require_positive;
 #[non_exhaustive]
 pub enum MotionProfile {
     /// Spot walks at a constant [`SimulationConfig::speed`](crate::sim::SimulationConfig::speed)
-    /// with its heading along a 1.2 m chord of the route, so it turns gently through corners
-    /// (at 0.6 m/s about 0.5 rad/s at most, 6° between 5 Hz scans). One sample per LiDAR sweep.
+    /// with its heading along a 1.2 m chord of the route, so it turns through a corner while
+    /// walking on, over 1.2 m (at 0.6 m/s the turn rate rises to 1 rad/s at the corner itself;
+    /// about four pairs of 5 Hz scans differ by more than 10° at a right-angled corner). One
+    /// sample per LiDAR sweep.
     #[default]
     Walk,
     /// Spot walks each leg at [`SimulationConfig::speed`](crate::sim::SimulationConfig::speed),
     /// stops at each corner and turns in place at its full yaw rate
-    /// ([`MotionLimits::max_yaw_rate`](crate::robot::MotionLimits::max_yaw_rate), 1 rad/s: about
-    /// 11.5° between 5 Hz scans). One sample per LiDAR sweep.
+    /// ([`MotionLimits::max_yaw_rate`](crate::robot::MotionLimits::max_yaw_rate), 1 rad/s) for
+    /// as long as the corner takes: 11.5° between 5 Hz scans, with no translation, for about
+    /// 1.6 s of a right-angled corner (six pairs of scans differ by more than 10°). One sample
+    /// per LiDAR sweep.
     FastTurns(FastTurnsConfig),
     /// A person carries the LiDAR: a brisk walk with a shaking hand, quick turns at the
     /// corners, samples at a lower rate than the sweeps (each sample is one sweep, the others

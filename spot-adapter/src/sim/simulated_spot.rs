@@ -35,7 +35,7 @@ pub struct SimulationConfig {
     /// The LiDAR, a VLP-16 by default; Spot takes one sample per sweep, so its
     /// `rotation_rate` (5 Hz) is the sample rate.
     pub lidar: LidarConfig,
-    /// How the robot (or a person carrying the LiDAR) moves along the route: Spot's gentle
+    /// How the robot (or a person carrying the LiDAR) moves along the route: Spot's
     /// walk by default.
     pub motion: MotionProfile,
     /// The odometry's drift.
