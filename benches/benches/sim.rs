@@ -1,5 +1,7 @@
-//! The simulated Spot: one full VLP-16 scan (16 x 1800 = 28,800 rays) against a generated
-//! building, the building's generation, and one whole simulated sample (pose, odometry, scan).
+//! The simulated Spot: one full VLP-16 scan (16 x 1800 = 28,800 rays) and one OS1-128 scan
+//! (128 x 1024 = 131,072 rays) against a generated building, the building's generation, and one
+//! whole simulated sample (pose, odometry, scan) of Spot's walk and of a handheld OS1-128 walk
+//! (motion-distorted, each column from the true pose at its firing time).
 //!
 //! `cargo bench -p spot-nav-benches --bench sim`
 
@@ -9,7 +11,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 use spot_adapter::sim::{
-    Building, BuildingConfig, Route, SimRng, SimulatedSpot, SimulationConfig, Vlp16, Vlp16Config,
+    Building, BuildingConfig, LidarConfig, MotionProfile, Route, SimRng, SimulatedSpot,
+    SimulationConfig, SpinningLidar,
 };
 
 fn sim(c: &mut Criterion) {
@@ -18,7 +21,7 @@ fn sim(c: &mut Criterion) {
         eprintln!("building generation failed: {e}");
         std::process::exit(1)
     });
-    let lidar = Vlp16::new(Vlp16Config::default()).unwrap_or_else(|e| {
+    let lidar = SpinningLidar::new(LidarConfig::default()).unwrap_or_else(|e| {
         eprintln!("lidar model failed: {e}");
         std::process::exit(1)
     });
@@ -49,6 +52,17 @@ fn sim(c: &mut Criterion) {
             black_box(lidar.scan_moving(&building, &poses[k], &end, &mut rng))
         });
     });
+    let os1 = SpinningLidar::new(LidarConfig::os1_128()).unwrap_or_else(|e| {
+        eprintln!("lidar model failed: {e}");
+        std::process::exit(1)
+    });
+    group.throughput(Throughput::Elements(os1.directions().len() as u64));
+    group.bench_function("os1_128_scan", |b| {
+        b.iter(|| {
+            k = (k + 1) % poses.len();
+            black_box(os1.scan(&building, &poses[k], &mut rng))
+        });
+    });
     group.throughput(Throughput::Elements(1));
     group.bench_function("building_generate", |b| {
         b.iter(|| black_box(Building::generate(black_box(7), &BuildingConfig::default())));
@@ -56,6 +70,17 @@ fn sim(c: &mut Criterion) {
     group.bench_function("simulated_sample", |b| {
         b.iter_batched(
             || SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(1)),
+            |sim| black_box(sim.map(|mut s| s.next())),
+            criterion::BatchSize::LargeInput,
+        );
+    });
+    let mut handheld = SimulationConfig::with_seed(1);
+    handheld.lidar = LidarConfig::os1_128();
+    handheld.motion = MotionProfile::handheld();
+    handheld.motion_distortion = true;
+    group.bench_function("handheld_os1_128_sample", |b| {
+        b.iter_batched(
+            || SimulatedSpot::corridor_loop(&handheld),
             |sim| black_box(sim.map(|mut s| s.next())),
             criterion::BatchSize::LargeInput,
         );

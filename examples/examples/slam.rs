@@ -30,7 +30,7 @@ use spot_adapter::record::{
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_nav_examples::{Registration, map_and_evaluate, out, parse_numbers};
+use spot_nav_examples::{Motion, Registration, Sensor, map_and_evaluate, out, parse_numbers};
 
 /// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
 const INFLATION: f64 = 0.30;
@@ -135,11 +135,19 @@ struct Args {
     /// Simulate scans cast while walking (motion distortion, 12 cm per sweep).
     #[arg(long, conflicts_with = "recording")]
     skewed: bool,
+    /// The simulated LiDAR: a VLP-16 (5 Hz) or an Ouster OS1-128 (10 Hz).
+    #[arg(long, value_enum, value_name = "SENSOR", default_value_t = Sensor::Vlp16, conflicts_with = "recording")]
+    sensor: Sensor,
+    /// How the simulated LiDAR moves: Spot's walk, Spot turning corners in place at 1 rad/s,
+    /// or a person carrying it (1.2 m/s, shaking, quick turns, a sample every 0.5 s).
+    #[arg(long, value_enum, value_name = "MOTION", default_value_t = Motion::Walk, conflicts_with = "recording")]
+    motion: Motion,
     /// Simulate a blank north corridor: plain walls and shut doors, where LiDAR odometry has
     /// little to hold on to along the corridor.
     #[arg(long, conflicts_with = "recording")]
     blank_corridor: bool,
-    /// The simulated LiDAR's largest range (metres; default 100).
+    /// The simulated LiDAR's largest range (metres; default the sensor's: 100 for the VLP-16,
+    /// 120 for the OS1-128).
     #[arg(
         long,
         value_name = "M",
@@ -275,6 +283,8 @@ fn slam(args: &Args) -> Result<()> {
         Ok(())
     } else {
         let mut sim_config = SimulationConfig::with_seed(args.seed);
+        sim_config.lidar = args.sensor.lidar();
+        sim_config.motion = args.motion.profile();
         sim_config.motion_distortion = args.skewed;
         sim_config.building.blank_corridor = args.blank_corridor;
         if let Some(range) = args.lidar_range {

@@ -1,6 +1,7 @@
 //! What the spot-nav examples share: where the bundled data lives, command-line pieces (backend
-//! choices, `X,Y` goals), standard output that ends quietly on a closed pipe, progress on stderr,
-//! timing summaries, and the map-and-evaluate loop of the `slam` and `mission` examples.
+//! choices, `X,Y` goals, the simulator's sensor and motion), standard output that ends quietly
+//! on a closed pipe, progress on stderr, timing summaries, and the map-and-evaluate loop of the
+//! `slam` and `mission` examples.
 //!
 //! Every example's `main` is a one-liner around [`run`], which gives each failure an exit
 //! status of 1 and a one-line reason on stderr:
@@ -26,10 +27,12 @@ pub mod mapping;
 pub mod output;
 pub mod picture;
 pub mod progress;
+pub mod sim_options;
 pub mod stats;
 
 pub use args::{Registration, parse_goal, parse_numbers, value_name};
 pub use mapping::{Mapping, map_and_evaluate};
 pub use output::{StdoutClosed, run, write_line};
 pub use progress::Progress;
+pub use sim_options::{Motion, Sensor};
 pub use stats::{Timings, quantile};

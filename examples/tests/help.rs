@@ -76,7 +76,23 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
         ],
     ),
     ("scan_stats", &["FILE"]),
-    ("simulate", &["--seed", "--out"]),
+    (
+        "simulate",
+        &[
+            "--seed",
+            "--sensor",
+            "--motion",
+            "--skewed",
+            "--out",
+            "--cloud-folder",
+            "--cloud-format",
+            "vlp16",
+            "os1-128",
+            "walk",
+            "fast-turns",
+            "handheld",
+        ],
+    ),
     (
         "slam",
         &[
@@ -89,6 +105,10 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--seed",
             "--registration",
             "--skewed",
+            "--sensor",
+            "--motion",
+            "os1-128",
+            "handheld",
             "--no-deskew",
             "--no-odometry",
             "--blank-corridor",
@@ -228,6 +248,19 @@ fn simulate_rejects_a_malformed_seed() {
 }
 
 #[test]
+fn simulate_rejects_an_unknown_sensor_motion_or_format() {
+    rejected("simulate", &["--sensor", "hdl64"], "--sensor");
+    rejected("simulate", &["--motion", "run"], "--motion");
+    rejected(
+        "simulate",
+        &["--cloud-folder", "dir", "--cloud-format", "las"],
+        "--cloud-format",
+    );
+    // A format with no folder to write is a mistake, not a silent no-op.
+    rejected("simulate", &["--cloud-format", "pcd"], "--cloud-folder");
+}
+
+#[test]
 fn slam_rejects_a_malformed_seed() {
     rejected("slam", &["--seed", "1.5"], "--seed");
 }
@@ -237,6 +270,9 @@ fn slam_refuses_simulator_options_with_a_recording() {
     rejected("slam", &["scans", "--blank-corridor"], "--blank-corridor");
     rejected("slam", &["scans", "--lidar-range", "25"], "--lidar-range");
     rejected("slam", &["scans", "--skewed"], "--skewed");
+    rejected("slam", &["scans", "--sensor", "os1-128"], "--sensor");
+    rejected("slam", &["scans", "--motion", "handheld"], "--motion");
+    rejected("slam", &["--motion", "jog"], "--motion");
 }
 
 /// `slam args` fails as a job (status 1, one line) naming `setting`, before it maps anything.

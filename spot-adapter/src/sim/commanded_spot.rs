@@ -10,7 +10,7 @@ use crate::robot::{
     VelocityCommand,
 };
 use crate::sim::building::Building;
-use crate::sim::lidar::Vlp16;
+use crate::sim::lidar::SpinningLidar;
 use crate::sim::odometry::OdometryModel;
 use crate::sim::rng::SimRng;
 use crate::sim::simulated_spot::SimulationConfig;
@@ -80,7 +80,7 @@ enum Active {
 #[derive(Clone, Debug)]
 pub struct CommandedSpot {
     building: Building,
-    lidar: Vlp16,
+    lidar: SpinningLidar,
     odometry: OdometryModel,
     noise: SimRng,
     description: RobotDescription,
@@ -109,7 +109,7 @@ impl CommandedSpot {
         yaw: f64,
         config: &SimulationConfig,
     ) -> Result<Self, AdapterError> {
-        let lidar = Vlp16::new(config.lidar.clone())?;
+        let lidar = SpinningLidar::new(config.lidar.clone())?;
         config.limits.validate()?;
         if !yaw.is_finite() {
             return Err(AdapterError::invalid("yaw", yaw, "finite (radians)"));

@@ -1,5 +1,6 @@
-//! A Velodyne VLP-16 model: 16 rings, a full turn of azimuth columns, Gaussian range noise and
-//! optional dropouts, ray-cast against the [`Building`].
+//! A spinning multi-beam LiDAR (Velodyne VLP-16, Ouster OS1-128 or any ring layout): rings of
+//! beams at fixed elevations swept through a full turn of azimuth columns, Gaussian range noise
+//! and optional dropouts, ray-cast against the [`Building`].
 
 use nalgebra::{Point3, Vector3};
 use slam_core::{PointCloud, Pose3, interpolate};
@@ -8,37 +9,48 @@ use crate::error::AdapterError;
 use crate::sim::building::Building;
 use crate::sim::rng::SimRng;
 
-/// VLP-16 parameters. Angles in radians, ranges in metres, rates in hertz.
+/// A spinning LiDAR's parameters. Angles in radians, ranges in metres, rates in hertz.
 ///
-/// The defaults follow the data sheet where the issue does not fix a value: 16 rings from -15°
-/// to +15° in 2° steps, 1800 columns (0.2° azimuth; the real sensor gives 0.2° at 10 Hz and 0.1°
-/// at 5 Hz), 100 m range, 1.5 cm range noise (the data sheet's ±3 cm "typical accuracy" read as
-/// two sigma), no dropouts, 5 Hz.
+/// The rings are evenly spaced in elevation, ring 0 the lowest; each column fires every ring at
+/// once, columns evenly spaced in azimuth (counter-clockwise from the LiDAR's x axis) over one
+/// turn. [`Default`] is [`LidarConfig::vlp16`]; [`LidarConfig::os1_128`] is an Ouster OS1-128.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
-pub struct Vlp16Config {
-    /// Elevation of the lowest ring, -15° (radians).
+pub struct LidarConfig {
+    /// Elevation of the lowest ring (radians): -15° for the VLP-16.
     pub lowest_elevation: f64,
-    /// Elevation step between rings, 2° (radians).
+    /// Elevation step between rings (radians): 2° for the VLP-16.
     pub ring_spacing: f64,
-    /// Number of rings, 16.
+    /// Number of rings: 16 for the VLP-16.
     pub rings: u16,
-    /// Azimuth columns per turn, 1800.
+    /// Azimuth columns per turn: 1800 for the VLP-16.
     pub columns: u32,
-    /// Largest range returned, 100 m.
+    /// Largest range returned (metres): 100 m for the VLP-16.
     pub max_range: f64,
-    /// Smallest range returned, 0.5 m (closer returns are dropped, as the sensor does).
+    /// Smallest range returned (metres; closer returns are dropped, as the sensor does): 0.5 m
+    /// for the VLP-16.
     pub min_range: f64,
-    /// Standard deviation of the Gaussian range noise, 0.015 m.
+    /// Standard deviation of the Gaussian range noise (metres): 0.015 m for the VLP-16.
     pub range_noise: f64,
     /// Probability that a return is lost, 0 by default (e.g. 0.02 for dark or glossy surfaces).
     pub dropout_probability: f64,
-    /// Turns per second, 5 Hz: one scan every 0.2 s.
+    /// Turns per second (hertz): 5 Hz for the VLP-16, one sweep every 0.2 s.
     pub rotation_rate: f64,
 }
 
-impl Default for Vlp16Config {
+impl Default for LidarConfig {
     fn default() -> Self {
+        Self::vlp16()
+    }
+}
+
+impl LidarConfig {
+    /// A Velodyne VLP-16, following the data sheet where the issue does not fix a value: 16
+    /// rings from -15° to +15° in 2° steps, 1800 columns (0.2° azimuth; the real sensor gives
+    /// 0.2° at 10 Hz and 0.1° at 5 Hz), 0.5-100 m, 1.5 cm range noise (the data sheet's ±3 cm
+    /// "typical accuracy" read as two sigma), no dropouts, 5 Hz.
+    #[must_use]
+    pub fn vlp16() -> Self {
         Self {
             lowest_elevation: (-15.0f64).to_radians(),
             ring_spacing: 2.0f64.to_radians(),
@@ -51,55 +63,66 @@ impl Default for Vlp16Config {
             rotation_rate: 5.0,
         }
     }
-}
 
-/// The sensor model with its ray directions computed once.
-///
-/// ```
-/// use nalgebra::{Translation3, UnitQuaternion};
-/// use spot_adapter::sim::{Building, BuildingConfig, SimRng, Vlp16, Vlp16Config};
-///
-/// let building = Building::generate(1, &BuildingConfig::default())?;
-/// let lidar = Vlp16::new(Vlp16Config::default())?;
-/// let start = building.corridor_loop()[0];
-/// let world_t_lidar = slam_core::Pose3::from_parts(
-///     Translation3::new(start.x, start.y, 0.8),
-///     UnitQuaternion::identity(),
-/// );
-/// let cloud = lidar.scan(&building, &world_t_lidar, &mut SimRng::new(1, 2));
-/// assert!(cloud.len() > 25_000, "walls, floor and ceiling return almost every ray");
-/// assert_eq!(cloud.ring().map(<[u16]>::len), Some(cloud.len()));
-/// # Ok::<(), spot_adapter::AdapterError>(())
-/// ```
-#[derive(Clone, Debug)]
-pub struct Vlp16 {
-    config: Vlp16Config,
-    /// Unit directions in the LiDAR frame, column-major (all rings of column 0 first).
-    directions: Vec<Vector3<f64>>,
-}
+    /// An Ouster OS1-128 in its usual 1024 x 10 Hz mode: 128 rings evenly from -22.5° to
+    /// +22.5° (0.354° apart), 1024 columns (0.35° azimuth), 10 Hz, 131,072 rays a sweep. From
+    /// the OS1 data sheet: 0.8-120 m (an 80 % reflective target) and 1.5 cm range noise (its
+    /// range repeatability at high signal, one sigma, which indoor walls a few metres away
+    /// give), no dropouts. Real beams have small per-beam azimuth offsets; these fire each
+    /// column at one azimuth.
+    #[must_use]
+    pub fn os1_128() -> Self {
+        let fov = 45.0f64.to_radians();
+        Self {
+            lowest_elevation: -0.5 * fov,
+            ring_spacing: fov / 127.0,
+            rings: 128,
+            columns: 1024,
+            max_range: 120.0,
+            min_range: 0.8,
+            range_noise: 0.015,
+            dropout_probability: 0.0,
+            rotation_rate: 10.0,
+        }
+    }
 
-impl Vlp16 {
-    /// The model for `config`.
+    /// Rays per sweep (`rings * columns`).
+    #[must_use]
+    pub fn rays(&self) -> usize {
+        usize::from(self.rings) * self.columns as usize
+    }
+
+    /// Elevation of the highest ring (radians).
+    #[must_use]
+    pub fn highest_elevation(&self) -> f64 {
+        self.lowest_elevation + self.ring_spacing * f64::from(self.rings.saturating_sub(1))
+    }
+
+    /// Every setting valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting: zero rings or columns, non-positive or non-finite
-    /// ranges, rates or angles, negative noise, or a dropout probability outside `[0, 1]`.
-    pub fn new(config: Vlp16Config) -> Result<Self, AdapterError> {
-        let c = &config;
+    /// [`AdapterError::InvalidConfig`] naming the first bad setting: zero rings or columns,
+    /// elevations outside ±90° or rings not spaced upwards, non-positive or non-finite ranges
+    /// or rates, negative noise, or a dropout probability outside `[0, 1]`.
+    pub fn validate(&self) -> Result<(), AdapterError> {
+        let c = self;
+        let right_angle = std::f64::consts::FRAC_PI_2;
         let checks = [
             ("rings", f64::from(c.rings), c.rings > 0, "at least 1"),
             ("columns", f64::from(c.columns), c.columns > 0, "at least 1"),
             (
                 "lowest_elevation",
                 c.lowest_elevation,
-                c.lowest_elevation.is_finite(),
-                "finite (radians)",
+                (-right_angle..=right_angle).contains(&c.lowest_elevation),
+                "within [-pi/2, pi/2] (radians)",
             ),
             (
                 "ring_spacing",
                 c.ring_spacing,
-                c.ring_spacing.is_finite(),
-                "finite (radians)",
+                c.ring_spacing.is_finite()
+                    && (c.rings < 2 || c.ring_spacing > 0.0)
+                    && c.highest_elevation() <= right_angle,
+                "finite, positive with several rings, the highest ring at most pi/2 (radians)",
             ),
             (
                 "min_range",
@@ -132,10 +155,49 @@ impl Vlp16 {
                 "finite and positive (hertz)",
             ),
         ];
-        if let Some(&(setting, value, _, expected)) = checks.iter().find(|c| !c.2) {
-            return Err(AdapterError::invalid(setting, value, expected));
+        match checks.iter().find(|c| !c.2) {
+            Some(&(setting, value, _, expected)) => {
+                Err(AdapterError::invalid(setting, value, expected))
+            }
+            None => Ok(()),
         }
-        let mut directions = Vec::with_capacity(c.rings as usize * c.columns as usize);
+    }
+}
+
+/// The sensor model with its ray directions computed once.
+///
+/// ```
+/// use nalgebra::{Translation3, UnitQuaternion};
+/// use spot_adapter::sim::{Building, BuildingConfig, SimRng, SpinningLidar, LidarConfig};
+///
+/// let building = Building::generate(1, &BuildingConfig::default())?;
+/// let lidar = SpinningLidar::new(LidarConfig::default())?;
+/// let start = building.corridor_loop()[0];
+/// let world_t_lidar = slam_core::Pose3::from_parts(
+///     Translation3::new(start.x, start.y, 0.8),
+///     UnitQuaternion::identity(),
+/// );
+/// let cloud = lidar.scan(&building, &world_t_lidar, &mut SimRng::new(1, 2));
+/// assert!(cloud.len() > 25_000, "walls, floor and ceiling return almost every ray");
+/// assert_eq!(cloud.ring().map(<[u16]>::len), Some(cloud.len()));
+/// # Ok::<(), spot_adapter::AdapterError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SpinningLidar {
+    config: LidarConfig,
+    /// Unit directions in the LiDAR frame, column-major (all rings of column 0 first).
+    directions: Vec<Vector3<f64>>,
+}
+
+impl SpinningLidar {
+    /// The model for `config`.
+    ///
+    /// # Errors
+    /// As [`LidarConfig::validate`].
+    pub fn new(config: LidarConfig) -> Result<Self, AdapterError> {
+        config.validate()?;
+        let c = &config;
+        let mut directions = Vec::with_capacity(c.rays());
         for col in 0..c.columns {
             let az = std::f64::consts::TAU * f64::from(col) / f64::from(c.columns);
             for ring in 0..c.rings {
@@ -152,7 +214,7 @@ impl Vlp16 {
 
     /// The configuration.
     #[must_use]
-    pub fn config(&self) -> &Vlp16Config {
+    pub fn config(&self) -> &LidarConfig {
         &self.config
     }
 
@@ -180,7 +242,7 @@ impl Vlp16 {
         self.cast(building, |_| *world_t_lidar, true, rng)
     }
 
-    /// As [`Vlp16::scan`], from a sensor that stood still during the sweep: every point's `time`
+    /// As [`SpinningLidar::scan`], from a sensor that stood still during the sweep: every point's `time`
     /// is 0, so a deskewing consumer leaves it alone (the points are the same).
     #[must_use]
     pub fn scan_at_rest(
@@ -194,7 +256,8 @@ impl Vlp16 {
 
     /// One full turn while the LiDAR moves from `start` (at time 0) to `end` (one sweep period
     /// later), each column cast from the pose interpolated at its firing time: the motion
-    /// distortion a real spinning LiDAR shows, for testing deskewing. Each point is in the LiDAR
+    /// distortion a real spinning LiDAR shows, for testing deskewing (for any other motion, see
+    /// [`SpinningLidar::scan_along`]). Each point is in the LiDAR
     /// frame at its own firing time, as the sensor reports it.
     #[must_use]
     pub fn scan_moving(
@@ -213,6 +276,33 @@ impl Vlp16 {
         )
     }
 
+    /// One full turn while the LiDAR follows a trajectory, `world_t_lidar_at(t)` with `t` in
+    /// seconds since the turn began: each column is cast from the pose at its firing time
+    /// (`col * column_period`, the `time` channel), so the sweep shows the motion distortion of
+    /// any motion, however long the gaps between the sweeps a source keeps. Each point is in the
+    /// LiDAR frame at its own firing time, as the sensor reports it.
+    #[must_use]
+    pub fn scan_along(
+        &self,
+        building: &Building,
+        world_t_lidar_at: impl Fn(f64) -> Pose3,
+        rng: &mut SimRng,
+    ) -> PointCloud {
+        let dt = self.column_period();
+        self.cast(
+            building,
+            |col| world_t_lidar_at(f64::from(col) * dt),
+            true,
+            rng,
+        )
+    }
+
+    /// Seconds between two columns' firings (`sweep_period / columns`).
+    #[must_use]
+    pub fn column_period(&self) -> f64 {
+        self.sweep_period() / f64::from(self.config.columns)
+    }
+
     /// Cast every ray, column `col` from `pose_of(col)`; `time` is each column's firing time when
     /// `firing_times`, else 0.
     fn cast(
@@ -229,7 +319,7 @@ impl Vlp16 {
         let mut times = Vec::with_capacity(n);
         let rings_per_col = c.rings as usize;
         let dt = if firing_times {
-            self.sweep_period() / f64::from(c.columns)
+            self.column_period()
         } else {
             0.0
         };

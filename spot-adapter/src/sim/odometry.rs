@@ -6,6 +6,7 @@ use slam_core::Pose3;
 
 use crate::error::AdapterError;
 use crate::sim::rng::SimRng;
+use crate::sim::setting_checks::require_non_negative;
 
 /// How the reported odometry drifts.
 ///
@@ -64,19 +65,11 @@ impl OdometryModel {
     /// outside `[-1, 1]`.
     pub fn new(config: OdometryDriftConfig, seed: u64) -> Result<Self, AdapterError> {
         let c = &config;
-        for (setting, value) in [
+        require_non_negative(&[
             ("drift_rate", c.drift_rate),
             ("yaw_noise", c.yaw_noise),
             ("translation_noise", c.translation_noise),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(AdapterError::invalid(
-                    setting,
-                    value,
-                    "finite and non-negative",
-                ));
-            }
-        }
+        ])?;
         if !(-1.0..=1.0).contains(&c.vertical_fraction) {
             return Err(AdapterError::invalid(
                 "vertical_fraction",

@@ -1,8 +1,9 @@
-//! The simulated Spot: walks a route through a [`Building`], scanning with a VLP-16 and
-//! reporting drifting odometry, one [`Sample`] per LiDAR turn.
+//! The simulated Spot: walks a route through a [`Building`] (or a person carries its LiDAR
+//! there), scanning with a spinning LiDAR and reporting drifting odometry, one [`Sample`] per
+//! LiDAR sweep kept.
 
-use slam_core::Pose3;
 use slam_core::io::StampedPose;
+use slam_core::{Pose3, interpolate};
 
 use crate::error::AdapterError;
 use crate::record::{Recording, RecordingWriter};
@@ -10,10 +11,14 @@ use crate::robot::{MotionLimits, Sample, SpotGeometry};
 use crate::sim::building::Building;
 use crate::sim::gait_sway::GaitSway;
 use crate::sim::generator::BuildingConfig;
-use crate::sim::lidar::{Vlp16, Vlp16Config};
+use crate::sim::hand_shake::HandShake;
+use crate::sim::lidar::{LidarConfig, SpinningLidar};
+use crate::sim::motion_profile::MotionProfile;
 use crate::sim::odometry::{OdometryDriftConfig, OdometryModel};
 use crate::sim::rng::SimRng;
 use crate::sim::route::Route;
+use crate::sim::setting_checks::{require_non_negative, require_positive};
+use crate::sim::timed_walk::{TimedWalk, WalkLimits};
 
 /// Settings of a simulated run.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,19 +30,24 @@ pub struct SimulationConfig {
     pub seed: u64,
     /// The building [`SimulatedSpot::corridor_loop`] generates.
     pub building: BuildingConfig,
-    /// Walking speed, 0.6 m/s (the thesis' runs).
+    /// Spot's walking speed, 0.6 m/s (the thesis' runs); a handheld walk has its own.
     pub speed: f64,
-    /// The LiDAR; one sample per turn, so its `rotation_rate` (5 Hz) is the sample rate.
-    pub lidar: Vlp16Config,
+    /// The LiDAR, a VLP-16 by default; Spot takes one sample per sweep, so its
+    /// `rotation_rate` (5 Hz) is the sample rate.
+    pub lidar: LidarConfig,
+    /// How the robot (or a person carrying the LiDAR) moves along the route: Spot's
+    /// walk by default.
+    pub motion: MotionProfile,
     /// The odometry's drift.
     pub odometry: OdometryDriftConfig,
     /// Body height and LiDAR mounting.
     pub spot: SpotGeometry,
     /// How fast a [`CommandedSpot`](crate::sim::CommandedSpot) may be commanded to move.
     pub limits: MotionLimits,
-    /// The body's sway while walking (none by default).
+    /// The body's sway while Spot walks (none by default; a handheld walk shakes by its own
+    /// [`HandShake`]).
     pub gait_sway: GaitSway,
-    /// Cast each column from the pose at its firing time (the robot walks 12 cm during a
+    /// Cast each column from the true pose at its firing time (Spot walks 12 cm during a
     /// sweep), as a real spinning LiDAR sees it; `false` (the default) casts the whole turn from
     /// the pose at the sample's stamp, so no deskewing is needed, and every point's `time` is 0.
     pub motion_distortion: bool,
@@ -49,7 +59,8 @@ impl Default for SimulationConfig {
             seed: 0,
             building: BuildingConfig::default(),
             speed: 0.6,
-            lidar: Vlp16Config::default(),
+            lidar: LidarConfig::default(),
+            motion: MotionProfile::default(),
             odometry: OdometryDriftConfig::default(),
             spot: SpotGeometry::default(),
             limits: MotionLimits::default(),
@@ -89,54 +100,128 @@ impl SimulationConfig {
 #[derive(Clone, Debug)]
 pub struct SimulatedSpot {
     building: Building,
-    lidar: Vlp16,
+    lidar: SpinningLidar,
     odometry: OdometryModel,
     noise: SimRng,
     body_t_lidar: Pose3,
+    motion: Motion,
     truth: Vec<StampedPose>,
     next: usize,
     motion_distortion: bool,
 }
 
+/// How the body moves between the samples.
+#[derive(Clone, Debug)]
+enum Motion {
+    /// Spot's walk: geodesic between the samples, which are one sweep apart.
+    Sampled,
+    /// Spot turning at corners, swaying as it walks.
+    Spot { walk: TimedWalk, sway: GaitSway },
+    /// A person carrying the LiDAR, with a shaking hand.
+    Hand { walk: TimedWalk, shake: HandShake },
+}
+
+impl Motion {
+    /// `world_T_body` at `t` seconds, for the timed motions.
+    fn timed_pose(&self, t: f64) -> Option<Pose3> {
+        match self {
+            Self::Sampled => None,
+            Self::Spot { walk, sway } => Some(walk.pose_at(t) * sway.offset(t)),
+            Self::Hand { walk, shake } => Some(walk.pose_at(t) * shake.offset(t, walk.duration())),
+        }
+    }
+
+    /// The samples of a timed motion at `rate` hertz from its start to its end (the last
+    /// one where the walk ended).
+    fn samples(&self, duration: f64, rate: f64) -> Vec<StampedPose> {
+        // A duration a whole number of periods long, give or take rounding, ends on a sample.
+        let n = (duration * rate - 1e-9).ceil().max(0.0) as usize;
+        (0..=n)
+            .filter_map(|k| {
+                let stamp = k as f64 / rate;
+                Some(StampedPose {
+                    stamp,
+                    pose: self.timed_pose(stamp)?,
+                })
+            })
+            .collect()
+    }
+}
+
 impl SimulatedSpot {
-    /// A run along `route` through `building`.
+    /// A run along `route` through `building`, moving as `config.motion` says.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry, speed or rate settings.
+    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry, speed, rate, gait sway,
+    /// motion limit or motion profile settings.
     pub fn new(
         building: Building,
         route: &Route,
         config: &SimulationConfig,
     ) -> Result<Self, AdapterError> {
-        let lidar = Vlp16::new(config.lidar.clone())?;
+        let lidar = SpinningLidar::new(config.lidar.clone())?;
         let sway = &config.gait_sway;
-        for (setting, value) in [
+        require_non_negative(&[
             ("gait_sway.height", sway.height),
             ("gait_sway.tilt", sway.tilt),
             ("gait_sway.frequency", sway.frequency),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(AdapterError::invalid(
-                    setting,
-                    value,
-                    "finite and non-negative",
-                ));
+        ])?;
+        let rotation_rate = config.lidar.rotation_rate;
+        let (motion, truth, body_t_lidar) = match &config.motion {
+            MotionProfile::Walk => {
+                let mut truth = route.walk(config.speed, rotation_rate, config.spot.body_height)?;
+                for p in &mut truth {
+                    p.pose *= sway.offset(p.stamp);
+                }
+                (Motion::Sampled, truth, config.spot.body_t_lidar)
             }
-        }
-        let mut truth = route.walk(
-            config.speed,
-            config.lidar.rotation_rate,
-            config.spot.body_height,
-        )?;
-        for p in &mut truth {
-            p.pose *= sway.offset(p.stamp);
-        }
+            MotionProfile::FastTurns(turns) => {
+                turns.validate()?;
+                config.limits.validate()?;
+                require_positive(&[("speed", config.speed, "finite and positive (m/s)")])?;
+                let limits = WalkLimits {
+                    speed: config.speed,
+                    corner_speed: 0.0,
+                    acceleration: turns.acceleration,
+                    turn_rate: config.limits.max_yaw_rate,
+                    turn_acceleration: turns.yaw_acceleration,
+                };
+                let walk = TimedWalk::new(route, &limits, config.spot.body_height);
+                let duration = walk.duration();
+                let motion = Motion::Spot {
+                    walk,
+                    sway: sway.clone(),
+                };
+                let truth = motion.samples(duration, rotation_rate);
+                (motion, truth, config.spot.body_t_lidar)
+            }
+            MotionProfile::Handheld(hand) => {
+                hand.validate(rotation_rate)?;
+                let limits = WalkLimits {
+                    speed: hand.speed,
+                    corner_speed: hand.corner_speed,
+                    acceleration: hand.acceleration,
+                    turn_rate: hand.turn_rate,
+                    turn_acceleration: hand.turn_acceleration,
+                };
+                let walk = TimedWalk::new(route, &limits, hand.height);
+                let duration = walk.duration();
+                let motion = Motion::Hand {
+                    walk,
+                    shake: hand.shake.clone(),
+                };
+                let truth = motion.samples(duration, hand.sample_rate);
+                // The person carries the LiDAR itself: the body is the sensor.
+                (motion, truth, Pose3::identity())
+            }
+        };
         Ok(Self {
             building,
             lidar,
             odometry: OdometryModel::new(config.odometry.clone(), config.seed)?,
             noise: SimRng::new(config.seed, 0x11da_4000),
-            body_t_lidar: config.spot.body_t_lidar,
+            body_t_lidar,
+            motion,
             truth,
             next: 0,
             motion_distortion: config.motion_distortion,
@@ -162,7 +247,7 @@ impl SimulatedSpot {
 
     /// The LiDAR model.
     #[must_use]
-    pub fn lidar(&self) -> &Vlp16 {
+    pub fn lidar(&self) -> &SpinningLidar {
         &self.lidar
     }
 
@@ -176,6 +261,29 @@ impl SimulatedSpot {
     #[must_use]
     pub fn ground_truth(&self) -> Vec<StampedPose> {
         self.truth.clone()
+    }
+
+    /// The true `world_T_body` at any time `t` (seconds; before the start the first pose,
+    /// after the end the last): the pose each column of a motion-distorted sweep is cast from.
+    /// Spot's walk moves along the geodesic between its samples, the other motions follow their
+    /// timed walk (so a sweep between two handheld samples 0.5 s apart sees the real motion,
+    /// not an interpolation).
+    #[must_use]
+    pub fn pose_at(&self, t: f64) -> Pose3 {
+        if let Some(pose) = self.motion.timed_pose(t) {
+            return pose;
+        }
+        let k = self.truth.partition_point(|p| p.stamp <= t);
+        match (
+            k.checked_sub(1).and_then(|i| self.truth.get(i)),
+            self.truth.get(k),
+        ) {
+            (Some(a), Some(b)) => {
+                interpolate(&a.pose, &b.pose, (t - a.stamp) / (b.stamp - a.stamp))
+            }
+            (Some(only), None) | (None, Some(only)) => only.pose,
+            (None, None) => Pose3::identity(),
+        }
     }
 
     /// Number of samples the whole run yields.
@@ -213,21 +321,36 @@ impl Iterator for SimulatedSpot {
         } = *self.truth.get(self.next)?;
         self.next += 1;
         let odom_t_body = self.odometry.step(&world_t_body);
-        let start = world_t_body * self.body_t_lidar;
-        let cloud = match self.truth.get(self.next) {
-            Some(&StampedPose {
-                pose: next_body, ..
-            }) if self.motion_distortion => self.lidar.scan_moving(
+        let body_t_lidar = self.body_t_lidar;
+        let start = world_t_body * body_t_lidar;
+        let cloud = match (&self.motion, self.truth.get(self.next)) {
+            (_, _) if !self.motion_distortion => {
+                self.lidar
+                    .scan_at_rest(&self.building, &start, &mut self.noise)
+            }
+            (
+                Motion::Sampled,
+                Some(&StampedPose {
+                    pose: next_body, ..
+                }),
+            ) => self.lidar.scan_moving(
                 &self.building,
                 &start,
-                &(next_body * self.body_t_lidar),
+                &(next_body * body_t_lidar),
                 &mut self.noise,
             ),
-            // The last sample of a run has no later pose: the robot has stopped.
-            // Cast from one pose: every point was measured at the stamp, and its time says so.
-            _ => self
-                .lidar
-                .scan_at_rest(&self.building, &start, &mut self.noise),
+            // The last sample of a walk has no later pose: the robot has stopped. Cast from one
+            // pose: every point was measured at the stamp, and its time says so.
+            (Motion::Sampled, None) => {
+                self.lidar
+                    .scan_at_rest(&self.building, &start, &mut self.noise)
+            }
+            // A timed motion is known between the samples, however far apart they are.
+            (motion, _) => self.lidar.scan_along(
+                &self.building,
+                |dt| motion.timed_pose(stamp + dt).unwrap_or(world_t_body) * body_t_lidar,
+                &mut self.noise,
+            ),
         };
         Some(Sample {
             stamp,

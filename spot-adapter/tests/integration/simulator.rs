@@ -9,12 +9,51 @@ use slam_core::Pose3;
 use spot_adapter::eval::end_point_drift;
 use spot_adapter::robot::SpotGeometry;
 use spot_adapter::sim::{
-    Building, BuildingConfig, OdometryDriftConfig, OdometryModel, Route, SimRng, SimulatedSpot,
-    SimulationConfig, Vlp16, Vlp16Config,
+    Building, BuildingConfig, LidarConfig, OdometryDriftConfig, OdometryModel, Route, SimRng,
+    SimulatedSpot, SimulationConfig, SpinningLidar,
 };
 
-fn noiseless() -> Vlp16Config {
-    let mut c = Vlp16Config::default();
+/// Whether `q` is in solid matter: inside a box, below the floor or above the ceiling.
+fn inside(b: &Building, q: Point3<f64>) -> bool {
+    q.z <= 0.0
+        || q.z >= b.ceiling_height()
+        || b.boxes()
+            .iter()
+            .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
+}
+
+/// Whether `q` is within `tolerance` metres of solid matter (a box, the floor or the ceiling).
+fn near_solid(b: &Building, q: Point3<f64>, tolerance: f64) -> bool {
+    q.z <= tolerance
+        || q.z >= b.ceiling_height() - tolerance
+        || b.boxes().iter().any(|bx| {
+            let outside = (0..3).map(|i| (bx.min[i] - q[i]).max(q[i] - bx.max[i]).max(0.0));
+            outside.map(|d| d * d).sum::<f64>() <= tolerance * tolerance
+        })
+}
+
+/// Whether the point `local` (LiDAR frame) seen from `world_t_lidar` is a return from a surface
+/// of `b` to within `tolerance` metres along its ray: free space just before it, and solid
+/// matter just behind it (or, for a ray that clips a box's corner, within `tolerance` of the
+/// point). An oracle independent of the ray caster.
+pub(crate) fn on_surface(
+    b: &Building,
+    world_t_lidar: &Pose3,
+    local: &Point3<f32>,
+    tolerance: f64,
+) -> bool {
+    let local = nalgebra::convert::<_, Vector3<f64>>(local.coords);
+    let (o, dir, r) = (
+        Point3::from(world_t_lidar.translation.vector),
+        world_t_lidar.rotation * local.normalize(),
+        local.norm(),
+    );
+    !inside(b, o + dir * (r - tolerance))
+        && (inside(b, o + dir * (r + tolerance)) || near_solid(b, o + dir * r, tolerance))
+}
+
+fn noiseless() -> LidarConfig {
+    let mut c = LidarConfig::default();
     c.range_noise = 0.0;
     c
 }
@@ -22,7 +61,7 @@ fn noiseless() -> Vlp16Config {
 #[test]
 fn scan_points_lie_at_the_ray_cast_distance() {
     let b = Building::generate(21, &BuildingConfig::default()).unwrap();
-    let lidar = Vlp16::new(noiseless()).unwrap();
+    let lidar = SpinningLidar::new(noiseless()).unwrap();
     let start = b.corridor_loop()[1];
     let world_t_lidar = Pose3::from_parts(
         Translation3::new(start.x - 0.3, start.y + 0.2, 0.8),
@@ -45,24 +84,17 @@ fn scan_points_lie_at_the_ray_cast_distance() {
             (p64.normalize() - dir).norm() < 1e-5,
             "point {k} off its beam"
         );
-        // Independent oracle: march along the world ray in 1 mm steps to the first obstacle
-        // (inside a box, below the floor or above the ceiling).
+        // Independent oracle: free space 2 mm before the return, solid matter (a box, below the
+        // floor or above the ceiling) 2 mm behind it.
         let o = Point3::from(world_t_lidar.translation.vector);
         let wd = world_t_lidar.rotation * dir;
-        let inside = |q: Point3<f64>| {
-            q.z <= 0.0
-                || q.z >= b.ceiling_height()
-                || b.boxes()
-                    .iter()
-                    .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
-        };
         let r = p64.norm();
         assert!(
-            !inside(o + wd * (r - 2e-3)),
+            !inside(&b, o + wd * (r - 2e-3)),
             "point {k}: free space ends before the return"
         );
         assert!(
-            inside(o + wd * (r + 2e-3)),
+            inside(&b, o + wd * (r + 2e-3)),
             "point {k}: no surface at the return"
         );
     }
@@ -72,7 +104,7 @@ fn scan_points_lie_at_the_ray_cast_distance() {
 #[test]
 fn scan_at_rest_has_the_points_of_a_scan_and_zero_times() {
     let b = Building::generate(6, &BuildingConfig::default()).unwrap();
-    let lidar = Vlp16::new(Vlp16Config::default()).unwrap();
+    let lidar = SpinningLidar::new(LidarConfig::default()).unwrap();
     let c = b.corridor_loop()[0];
     let pose = Pose3::translation(c.x + 1.0, c.y, 0.8);
     let scan = lidar.scan(&b, &pose, &mut SimRng::new(4, 4));
@@ -86,7 +118,7 @@ fn scan_at_rest_has_the_points_of_a_scan_and_zero_times() {
 #[test]
 fn moving_scan_casts_each_column_from_its_firing_pose() {
     let b = Building::generate(6, &BuildingConfig::default()).unwrap();
-    let lidar = Vlp16::new(noiseless()).unwrap();
+    let lidar = SpinningLidar::new(noiseless()).unwrap();
     let c = b.corridor_loop()[0];
     let start = Pose3::from_parts(
         Translation3::new(c.x + 2.0, c.y, 0.8),
@@ -104,26 +136,11 @@ fn moving_scan_casts_each_column_from_its_firing_pose() {
     // Column 0 fires at the start pose: identical points.
     let first = time.iter().take_while(|&&t| t == 0.0).count();
     assert_eq!(moving.points()[..first], still.points()[..first]);
-    let inside = |q: Point3<f64>| {
-        q.z <= 0.0
-            || q.z >= b.ceiling_height()
-            || b.boxes()
-                .iter()
-                .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
-    };
     let mut moved = 0;
     for (k, p) in moving.points().iter().enumerate().step_by(41) {
         let pose = slam_core::interpolate(&start, &end, f64::from(time[k]) / 0.2);
         let local = nalgebra::convert::<_, Vector3<f64>>(p.coords);
-        let (o, dir, r) = (
-            Point3::from(pose.translation.vector),
-            pose.rotation * local.normalize(),
-            local.norm(),
-        );
-        assert!(
-            !inside(o + dir * (r - 2e-3)) && inside(o + dir * (r + 2e-3)),
-            "point {k}"
-        );
+        assert!(on_surface(&b, &pose, p, 2e-3), "point {k}");
         // The same point seen as if from the start pose lands off the surface late in the sweep.
         let naive = start * Point3::from(local);
         moved +=
@@ -140,12 +157,12 @@ fn noise_and_dropouts_have_the_configured_size() {
     let b = Building::generate(3, &BuildingConfig::default()).unwrap();
     let start = b.corridor_loop()[2];
     let pose = Pose3::translation(start.x, start.y, 0.8);
-    let clean = Vlp16::new(noiseless())
+    let clean = SpinningLidar::new(noiseless())
         .unwrap()
         .scan(&b, &pose, &mut SimRng::new(0, 0));
-    let mut noisy_cfg = Vlp16Config::default();
+    let mut noisy_cfg = LidarConfig::default();
     noisy_cfg.range_noise = 0.02;
-    let noisy = Vlp16::new(noisy_cfg)
+    let noisy = SpinningLidar::new(noisy_cfg)
         .unwrap()
         .scan(&b, &pose, &mut SimRng::new(0, 0));
     assert_eq!(clean.len(), noisy.len());
@@ -160,7 +177,7 @@ fn noise_and_dropouts_have_the_configured_size() {
     assert!((var.sqrt() - 0.02).abs() < 0.001, "sigma {}", var.sqrt());
     let mut drop_cfg = noiseless();
     drop_cfg.dropout_probability = 0.1;
-    let dropped = Vlp16::new(drop_cfg)
+    let dropped = SpinningLidar::new(drop_cfg)
         .unwrap()
         .scan(&b, &pose, &mut SimRng::new(0, 0));
     let kept = dropped.len() as f64 / n;
@@ -266,20 +283,7 @@ fn gait_sway_moves_the_body_within_its_amplitudes() {
     // Scans are cast from the swaying pose: points land on surfaces through it.
     let sample = sim.nth(7).unwrap();
     let world_t_lidar = sample.ground_truth.unwrap() * sample.body_t_lidar;
-    let inside = |q: Point3<f64>| {
-        q.z <= 0.0
-            || q.z >= b.ceiling_height()
-            || b.boxes()
-                .iter()
-                .any(|bx| (0..3).all(|i| q[i] >= bx.min[i] && q[i] <= bx.max[i]))
-    };
     for p in sample.cloud.points().iter().step_by(97) {
-        let local = nalgebra::convert::<_, Vector3<f64>>(p.coords);
-        let (o, dir, r) = (
-            Point3::from(world_t_lidar.translation.vector),
-            world_t_lidar.rotation * local.normalize(),
-            local.norm(),
-        );
-        assert!(!inside(o + dir * (r - 2e-3)) && inside(o + dir * (r + 2e-3)));
+        assert!(on_surface(&b, &world_t_lidar, p, 2e-3));
     }
 }
