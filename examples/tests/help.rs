@@ -96,6 +96,8 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--odometry-information",
             "--loop-drift-rate",
             "--out",
+            "--ground-truth",
+            "--summary",
         ],
     ),
 ];
@@ -237,6 +239,12 @@ fn slam_refuses_simulator_options_with_a_recording() {
     rejected("slam", &["scans", "--blank-corridor"], "--blank-corridor");
     rejected("slam", &["scans", "--lidar-range", "25"], "--lidar-range");
     rejected("slam", &["scans", "--skewed"], "--skewed");
+}
+
+#[test]
+fn slam_takes_a_ground_truth_file_with_a_recording_only() {
+    // The simulator has its own ground truth.
+    rejected("slam", &["--ground-truth", "truth.tum"], "<PATH>");
 }
 
 /// `slam args` fails as a job (status 1, one line) naming `setting`, before it maps anything.

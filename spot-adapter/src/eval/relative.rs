@@ -33,8 +33,8 @@ impl KittiRpe {
     }
 }
 
-/// Smallest ladder scale tried: segments of 1 to 8 mm.
-const MIN_SCALE: f64 = 1e-5;
+/// Largest divisor of the ladder tried: segments of 1 to 8 mm.
+const MAX_DIVISOR: f64 = 1e5;
 
 /// KITTI's RPE of `estimate` against `reference` (associated pose lists of equal length): the
 /// devkit's [`kitti_segment_drift`] over [`KITTI_SEGMENT_LENGTHS`]; when the reference path is
@@ -44,20 +44,21 @@ const MIN_SCALE: f64 = 1e-5;
 #[must_use]
 pub fn kitti_rpe(estimate: &[Pose3], reference: &[Pose3]) -> Option<KittiRpe> {
     let path = path_length(reference);
-    let mut scale = 1.0;
-    while KITTI_SEGMENT_LENGTHS[0] * scale >= path {
-        scale *= 0.1;
-        if scale < MIN_SCALE {
+    // Lengths divided by an exact power of ten, so that 100 / 10 is 10 to the last bit.
+    let mut divisor = 1.0;
+    while KITTI_SEGMENT_LENGTHS[0] / divisor >= path {
+        divisor *= 10.0;
+        if divisor > MAX_DIVISOR {
             return None;
         }
     }
-    let ladder: Vec<f64> = KITTI_SEGMENT_LENGTHS.iter().map(|l| l * scale).collect();
+    let ladder: Vec<f64> = KITTI_SEGMENT_LENGTHS.iter().map(|l| l / divisor).collect();
     let drift = kitti_segment_drift(estimate, reference, &ladder).ok()?;
     Some(KittiRpe {
         translation_percent: 100.0 * drift.translation,
         rotation_deg_per_100m: 100.0 * drift.rotation.to_degrees(),
         lengths: drift.per_length.iter().map(|&(l, _, _)| l).collect(),
-        scale,
+        scale: 1.0 / divisor,
         segments: drift.segments,
     })
 }
