@@ -477,7 +477,14 @@ fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         Truth::Stamped(poses) => Some(poses.to_vec()),
         Truth::File(file) => Some(file.stamped(&run.stamps)?),
     };
-    let (evaluation, estimate) = evaluate(slam, body_t_lidar, truth.as_deref())?;
+    let (evaluation, estimate) =
+        evaluate(slam, body_t_lidar, truth.as_deref()).with_context(|| {
+            format!(
+                "evaluating {} scan poses against the ground truth ({})",
+                slam.scan_trajectory().len(),
+                context.input.ground_truth.as_deref().unwrap_or("none")
+            )
+        })?;
     let mapping = Mapping {
         estimate,
         evaluation,
@@ -537,7 +544,7 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         time.scan_to_scan_ms_max,
     ) {
         out!(
-            "            scan-to-scan odometry {mean:.2} ms mean, {p99:.2} ms p99, {max:.2} ms max per scan (on the read-ahead thread, reading left out)"
+            "            scan-to-scan odometry {mean:.2} ms mean, {p99:.2} ms p99, {max:.2} ms max per scan (LiDAR-only, before the engine: a recording's on the read-ahead thread; reading left out)"
         )?;
     }
     let points = points.map(|p| Points {
