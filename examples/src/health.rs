@@ -30,14 +30,18 @@ const SCAN_TO_SCAN: &str = "scan-to-scan registration failed or diverged";
 #[must_use]
 pub fn engine_fallback_reasons(report: &SlamReport) -> Vec<(&'static str, usize)> {
     let _ = report;
-    Vec::new()
+    vec![
+        // ("no convergence", report.fallbacks_diverged),
+    ]
 }
 
 /// The engine's odometry faults by reason (none yet: see [`engine_fallback_reasons`]).
 #[must_use]
 pub fn fault_reasons(report: &SlamReport) -> Vec<(&'static str, usize)> {
     let _ = report;
-    Vec::new()
+    vec![
+        // ("step contradicted by registration", report.faults_contradicted),
+    ]
 }
 
 /// Skipped scans by reason, one line per `SkipReason`.
@@ -141,6 +145,21 @@ impl TrackingHealth {
     pub fn fallbacks(&self) -> usize {
         self.engine_fallbacks + self.scan_to_scan_fallbacks.unwrap_or(0)
     }
+
+    /// The `warning:` line when tracking was lost on more than [`LOST_SHARE`] of the scans.
+    #[must_use]
+    pub fn warning(&self) -> Option<String> {
+        self.lost.then(|| {
+            format!(
+                "warning: tracking was lost on {:.1} % of the scans ({} of {}, more than {:.0} %: {}): on those scans the pose is a prediction, not a registration, so the trajectory and the map are not to be trusted there",
+                100.0 * self.fallback_share,
+                self.fallbacks(),
+                self.scans,
+                100.0 * LOST_SHARE,
+                listed(&self.fallbacks_by_reason)
+            )
+        })
+    }
 }
 
 /// `count reason, count reason` of a map, or `none`.
@@ -185,15 +204,8 @@ pub fn print_tracking_health(
         health.skipped,
         listed(&health.skipped_by_reason)
     )?;
-    if health.lost {
-        eprintln!(
-            "warning: tracking was lost on {:.1} % of the scans ({} of {}, more than {:.0} %: {}): on those scans the pose is a prediction, not a registration, so the trajectory and the map are not to be trusted there",
-            100.0 * health.fallback_share,
-            health.fallbacks(),
-            health.scans,
-            100.0 * LOST_SHARE,
-            listed(&health.fallbacks_by_reason)
-        );
+    if let Some(warning) = health.warning() {
+        eprintln!("{warning}");
     }
     Ok(health)
 }
@@ -216,9 +228,16 @@ mod tests {
         assert_eq!(h.fallbacks_by_reason[REJECTED], 4);
         assert_eq!(h.fallbacks_by_reason[SCAN_TO_SCAN], 7);
         assert_eq!((h.skipped, h.skipped_by_reason["too few points"]), (2, 2));
+        let warning = h.warning().unwrap();
+        assert!(
+            warning.starts_with("warning: tracking was lost on 5.5 % of the scans (11 of 200")
+                && warning.contains("4 registration rejected")
+                && warning.contains("not to be trusted"),
+            "{warning}"
+        );
         // 10 of 200 is 5 %: not more than the share.
         let h = TrackingHealth::new(&report, Some(6));
-        assert!(!h.lost);
+        assert!(!h.lost && h.warning().is_none());
         let h = TrackingHealth::new(&SlamReport::default(), None);
         assert!(!h.lost && h.fallbacks_by_reason.is_empty() && h.skipped_by_reason.is_empty());
     }
