@@ -144,6 +144,31 @@ fn line<'a>(stdout: &'a str, label: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no {label} line in:\n{stdout}"))
 }
 
+/// `slam RECORDING --ground-truth TRUTH OPTION PATH` succeeds; its stdout.
+fn slam_succeeds(recording: &Path, truth: &Path, option: &str, path: &Path) -> String {
+    let run = Command::new(example("slam"))
+        .arg(recording)
+        .arg("--ground-truth")
+        .arg(truth)
+        .arg(option)
+        .arg(path)
+        .output()
+        .expect("slam runs");
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    stdout
+}
+
+/// The summary.json at `path`.
+fn summary_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).expect("summary.json written");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
 /// `poses` written as a TUM file and as KITTI poses beside `scans`.
 fn truth_files(scans: &Path, poses: &[(f64, slam_core::Pose3)]) -> (PathBuf, PathBuf) {
     let tum = scans.with_extension("tum");
@@ -244,24 +269,8 @@ fn a_ground_truth_file_is_evaluated_and_the_summary_says_what_was_printed() {
     let mut accuracies = Vec::new();
     for truth in [&tum, &kitti] {
         let out = temp_dir("moving-out");
-        let run = Command::new(example("slam"))
-            .arg(&scans)
-            .arg("--ground-truth")
-            .arg(truth)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .expect("slam runs");
-        let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
-        assert!(
-            run.status.success(),
-            "{stdout}\n{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let json: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(out.join("summary.json")).expect("summary.json written"),
-        )
-        .expect("summary.json is JSON");
+        let stdout = slam_succeeds(&scans, truth, "--out", &out);
+        let json = summary_json(&out.join("summary.json"));
         check_summary(&stdout, &json, truth);
         accuracies.push(json["accuracy"].clone());
     }
@@ -306,4 +315,42 @@ fn a_bad_ground_truth_fails_naming_its_file_and_line() {
         ];
         slam_fails_leaving_nothing(&args, &dir.join("out"), &[&file.to_string_lossy(), expect]);
     }
+}
+
+#[test]
+fn a_ground_truth_file_replaces_the_recordings_own_and_says_so() {
+    // A KITTI sequence of 4 copies of a real scan, with its own poses.txt (the identity) and no
+    // times.txt (10 Hz from 0); the file given replaces it.
+    let dir = temp_dir("kitti");
+    std::fs::create_dir_all(dir.join("velodyne")).expect("temp folder");
+    let scan = slam_core::io::read_pcd(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../slam-core/tests/data/hdl32e_garage_1503604882.703390000.pcd"),
+    )
+    .expect("the bundled scan");
+    let mut own = String::new();
+    let mut given = String::new();
+    for i in 0..4 {
+        slam_core::io::write_kitti_bin(dir.join(format!("velodyne/{i:06}.bin")), &scan)
+            .expect("write a scan");
+        own += "1 0 0 0 0 1 0 0 0 0 1 0\n";
+        writeln!(given, "{} 0 0 0 0 0 0 1", 0.1 * f64::from(i)).expect("a string");
+    }
+    std::fs::write(dir.join("poses.txt"), own).expect("write poses.txt");
+    let truth = dir.with_extension("tum");
+    std::fs::write(&truth, given).expect("write the ground truth");
+    let summary = dir.with_extension("json");
+    let stdout = slam_succeeds(&dir, &truth, "--summary", &summary);
+    assert!(
+        line(&stdout, "truth ").contains("replacing the recording's own ground truth"),
+        "{stdout}"
+    );
+    let json = summary_json(&summary);
+    assert!(
+        json["input"]["ground_truth"]
+            .as_str()
+            .is_some_and(|g| g.contains("replacing")),
+        "{json}"
+    );
+    assert_eq!(json["accuracy"]["ate_pairs"], 4);
 }
