@@ -12,7 +12,8 @@
 # KISS_VOXEL_SIZE (m) and KISS_THREADS (0 = all cores, its default) change them. Prints end-point
 # drift, ATE, RPE per 100 m, height drift, steps with more than 2 and 5 degrees of rotation error,
 # mean and p99 ms a scan (ours: the engine's, from summary.json, and the scan-to-scan odometry's;
-# KISS-ICP: register_frame alone) and the ratio of the means. Installs kiss-icp into target/peers.
+# KISS-ICP: register_frame alone) and the ratio of the means. Installs kiss-icp into target/peers
+# and leaves both trajectories in target/peers/kiss-icp-out.
 set -euo pipefail
 if [ $# -lt 2 ]; then
     sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
@@ -30,8 +31,10 @@ fi
 "$venv/bin/python" benches/peers/kiss_icp_peer.py --selftest spot-adapter/tests/data/evo
 cargo build -q --release -p spot-nav-examples --example slam
 slam="${CARGO_TARGET_DIR:-target}/release/examples/slam"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+# What both wrote stays for a look: ours/ (slam --out), kiss_icp.tum (KISS-ICP's body poses).
+work=target/peers/kiss-icp-out
+rm -rf "$work"
+mkdir -p "$work"
 echo "== ours: slam $scans --no-odometry --ground-truth $truth $*"
 "$slam" "$scans" --no-odometry --ground-truth "$truth" --out "$work/ours" "$@"
 kiss_args=()
@@ -48,4 +51,5 @@ for a in "$@"; do
 done
 [ -n "$calibration" ] && kiss_args+=(--calibration "$calibration")
 echo "== KISS-ICP 1.3.0 and both against the ground truth"
-"$venv/bin/python" benches/peers/kiss_icp_peer.py "$scans" "$truth" "$work/ours" "${kiss_args[@]}"
+"$venv/bin/python" benches/peers/kiss_icp_peer.py "$scans" "$truth" "$work/ours" \
+    --write-tum "$work/kiss_icp.tum" "${kiss_args[@]}"

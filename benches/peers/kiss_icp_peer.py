@@ -9,7 +9,7 @@ them side by side.
 
 Usage:
   python kiss_icp_peer.py SCANS_DIR GROUND_TRUTH OURS_DIR [--max-range M] [--voxel-size M]
-                     [--threads N] [--calibration tx,ty,tz,qx,qy,qz,qw]
+                     [--threads N] [--calibration tx,ty,tz,qx,qy,qz,qw] [--write-tum PATH]
   python kiss_icp_peer.py --selftest GOLDEN_DIR   (evaluate() against evo's figures, see below)
 
 SCANS_DIR: PCD or PLY scans, one a file; names that are numbers are stamps (seconds), else the
@@ -388,7 +388,8 @@ def compare(args):
     # KISS-ICP's poses are the LiDAR's; the truth and ours are the body's.
     lidar_t_body = np.linalg.inv(calibration_pose(args.calibration))
     kiss_body = [p @ lidar_t_body for p in kiss_poses]
-    write_tum(ours_dir / "kiss_icp.tum", stamps, kiss_body)
+    if args.write_tum:
+        write_tum(args.write_tum, stamps, kiss_body)
     ours, kiss = evaluate(our_stamps, our_poses, ref_stamps, ref_poses), evaluate(
         stamps, kiss_body, ref_stamps, ref_poses)
     t = summary["time"]
@@ -462,6 +463,7 @@ def main():
     parser.add_argument("--voxel-size", type=float)
     parser.add_argument("--threads", type=int)
     parser.add_argument("--calibration")
+    parser.add_argument("--write-tum", metavar="PATH", help="write KISS-ICP's body poses here")
     args = parser.parse_args()
     if args.selftest:
         selftest(args.selftest)

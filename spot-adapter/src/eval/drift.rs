@@ -1,6 +1,6 @@
-//! Relative drift: the end-point error over the path length, KITTI-style segment drift (Geiger
-//! et al., "Are we ready for autonomous driving?", CVPR 2012, devkit `evaluate_odometry`), and the
-//! loop end-point error. Inputs are associated pose lists of equal length (estimate[i] and
+//! Relative drift: the end-point error over the path length, the height drift, segment drift and
+//! the KITTI devkit's own (Geiger et al., "Are we ready for autonomous driving?", CVPR 2012,
+//! devkit `evaluate_odometry`), and the loop end-point error. Inputs are associated pose lists of equal length (estimate[i] and
 //! reference[i] at the same instant), e.g. from [`associate`](crate::eval::associate).
 
 use slam_core::Pose3;
