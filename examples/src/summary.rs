@@ -108,7 +108,8 @@ pub struct Times {
     pub loop_steps: usize,
     /// The slowest of them.
     pub loop_ms_max: f64,
-    /// Wall-clock seconds of the whole run (reading or simulating included).
+    /// Wall-clock seconds of feeding the scans to the engine (reading or simulating them
+    /// included; the evaluation and the outputs after it not).
     pub seconds: f64,
 }
 

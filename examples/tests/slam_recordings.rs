@@ -289,6 +289,11 @@ fn a_ground_truth_file_is_evaluated_and_the_summary_says_what_was_printed() {
         );
         assert!((x - y).abs() < 1e-6, "{key}: {x} and {y}");
     }
+    // Tidy up (temp_dir empties the last run's output folder).
+    temp_dir("moving-out");
+    let _ = std::fs::remove_dir_all(&scans);
+    let _ = std::fs::remove_file(&tum);
+    let _ = std::fs::remove_file(&kitti);
 }
 
 #[test]
@@ -314,6 +319,9 @@ fn a_bad_ground_truth_fails_naming_its_file_and_line() {
             file.as_os_str(),
         ];
         slam_fails_leaving_nothing(&args, &dir.join("out"), &[&file.to_string_lossy(), expect]);
+    }
+    for path in [&scans, &dir] {
+        let _ = std::fs::remove_dir_all(path);
     }
 }
 
@@ -353,4 +361,7 @@ fn a_ground_truth_file_replaces_the_recordings_own_and_says_so() {
         "{json}"
     );
     assert_eq!(json["accuracy"]["ate_pairs"], 4);
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_file(&truth);
+    let _ = std::fs::remove_file(&summary);
 }
