@@ -43,8 +43,8 @@ use spot_nav_examples::summary::{
     Accuracy, Input, Loops, Points, SlamSummary, Times, write_summary,
 };
 use spot_nav_examples::{
-    GroundTruthFile, Mapping, MeasuredScanToScan, Registration, ScanToScanStats, evaluate,
-    map_samples, out, parse_numbers, print_tracking_health, value_name,
+    GroundTruthFile, MappedScans, Mapping, MeasuredScanToScan, Registration, ScanToScanStats,
+    evaluate, map_samples, out, parse_numbers, print_tracking_health, value_name,
 };
 
 /// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
@@ -466,7 +466,7 @@ where
 /// outputs.
 fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
-    run: &spot_nav_examples::Run,
+    run: &MappedScans,
     body_t_lidar: &Pose3,
     points: Option<DroppedPoints>,
     args: &Args,

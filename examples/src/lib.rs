@@ -38,7 +38,7 @@ pub use args::{Registration, parse_goal, parse_numbers, value_name};
 pub use ground_truth::{GroundTruthFile, GroundTruthFormat};
 pub use health::{TrackingHealth, print_tracking_health};
 pub use lidar_only::{MeasuredScanToScan, ScanToScanStats};
-pub use mapping::{Mapping, Run, evaluate, map_and_evaluate, map_samples};
+pub use mapping::{MappedScans, Mapping, evaluate, map_and_evaluate, map_samples};
 pub use output::{StdoutClosed, run, write_line};
 pub use progress::Progress;
 pub use stats::{Timings, quantile};

@@ -54,7 +54,7 @@ where
 
 /// What feeding the samples gave besides the engine's state.
 #[derive(Clone, Debug)]
-pub struct Run {
+pub struct MappedScans {
     /// Wall-clock seconds of feeding the samples (reading or simulating them included).
     pub seconds: f64,
     /// The stamp of every sample read, in order (skipped scans too).
@@ -70,7 +70,7 @@ pub fn map_samples<R, C, O, I, E>(
     slam: &mut GraphSlam<R, C, O>,
     samples: I,
     label: &str,
-) -> Result<Run>
+) -> Result<MappedScans>
 where
     R: MapRegistrator,
     C: MapRegistrator,
@@ -105,7 +105,7 @@ where
             report.scans
         );
     }
-    Ok(Run { seconds, stamps })
+    Ok(MappedScans { seconds, stamps })
 }
 
 /// The body trajectory of `slam`'s scans (`body_t_lidar`: the LiDAR mounting), evaluated
