@@ -2,11 +2,14 @@
 //! (`.mcap`, or its folder), a KITTI sequence, a folder of PCD/PLY scans or a spot-nav
 //! recording, detected from PATH. Point-to-plane ICP (or LOAM) odometry against the local map,
 //! loop closure (point-to-point check, point-to-plane or LOAM refinement), Levenberg-Marquardt.
-//! Prints what the recording holds, then scans, keyframes, loop closures, per-scan times and,
-//! with ground truth, ATE, drift and loop end-point error; writes the map (PLY, PCD), the
-//! trajectory (TUM), the pose graph (g2o) and the occupancy grid (PNG, ROS map) with `--out`.
+//! Prints what the recording holds, then scans, keyframes, loop closures, tracking health
+//! (fallbacks, faults, skipped scans; a warning when tracking was lost on more than 5 % of the
+//! scans), per-scan times and, with ground truth (the recording's, or `--ground-truth FILE`),
+//! ATE, RPE per 100 m, end-point and height drift and each step's rotation error; writes the map
+//! (PLY, PCD), the trajectory (TUM), the pose graph (g2o), the occupancy grid (PNG, ROS map) and
+//! `summary.json` with `--out`.
 //!
-//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR]`
+//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR] [--ground-truth FILE] [--summary FILE]`
 
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
@@ -25,12 +28,19 @@ use slam_core::{
 use spot_adapter::nav::{NavigationMap, NavigatorConfig};
 use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::record::{
-    BagConfig, ImuSource, OdometrySource, PointCloud2Config, ReadAhead, ReturnFilter,
-    SampleSource, SourceConfig, TimeUnit, open_recording,
+    BagConfig, DroppedPoints, ImuSource, OdometrySource, PointCloud2Config, ReadAhead,
+    ReturnFilter, SampleSource, SourceConfig, TimeUnit, open_recording,
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_nav_examples::{Motion, Registration, Sensor, map_and_evaluate, out, parse_numbers};
+use spot_nav_examples::health::skip_reasons;
+use spot_nav_examples::summary::{
+    Accuracy, Input, Loops, Points, SlamSummary, Times, write_summary,
+};
+use spot_nav_examples::{
+    GroundTruthFile, MappedScans, Mapping, Motion, Registration, Sensor, evaluate, map_samples,
+    out, parse_numbers, print_tracking_health, value_name,
+};
 
 /// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
 const INFLATION: f64 = 0.30;
@@ -64,11 +74,14 @@ enum OdometryInformation {
 /// or PLY scans (names that are numbers are stamps), or a spot-nav recording (index.txt). What
 /// it holds is printed first. A recording without odometry runs LiDAR-only (every scan
 /// registered against the local map from a constant-velocity guess). Prints scans, keyframes, loop closures, per-scan
-/// times and, when the ground truth is known, ATE, drift and loop end-point error. With `--out`
-/// it writes the map (`map.ply`, `map.pcd`), the body trajectory (`trajectory.tum`), the pose
-/// graph (`graph.g2o`) and the occupancy grid (`grid.png`, `map.yaml` + `map.pgm`), all after
-/// the run: a failed run leaves nothing. Fails when the recording cannot be read or the engine
-/// accepts no scan.
+/// times, tracking health (fallbacks, odometry faults, skipped scans by reason; a `warning:` on
+/// stderr when more than 5 % of the scans fell back, i.e. tracking was lost there) and, when the
+/// ground truth is known (the recording's, or `--ground-truth`), ATE, RPE per 100 m, end-point
+/// and height drift, loop end-point error and each step's rotation error. With `--out` it
+/// writes the map (`map.ply`, `map.pcd`), the body trajectory (`trajectory.tum`), the pose graph
+/// (`graph.g2o`), the occupancy grid (`grid.png`, `map.yaml` + `map.pgm`) and `summary.json`,
+/// all after the run: a failed run leaves nothing. Fails when the recording or the ground truth
+/// cannot be read or the engine accepts no scan.
 #[derive(Debug, Parser)]
 #[command(name = "slam")]
 #[allow(clippy::struct_excessive_bools)]
@@ -170,9 +183,21 @@ struct Args {
     /// loops are found however far the estimate drifted).
     #[arg(long)]
     no_place_recognition: bool,
-    /// Write the map, trajectory, pose graph and grid to this folder.
+    /// Write the map, trajectory, pose graph, grid and summary.json to this folder.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Recordings: the body's ground truth (`world_T_body`; a scan folder without
+    /// `--calibration` has body = LiDAR). A TUM file (8 numbers a line: stamp tx ty tz qx qy qz
+    /// qw, matched to the scans by stamp within 0.01 s) or KITTI poses (12 numbers a line, a
+    /// row-major [R|t], one line per scan in the recording's order, stamped with the scans'
+    /// stamps), told apart by the count of numbers on the first line whatever the file's
+    /// extension. Replaces the recording's own ground truth (KITTI poses.txt, a spot-nav
+    /// recording's) when it has one.
+    #[arg(long, value_name = "FILE", requires = "recording")]
+    ground_truth: Option<PathBuf>,
+    /// Write summary.json (what `--out` writes) to this file too, or alone.
+    #[arg(long, value_name = "FILE")]
+    summary: Option<PathBuf>,
 }
 
 /// `tx,ty,tz,qx,qy,qz,qw` as a pose.
@@ -257,30 +282,7 @@ fn slam(args: &Args) -> Result<()> {
         };
     }
     if let Some(path) = &args.recording {
-        let source = open_recording(path, &source_config(args))?;
-        out!("{}", source.description)?;
-        let lidar_only = !source.has_odometry || args.no_odometry;
-        if lidar_only {
-            out!("odometry    none: LiDAR-only, every scan registered against the local map")?;
-        }
-        let samples = source.samples;
-        // Reading runs on a thread of its own, a few scans ahead of the engine.
-        let mut samples = ReadAhead::new(samples, READ_AHEAD);
-        backend(
-            args,
-            config,
-            &mut samples,
-            source.body_t_lidar,
-            source.ground_truth.as_deref(),
-            lidar_only,
-        )?;
-        let dropped = samples.dropped_points();
-        out!(
-            "points      {} no-return and {} non-finite points removed",
-            dropped.no_return,
-            dropped.non_finite
-        )?;
-        Ok(())
+        replay(args, config, path)
     } else {
         let mut sim_config = SimulationConfig::with_seed(args.seed);
         sim_config.lidar = args.sensor.lidar();
@@ -293,32 +295,139 @@ fn slam(args: &Args) -> Result<()> {
         let sim = SimulatedSpot::corridor_loop(&sim_config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
+        let context = RunContext {
+            input: Input {
+                source: "simulator".to_owned(),
+                path: None,
+                description: simulation_description(args),
+                odometry: if args.no_odometry {
+                    "LiDAR-only"
+                } else {
+                    "simulated legs"
+                }
+                .to_owned(),
+                ground_truth: Some("the simulator's".to_owned()),
+            },
+            truth: Truth::Stamped(&truth),
+            lidar_only: args.no_odometry,
+        };
         if args.no_odometry {
             out!("odometry    none: LiDAR-only, every scan registered against the local map")?;
         }
-        let samples = sim.map(Ok::<Sample, Infallible>);
-        backend(
-            args,
-            config,
-            samples,
-            body_t_lidar,
-            Some(&truth),
-            args.no_odometry,
-        )
+        let mut samples = sim.map(Ok::<Sample, Infallible>);
+        backend(args, config, &mut samples, |_| None, body_t_lidar, &context)
     }
 }
 
-/// The engine `--registration` chooses, run on `samples`.
-fn backend<I, E>(
+/// Replays the recording at `path` through the engine.
+fn replay(args: &Args, config: GraphSlamConfig, path: &Path) -> Result<()> {
+    let truth_file = args
+        .ground_truth
+        .as_deref()
+        .map(GroundTruthFile::read)
+        .transpose()?;
+    let source = open_recording(path, &source_config(args))?;
+    out!("{}", source.description)?;
+    let own_truth = source.ground_truth.as_deref();
+    let ground_truth = match (&truth_file, own_truth) {
+        (Some(file), own) => {
+            file.check_count(source.samples.len())?;
+            let replacing = if own.is_some() {
+                ", replacing the recording's own ground truth"
+            } else {
+                ""
+            };
+            out!("truth       {}{replacing}", file.describe())?;
+            Some(format!("{}{replacing}", file.describe()))
+        }
+        (None, Some(_)) => Some("the recording's".to_owned()),
+        (None, None) => None,
+    };
+    let lidar_only_run = !source.has_odometry || args.no_odometry;
+    if lidar_only_run {
+        out!("odometry    none: LiDAR-only, every scan registered against the local map")?;
+    }
+    let samples = source.samples;
+    let context = RunContext {
+        input: Input {
+            source: "recording".to_owned(),
+            path: Some(path.display().to_string()),
+            description: source.description.clone(),
+            odometry: if lidar_only_run {
+                "LiDAR-only"
+            } else {
+                "recording"
+            }
+            .to_owned(),
+            ground_truth,
+        },
+        truth: match (&truth_file, own_truth) {
+            (Some(file), _) => Truth::File(file),
+            (None, Some(own)) => Truth::Stamped(own),
+            (None, None) => Truth::None,
+        },
+        lidar_only: lidar_only_run,
+    };
+    // Reading runs on a thread of its own, a few scans ahead of the engine.
+    let mut samples = ReadAhead::new(samples, READ_AHEAD);
+    backend(
+        args,
+        config,
+        &mut samples,
+        |s| Some(s.dropped_points()),
+        source.body_t_lidar,
+        &context,
+    )
+}
+
+/// The simulated run in a few words, for `summary.json`.
+fn simulation_description(args: &Args) -> String {
+    let range = args
+        .lidar_range
+        .map_or_else(String::new, |r| format!(", LiDAR range {r} m"));
+    format!(
+        "simulated corridor lap, seed {}{}{}{range}",
+        args.seed,
+        if args.skewed { ", skewed scans" } else { "" },
+        if args.blank_corridor {
+            ", blank corridor"
+        } else {
+            ""
+        }
+    )
+}
+
+/// Where the ground truth comes from; a file of KITTI poses takes the scans' stamps once they
+/// are read.
+enum Truth<'a> {
+    /// None known.
+    None,
+    /// The source's own, stamped.
+    Stamped(&'a [StampedPose]),
+    /// `--ground-truth`.
+    File(&'a GroundTruthFile),
+}
+
+/// What a run reports besides the engine's own figures.
+struct RunContext<'a> {
+    input: Input,
+    truth: Truth<'a>,
+    /// Whether the scans go to the engine without their odometry.
+    lidar_only: bool,
+}
+
+/// The engine `--registration` chooses, run on `samples`; `dropped` reads the points the
+/// reader removed once they are all read.
+fn backend<S, E>(
     args: &Args,
     config: GraphSlamConfig,
-    samples: I,
+    samples: &mut S,
+    dropped: fn(&S) -> Option<DroppedPoints>,
     body_t_lidar: Pose3,
-    truth: Option<&[StampedPose]>,
-    lidar_only: bool,
+    context: &RunContext<'_>,
 ) -> Result<()>
 where
-    I: ExactSizeIterator<Item = Result<Sample, E>>,
+    S: ExactSizeIterator<Item = Result<Sample, E>>,
     E: Into<anyhow::Error>,
 {
     let label = if args.recording.is_some() {
@@ -332,91 +441,188 @@ where
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
-            let mapping =
-                map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label, lidar_only)?;
-            report(&slam, &mapping, args)
+            let run = map_samples(&mut slam, &mut *samples, label, context.lidar_only)?;
+            let points = dropped(samples);
+            finish(&slam, &run, &body_t_lidar, points, args, context)
         }
         Registration::Loam => {
             let mut slam = loam_slam(config)?;
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
-            let mapping =
-                map_and_evaluate(&mut slam, samples, &body_t_lidar, truth, label, lidar_only)?;
-            report(&slam, &mapping, args)
+            let run = map_samples(&mut slam, &mut *samples, label, context.lidar_only)?;
+            let points = dropped(samples);
+            finish(&slam, &run, &body_t_lidar, points, args, context)
         }
     }
 }
 
-/// Print the run's figures and write the outputs to `out`.
-fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+/// Evaluates the run against the ground truth (when known), prints its figures and writes the
+/// outputs.
+fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
-    mapping: &spot_nav_examples::Mapping,
+    run: &MappedScans,
+    body_t_lidar: &Pose3,
+    points: Option<DroppedPoints>,
     args: &Args,
+    context: &RunContext<'_>,
 ) -> Result<()> {
-    let report = slam.report();
-    out!(
-        "scans       {} ({} keyframes, {} skipped)",
-        report.scans,
-        report.keyframes,
-        report.skipped_out_of_order
-            + report.skipped_non_finite_odometry
-            + report.skipped_too_few_points
-            + report.skipped_preparation
-            + report.skipped_awaiting_velocity
-            + report.skipped_non_finite_pose
-    )?;
-    out!(
-        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end); {} odometry fallbacks, {} odometry faults",
-        report.loops_closed,
-        report.loops_attempted,
-        report.place_loops_closed,
-        report.loops_beyond_drift,
-        report.loops_weighted_out,
-        report.fallbacks(),
-        report.odometry_faults
-    )?;
-    let loop_max = report.loop_ms.iter().copied().fold(0.0, f64::max);
-    let p99 = report.scan_ms_quantile(0.99);
-    let slowest = report
-        .scan_ms
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.total_cmp(b.1))
-        .map_or(0, |(i, _)| i + 1);
-    out!(
-        "time        {:.2} ms mean, {p99:.2} ms p99, {:.2} ms max (scan {slowest}) per scan (odometry path); loop steps max {loop_max:.1} ms; {:.1} s in all",
-        report.mean_scan_ms(),
-        report.max_scan_ms(),
-        mapping.seconds
-    )?;
-    if let Some(e) = &mapping.evaluation {
-        out!(
-            "accuracy    ATE {:.3} m, loop end-point error {:.3} m, drift {:.3} % of {:.1} m{}",
-            e.ate.rmse,
-            e.loop_end_point_error,
-            100.0 * e.end_point.relative_drift,
-            e.end_point.path_length,
-            e.segments.as_ref().map_or_else(String::new, |s| format!(
-                ", segments {:.3} %",
-                100.0 * s.translation
-            ))
-        )?;
-    }
+    let truth = match context.truth {
+        Truth::None => None,
+        Truth::Stamped(poses) => Some(poses.to_vec()),
+        Truth::File(file) => Some(file.stamped(&run.stamps)?),
+    };
+    let (evaluation, estimate) =
+        evaluate(slam, body_t_lidar, truth.as_deref()).with_context(|| {
+            format!(
+                "evaluating {} scan poses against the ground truth ({})",
+                slam.scan_trajectory().len(),
+                context.input.ground_truth.as_deref().unwrap_or("none")
+            )
+        })?;
+    let mapping = Mapping {
+        estimate,
+        evaluation,
+        seconds: run.seconds,
+    };
+    let summary = report(slam, &mapping, points, args, context)?;
     if let Some(dir) = &args.out {
-        write_outputs(slam, mapping, dir, args.lidar_height)?;
+        write_outputs(slam, &mapping, dir, args.lidar_height, &summary)?;
+    }
+    if let Some(path) = &args.summary {
+        write_summary(path, &summary)?;
+        out!("wrote       {}", path.display())?;
     }
     Ok(())
 }
 
-/// The map, trajectory, graph and grid in `dir` (made here, after the run).
+/// Prints the run's figures; returns them as `summary.json` holds them.
+fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    mapping: &Mapping,
+    points: Option<DroppedPoints>,
+    args: &Args,
+    context: &RunContext<'_>,
+) -> Result<SlamSummary> {
+    let report = slam.report();
+    let skipped: usize = skip_reasons(report).iter().map(|&(_, n)| n).sum();
+    out!(
+        "scans       {} ({} keyframes, {skipped} skipped)",
+        report.scans,
+        report.keyframes
+    )?;
+    let loops = Loops::new(report);
+    out!(
+        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end)",
+        loops.closed,
+        loops.tried,
+        loops.by_appearance,
+        loops.refused_beyond_drift,
+        loops.weighted_out
+    )?;
+    let health = print_tracking_health(report)?;
+    let time = Times::new(report, mapping.seconds);
+    out!(
+        "time        {:.2} ms mean, {:.2} ms p99, {:.2} ms max (scan {}) per scan (odometry path); loop steps max {:.1} ms; {:.1} s in all",
+        time.scan_ms_mean,
+        time.scan_ms_p99,
+        time.scan_ms_max,
+        time.slowest_scan,
+        time.loop_ms_max,
+        time.seconds
+    )?;
+    let points = points.map(|p| Points {
+        no_return: p.no_return,
+        non_finite: p.non_finite,
+    });
+    if let Some(p) = &points {
+        out!(
+            "points      {} no-return and {} non-finite points removed",
+            p.no_return,
+            p.non_finite
+        )?;
+    }
+    let accuracy = mapping.evaluation.as_ref().map(Accuracy::new);
+    if let Some(a) = &accuracy {
+        print_accuracy(a)?;
+    }
+    Ok(SlamSummary {
+        input: context.input.clone(),
+        registration: value_name(&args.registration),
+        scans: report.scans,
+        keyframes: report.keyframes,
+        loops,
+        tracking: health,
+        time,
+        points,
+        accuracy,
+    })
+}
+
+/// The accuracy lines: ATE and drifts, KITTI's RPE, each step's rotation error.
+fn print_accuracy(a: &Accuracy) -> Result<()> {
+    let drift = a.end_point_drift_percent.map_or_else(
+        || "the truth did not move".to_owned(),
+        |d| format!("{d:.3} % of {:.1} m", a.path_length_m),
+    );
+    let segments = a
+        .segment_drift_percent
+        .map_or_else(String::new, |s| format!(", segments (10-50 m) {s:.3} %"));
+    out!(
+        "accuracy    ATE {:.3} m (RMSE after SE(3) alignment, {} poses), end point {:.3} m ({drift}), height drift {:+.3} m, loop end-point error {:.3} m{segments}",
+        a.ate_m,
+        a.ate_pairs,
+        a.end_point_error_m,
+        a.height_drift_m,
+        a.loop_end_point_error_m
+    )?;
+    match (a.rpe_percent, a.rpe_rotation_deg_per_100m) {
+        (Some(t), Some(r)) => {
+            let lengths = match (
+                a.rpe_segment_lengths_m.first(),
+                a.rpe_segment_lengths_m.last(),
+            ) {
+                (Some(first), Some(last)) if first < last => format!("{first}-{last} m"),
+                (Some(first), _) => format!("{first} m"),
+                _ => String::new(),
+            };
+            let which = if a.rpe_kitti_lengths {
+                format!("KITTI's segments of {lengths}")
+            } else {
+                format!(
+                    "the path, {:.1} m, is shorter than KITTI's 100 m segments: over {lengths} instead",
+                    a.path_length_m
+                )
+            };
+            out!(
+                "rpe         {t:.3} % per 100 m, {r:.3} deg per 100 m ({which}; {} segments)",
+                a.rpe_segments
+            )?;
+        }
+        _ => out!(
+            "rpe         none: the path ({:.3} m) is too short for any segment",
+            a.path_length_m
+        )?,
+    }
+    out!(
+        "steps       {} of {} steps with more than 2 deg of rotation error against the truth, {} with more than 5 deg (largest {:.2} deg)",
+        a.steps_over_2_deg,
+        a.steps,
+        a.steps_over_5_deg,
+        a.step_rotation_error_max_deg
+    )
+}
+
+/// The map, trajectory, graph, grid and summary in `dir` (made here, after the run).
 fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
-    mapping: &spot_nav_examples::Mapping,
+    mapping: &Mapping,
     dir: &Path,
     lidar_height: f64,
+    summary: &SlamSummary,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_summary(&dir.join("summary.json"), summary)?;
     let map = slam.map(0.05)?;
     write_ply(dir.join("map.ply"), &map, PlyEncoding::BinaryLittleEndian)?;
     write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
@@ -439,14 +645,14 @@ fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             gridmap::write_png(dir.join("grid.png"), grid, Some(&inflated), &path, &[])?;
             gridmap::write_ros_map(grid, dir.join("map.yaml"))?;
             out!(
-                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, grid.png, map.yaml + map.pgm",
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, grid.png, map.yaml + map.pgm, summary.json",
                 dir.display()
             )?;
         }
         Err(e) => {
             eprintln!("note: no grid ({e:#}); is --lidar-height {lidar_height} m right?");
             out!(
-                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o",
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, summary.json",
                 dir.display()
             )?;
         }

@@ -1,7 +1,8 @@
 //! What the spot-nav examples share: where the bundled data lives, command-line pieces (backend
 //! choices, `X,Y` goals, the simulator's sensor and motion), standard output that ends quietly
-//! on a closed pipe, progress on stderr, timing summaries, and the map-and-evaluate loop of the
-//! `slam` and `mission` examples.
+//! on a closed pipe, progress on stderr, timing summaries, the map-and-evaluate loop of the
+//! `slam` and `mission` examples, and what `slam` adds to it: a ground-truth file, tracking
+//! health and `summary.json`.
 //!
 //! Every example's `main` is a one-liner around [`run`], which gives each failure an exit
 //! status of 1 and a one-line reason on stderr:
@@ -23,15 +24,20 @@
 
 pub mod args;
 pub mod data;
+pub mod ground_truth;
+pub mod health;
 pub mod mapping;
 pub mod output;
 pub mod picture;
 pub mod progress;
 pub mod sim_options;
 pub mod stats;
+pub mod summary;
 
 pub use args::{Registration, parse_goal, parse_numbers, value_name};
-pub use mapping::{Mapping, map_and_evaluate};
+pub use ground_truth::{GroundTruthFile, GroundTruthFormat};
+pub use health::{HealthSummary, print_tracking_health};
+pub use mapping::{MappedScans, Mapping, evaluate, map_and_evaluate, map_samples};
 pub use output::{StdoutClosed, run, write_line};
 pub use progress::Progress;
 pub use sim_options::{Motion, Sensor};

@@ -1,6 +1,6 @@
 //! The map-and-evaluate loop of the `slam` and `mission` examples: feed every sample to the
-//! Graph-SLAM engine with progress on stderr, then evaluate the body trajectory against the
-//! ground truth when the source knows it.
+//! Graph-SLAM engine with progress on stderr ([`map_samples`]), then evaluate the body trajectory
+//! against the ground truth when the source knows it ([`evaluate`]).
 
 use std::time::Instant;
 
@@ -25,12 +25,11 @@ pub struct Mapping {
 
 /// Feeds every sample to `slam` (progress labelled `label` on stderr, a line for each skipped
 /// scan; with `lidar_only` without their odometry, so that the engine tracks the scans by
-/// registration alone), then evaluates the body trajectory (`body_t_lidar`: the LiDAR mounting) against `truth`
-/// (`world_T_body`) when given.
+/// registration alone), then evaluates the body trajectory (`body_t_lidar`: the LiDAR mounting)
+/// against `truth` (`world_T_body`) when given: [`map_samples`] then [`evaluate`].
 ///
 /// # Errors
-/// The first sample that could not be read, a failed evaluation (fewer than 3 poses matched by
-/// stamp), or an engine that accepted no scan at all.
+/// As [`map_samples`] and [`evaluate`].
 pub fn map_and_evaluate<R, C, O, I, E>(
     slam: &mut GraphSlam<R, C, O>,
     samples: I,
@@ -46,10 +45,48 @@ where
     I: ExactSizeIterator<Item = Result<Sample, E>>,
     E: Into<anyhow::Error>,
 {
+    let run = map_samples(slam, samples, label, lidar_only)?;
+    let (evaluation, estimate) = evaluate(slam, body_t_lidar, truth)?;
+    Ok(Mapping {
+        estimate,
+        evaluation,
+        seconds: run.seconds,
+    })
+}
+
+/// What feeding the samples gave besides the engine's state.
+#[derive(Clone, Debug)]
+pub struct MappedScans {
+    /// Wall-clock seconds of feeding the samples (reading or simulating them included).
+    pub seconds: f64,
+    /// The stamp of every sample read, in order (skipped scans too).
+    pub stamps: Vec<f64>,
+}
+
+/// Feeds every sample to `slam` (without their odometry when `lidar_only`), with progress
+/// labelled `label` on stderr and a line for each skipped scan.
+///
+/// # Errors
+/// The first sample that could not be read, or an engine that accepted no scan at all.
+pub fn map_samples<R, C, O, I, E>(
+    slam: &mut GraphSlam<R, C, O>,
+    samples: I,
+    label: &str,
+    lidar_only: bool,
+) -> Result<MappedScans>
+where
+    R: MapRegistrator,
+    C: MapRegistrator,
+    O: Optimizer<Pose3>,
+    I: ExactSizeIterator<Item = Result<Sample, E>>,
+    E: Into<anyhow::Error>,
+{
     let mut progress = Progress::new(label, "scans", Some(samples.len() as u64));
+    let mut stamps = Vec::with_capacity(samples.len());
     let started = Instant::now();
     for (n, sample) in (1u64..).zip(samples) {
         let sample = sample.map_err(Into::into)?;
+        stamps.push(sample.stamp);
         let input = if lidar_only {
             sample.lidar_only_input()
         } else {
@@ -76,7 +113,25 @@ where
             report.scans
         );
     }
-    let (evaluation, estimate) = match truth {
+    Ok(MappedScans { seconds, stamps })
+}
+
+/// The body trajectory of `slam`'s scans (`body_t_lidar`: the LiDAR mounting), evaluated
+/// against `truth` (`world_T_body`) when given.
+///
+/// # Errors
+/// A failed evaluation (fewer than 3 poses matched by stamp).
+pub fn evaluate<R, C, O>(
+    slam: &GraphSlam<R, C, O>,
+    body_t_lidar: &Pose3,
+    truth: Option<&[StampedPose]>,
+) -> Result<(Option<TrajectoryEvaluation>, Vec<StampedPose>)>
+where
+    R: MapRegistrator,
+    C: MapRegistrator,
+    O: Optimizer<Pose3>,
+{
+    Ok(match truth {
         Some(truth) => {
             let (evaluation, estimate) = TrajectoryEvaluation::of_lidar_trajectory(
                 slam.scan_trajectory(),
@@ -86,10 +141,5 @@ where
             (Some(evaluation), estimate)
         }
         None => (None, body_trajectory(slam.scan_trajectory(), body_t_lidar)),
-    };
-    Ok(Mapping {
-        estimate,
-        evaluation,
-        seconds,
     })
 }

@@ -116,6 +116,8 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--odometry-information",
             "--loop-drift-rate",
             "--out",
+            "--ground-truth",
+            "--summary",
         ],
     ),
 ];
@@ -273,6 +275,12 @@ fn slam_refuses_simulator_options_with_a_recording() {
     rejected("slam", &["scans", "--sensor", "os1-128"], "--sensor");
     rejected("slam", &["scans", "--motion", "handheld"], "--motion");
     rejected("slam", &["--motion", "jog"], "--motion");
+}
+
+#[test]
+fn slam_takes_a_ground_truth_file_with_a_recording_only() {
+    // The simulator has its own ground truth.
+    rejected("slam", &["--ground-truth", "truth.tum"], "<PATH>");
 }
 
 /// `slam args` fails as a job (status 1, one line) naming `setting`, before it maps anything.

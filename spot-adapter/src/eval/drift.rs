@@ -1,6 +1,6 @@
-//! Relative drift: the end-point error over the path length, KITTI-style segment drift (Geiger
-//! et al., "Are we ready for autonomous driving?", CVPR 2012, devkit `evaluate_odometry`), and the
-//! loop end-point error. Inputs are associated pose lists of equal length (estimate[i] and
+//! Relative drift: the end-point error over the path length, the height drift, segment drift and
+//! the KITTI devkit's own (Geiger et al., "Are we ready for autonomous driving?", CVPR 2012,
+//! devkit `evaluate_odometry`), and the loop end-point error. Inputs are associated pose lists of equal length (estimate[i] and
 //! reference[i] at the same instant), e.g. from [`associate`](crate::eval::associate).
 
 use slam_core::Pose3;
@@ -23,7 +23,8 @@ pub fn path_length(poses: &[Pose3]) -> f64 {
         .sum()
 }
 
-fn check_lengths(estimate: &[Pose3], reference: &[Pose3]) -> Result<(), AdapterError> {
+/// Associated lists must be of equal length, at least 2.
+pub(crate) fn check_lengths(estimate: &[Pose3], reference: &[Pose3]) -> Result<(), AdapterError> {
     if estimate.len() != reference.len() || estimate.len() < 2 {
         return Err(AdapterError::TooFewPoses {
             found: estimate.len().min(reference.len()),
@@ -96,10 +97,10 @@ pub struct SegmentDrift {
     pub per_length: Vec<(f64, f64, usize)>,
 }
 
-/// KITTI's segment drift: from every `step`-th pose, for each length `L` in `lengths`, the
-/// first pose at least `L` metres further along the reference path ends a segment; the
-/// segment's error is `(est_i^-1 est_j)^-1 (ref_i^-1 ref_j)`, its translation and rotation
-/// divided by `L`. Lengths no segment reaches are left out.
+/// Segment drift: from every `step`-th pose, for each length `L` in `lengths`, the first pose
+/// at least `L` metres further along the reference path ends a segment; the segment's error is
+/// `(est_i^-1 est_j)^-1 (ref_i^-1 ref_j)`, its translation and rotation divided by `L`. Lengths
+/// no segment reaches are left out. [`kitti_segment_drift`] is the KITTI devkit's exact rule.
 ///
 /// # Errors
 /// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2, or when no
@@ -109,6 +110,36 @@ pub fn segment_drift(
     reference: &[Pose3],
     lengths: &[f64],
     step: usize,
+) -> Result<SegmentDrift, AdapterError> {
+    segments(estimate, reference, lengths, step, |d, end| d >= end)
+}
+
+/// The KITTI odometry devkit's segment drift (`evaluate_odometry.cpp`, `calcSequenceErrors`):
+/// segments from every 10th pose, each ending at the first pose *more* than its length further
+/// along the reference path, the mean over every segment of every length (not a mean of the
+/// lengths' means). With [`KITTI_SEGMENT_LENGTHS`] its `translation` times 100 is KITTI's
+/// "translation error" in %.
+///
+/// # Errors
+/// As [`segment_drift`].
+pub fn kitti_segment_drift(
+    estimate: &[Pose3],
+    reference: &[Pose3],
+    lengths: &[f64],
+) -> Result<SegmentDrift, AdapterError> {
+    segments(estimate, reference, lengths, KITTI_STEP, |d, end| d > end)
+}
+
+/// Poses between the starts of two KITTI segments (the devkit's `step_size`: 1 s at 10 Hz).
+pub const KITTI_STEP: usize = 10;
+
+/// [`segment_drift`] with the rule `ends(distance, start + length)` for a segment's last pose.
+fn segments(
+    estimate: &[Pose3],
+    reference: &[Pose3],
+    lengths: &[f64],
+    step: usize,
+    ends: impl Fn(f64, f64) -> bool,
 ) -> Result<SegmentDrift, AdapterError> {
     check_lengths(estimate, reference)?;
     let mut dist = vec![0.0];
@@ -122,7 +153,7 @@ pub fn segment_drift(
     for &len in lengths {
         let (mut lt, mut ln) = (0.0, 0usize);
         for i in (0..reference.len()).step_by(step.max(1)) {
-            let Some(j) = (i..reference.len()).find(|&j| dist[j] >= dist[i] + len) else {
+            let Some(j) = (i..reference.len()).find(|&j| ends(dist[j], dist[i] + len)) else {
                 break;
             };
             let e = estimate[i].inverse() * estimate[j];
@@ -151,4 +182,20 @@ pub fn segment_drift(
         segments: count,
         per_length,
     })
+}
+
+/// How much higher the estimate ends than the truth once their first poses are aligned: the
+/// estimate moved rigidly so that its first pose is the reference's first pose (`ref_0 est_0^-1
+/// est_i`), then the z of its last position minus the z of the reference's last position, in
+/// the reference's world frame (metres; positive when the estimate ends higher). Both start at
+/// the same point, so this is the estimate's climb from start to end minus the truth's. It
+/// needs a reference whose z is up (REP-103).
+///
+/// # Errors
+/// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2.
+pub fn height_drift(estimate: &[Pose3], reference: &[Pose3]) -> Result<f64, AdapterError> {
+    check_lengths(estimate, reference)?;
+    let n = estimate.len() - 1;
+    let end = reference[0] * estimate[0].inverse() * estimate[n];
+    Ok(end.translation.z - reference[n].translation.z)
 }

@@ -1,5 +1,6 @@
-//! Every accuracy figure of a run at once: ATE, end-point drift, segment drift and loop error of
-//! an estimated trajectory against the ground truth, associated by stamp.
+//! Every accuracy figure of a run at once: ATE, end-point and height drift, segment drift,
+//! KITTI's RPE, each step's rotation error and the loop error of an estimated trajectory against
+//! the ground truth, associated by stamp.
 
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
@@ -9,9 +10,10 @@ use crate::eval::ate::{
     AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate,
 };
 use crate::eval::drift::{
-    EndPointDrift, INDOOR_SEGMENT_LENGTHS, SegmentDrift, end_point_drift, loop_end_point_error,
-    segment_drift,
+    EndPointDrift, INDOOR_SEGMENT_LENGTHS, SegmentDrift, end_point_drift, height_drift,
+    loop_end_point_error, segment_drift,
 };
+use crate::eval::relative::{KittiRpe, kitti_rpe, step_rotation_errors};
 
 /// A trajectory of LiDAR poses (`map_T_lidar` per stamp) as body poses (`map_T_body`).
 #[must_use]
@@ -39,6 +41,15 @@ pub struct TrajectoryEvaluation {
     pub end_point: EndPointDrift,
     /// Segment drift over the given lengths, `None` when the path is shorter than all of them.
     pub segments: Option<SegmentDrift>,
+    /// KITTI's RPE per 100 m ([`kitti_rpe`]: 100 to 800 m segments, or the ladder scaled down
+    /// for a shorter path), `None` when the reference did not move.
+    pub rpe: Option<KittiRpe>,
+    /// How much higher the estimate ends than the truth with their first poses aligned
+    /// ([`height_drift`](crate::eval::height_drift), metres, signed).
+    pub height_drift: f64,
+    /// The rotation error of each step between consecutive associated poses (radians,
+    /// [`step_rotation_errors`]).
+    pub step_rotation_errors: Vec<f64>,
     /// Distance between the estimate's first and last positions minus the reference's (metres,
     /// never negative): for a run that returns to its start, the loop end-point error.
     pub loop_end_point_error: f64,
@@ -71,8 +82,31 @@ impl TrajectoryEvaluation {
             ate,
             end_point,
             segments,
+            rpe: kitti_rpe(&est, &gt),
+            height_drift: height_drift(&est, &gt)?,
+            step_rotation_errors: step_rotation_errors(&est, &gt)?,
             loop_end_point_error,
         })
+    }
+
+    /// Steps whose rotation error is larger than `degrees`.
+    #[must_use]
+    pub fn steps_over(&self, degrees: f64) -> usize {
+        let limit = degrees.to_radians();
+        self.step_rotation_errors
+            .iter()
+            .filter(|&&e| e > limit)
+            .count()
+    }
+
+    /// The largest step rotation error (degrees; 0 without steps).
+    #[must_use]
+    pub fn max_step_rotation_error_deg(&self) -> f64 {
+        self.step_rotation_errors
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            .to_degrees()
     }
 
     /// Evaluate a SLAM run's trajectory of LiDAR poses (`map_T_lidar` per stamp, as

@@ -249,3 +249,143 @@ fn evaluation_combines_the_figures() {
     assert!(e.ate.rmse > 0.0 && e.ate.rmse < 0.5);
     assert!(e.segments.is_some());
 }
+
+/// The trajectory pair of `tests/data/evo`, read as the `slam` example reads a ground truth.
+fn evo_pair() -> (Vec<StampedPose>, Vec<StampedPose>) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/evo");
+    let truth = slam_core::io::read_tum(dir.join("ground_truth.tum")).unwrap();
+    let estimate = slam_core::io::read_tum(dir.join("estimate.tum")).unwrap();
+    (truth, estimate)
+}
+
+/// `a` within `tolerance` of the golden `b`.
+fn close(a: f64, b: f64, tolerance: f64, what: &str) {
+    assert!((a - b).abs() <= tolerance, "{what}: ours {a}, golden {b}");
+}
+
+#[test]
+// The golden figures are written as the tools printed them, to be found in the README.
+#[allow(clippy::unreadable_literal)]
+fn evo_golden_figures() {
+    // Golden answers: evo 1.38.1's `evo_ape tum ground_truth.tum estimate.tum -a` and `evo_rpe
+    // ... -r angle_deg --delta 1 --delta_unit f` to full precision (evo_figures.py), and the
+    // KITTI devkit's translation error through KISS-ICP 1.3.0's port (kitti_figures.py);
+    // tests/data/evo/README.md has the commands and what they printed.
+    let (truth, estimate) = evo_pair();
+    let e = spot_adapter::eval::TrajectoryEvaluation::compute(
+        &estimate,
+        &truth,
+        DEFAULT_MAX_STAMP_DIFFERENCE,
+        &spot_adapter::eval::INDOOR_SEGMENT_LENGTHS,
+    )
+    .unwrap();
+    assert_eq!(e.ate.pairs, 565);
+    close(e.ate.rmse, 2.334440560218639, 1e-9, "ATE rmse");
+    close(e.ate.mean, 2.04081752465752, 1e-9, "ATE mean");
+    close(e.ate.median, 1.5913037604322984, 1e-9, "ATE median");
+    close(e.ate.max, 4.591366684701789, 1e-9, "ATE max");
+    close(
+        e.end_point.path_length,
+        360.2575219110453,
+        1e-9,
+        "path length",
+    );
+    // evo's RPE of 1-frame steps in degrees.
+    let steps: Vec<f64> = e
+        .step_rotation_errors
+        .iter()
+        .map(|r| r.to_degrees())
+        .collect();
+    assert_eq!(steps.len(), 564);
+    let n = steps.len() as f64;
+    let rmse = (steps.iter().map(|s| s * s).sum::<f64>() / n).sqrt();
+    close(rmse, 0.32676077959942423, 1e-9, "step rmse");
+    close(
+        steps.iter().sum::<f64>() / n,
+        0.06687034540976393,
+        1e-9,
+        "step mean",
+    );
+    close(
+        e.max_step_rotation_error_deg(),
+        7.018302228558682,
+        1e-9,
+        "step max",
+    );
+    assert_eq!((e.steps_over(2.0), e.steps_over(5.0)), (2, 1));
+    // KITTI: float32 from the peer, about 7 significant digits.
+    let rpe = e.rpe.as_ref().unwrap();
+    close(
+        rpe.translation_percent,
+        2.474599838256836,
+        2.5e-6,
+        "KITTI translation %",
+    );
+    assert_eq!(rpe.lengths, [100.0, 200.0, 300.0]);
+    assert!(rpe.is_kitti_ladder());
+}
+
+#[test]
+fn known_drifts_give_known_figures() {
+    // A straight 65 m walk along x in a world turned 30 degrees about z; the estimate, in a
+    // frame of its own, overshoots by 2 % and climbs 1 cm per metre walked.
+    let world = Pose3::from_parts(
+        Translation3::new(3.0, -2.0, 1.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, 30f64.to_radians()),
+    );
+    let own = Pose3::from_parts(
+        Translation3::new(-7.0, 4.0, 0.5),
+        UnitQuaternion::from_euler_angles(0.1, -0.2, 1.0),
+    );
+    let gt: Vec<Pose3> = (0..=650)
+        .map(|i| world * Pose3::translation(0.1 * f64::from(i), 0.0, 0.0))
+        .collect();
+    let climb = |x: f64| Pose3::translation(1.02 * x, 0.0, 0.01 * x);
+    let est: Vec<Pose3> = (0..=650).map(|i| own * climb(0.1 * f64::from(i))).collect();
+    let d = spot_adapter::eval::height_drift(&est, &gt).unwrap();
+    assert!((d - 0.65).abs() < 1e-9, "{d}");
+    // The end point: 1.3 m ahead and 0.65 m up.
+    let end = end_point_drift(&est, &gt).unwrap();
+    assert!((end.end_point_error - 1.3f64.hypot(0.65)).abs() < 1e-9);
+    // 65 m is shorter than KITTI's 100 m: its ladder tenfold smaller, 10 to 60 m fit (70 and
+    // more do not), and every segment is off by the same 2 % ahead and 1 % up.
+    let rpe = spot_adapter::eval::kitti_rpe(&est, &gt).unwrap();
+    assert!(!rpe.is_kitti_ladder() && (rpe.scale - 0.1).abs() < 1e-12);
+    assert_eq!(rpe.lengths.len(), 6);
+    for (l, expect) in rpe.lengths.iter().zip([10.0, 20.0, 30.0, 40.0, 50.0, 60.0]) {
+        assert!((l - expect).abs() < 1e-9);
+    }
+    let per_metre = 0.02f64.hypot(0.01);
+    // Segments end at the first pose beyond their length (0.1 m later), as KITTI's do.
+    assert!(
+        (rpe.translation_percent - 100.0 * per_metre).abs() < 100.0 * per_metre * 0.011,
+        "{rpe:?}"
+    );
+    // The pitch of the climb is a constant rotation between the frames, not a step error.
+    let steps = spot_adapter::eval::step_rotation_errors(&est, &gt).unwrap();
+    assert!(steps.iter().all(|&s| s < 1e-9));
+    // A sensor that did not move has no RPE.
+    let still = vec![world; 10];
+    assert!(spot_adapter::eval::kitti_rpe(&still, &still).is_none());
+}
+
+#[test]
+fn a_rotation_spike_is_one_step_error() {
+    // A 5 degree yaw kick at step 40 of a straight walk: that step, and no other, is 5 degrees
+    // off, whatever the path does afterwards.
+    let gt: Vec<Pose3> = (0..100)
+        .map(|i| Pose3::translation(0.2 * f64::from(i), 0.0, 0.0))
+        .collect();
+    let kick = Pose3::rotation(Vector3::z() * 5f64.to_radians());
+    let mut est = vec![gt[0]];
+    for k in 1..gt.len() {
+        let step = gt[k - 1].inverse() * gt[k];
+        let step = if k == 40 { step * kick } else { step };
+        est.push(est[k - 1] * step);
+    }
+    let steps = spot_adapter::eval::step_rotation_errors(&est, &gt).unwrap();
+    for (k, s) in steps.iter().enumerate() {
+        let expect = if k == 39 { 5f64.to_radians() } else { 0.0 };
+        assert!((s - expect).abs() < 1e-9, "step {k}: {s}");
+    }
+}
