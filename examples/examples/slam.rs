@@ -179,6 +179,10 @@ struct Args {
     /// Turn off the engine's deskewing of scans with per-point times.
     #[arg(long)]
     no_deskew: bool,
+    /// LiDAR-only: deskew each scan with the constant velocity of the last two scans only,
+    /// without estimating the sweep's own motion (`GraphSlamConfig::sweep_motion`).
+    #[arg(long)]
+    no_sweep_motion: bool,
     /// Seek loops by position only: no Scan Context place recognition (on by default, so that
     /// loops are found however far the estimate drifted).
     #[arg(long)]
@@ -262,6 +266,9 @@ fn slam(args: &Args) -> Result<()> {
     let mut config = slam_config();
     if args.no_deskew {
         config.deskew = false;
+    }
+    if args.no_sweep_motion {
+        config.sweep_motion = false;
     }
     if let Some(rate) = args.loop_drift_rate {
         config.loop_max_drift_rate = rate;

@@ -93,7 +93,9 @@ impl Default for IcpConfig {
 
 impl IcpConfig {
     /// These settings with the correspondence reach and the kernel's threshold of `reach` (a
-    /// kernel without a threshold stays as it is).
+    /// kernel without a threshold stays as it is), for a tracker's coarse stage: a coarse stride
+    /// of at least 4 and tolerances of at least 1 mm and 1 mrad, since the tracker's own fine
+    /// alignment follows.
     ///
     /// # Errors
     /// [`RegistrationError::InvalidConfig`] for a `reach` that is not finite and positive.
@@ -118,6 +120,13 @@ impl IcpConfig {
         Ok(Self {
             max_correspondence_distance: reach.distance,
             kernel,
+            // A wide reach pulls a scan into the basin of the alignment that follows: every
+            // fourth point first, and millimetres are enough.
+            coarse_stride: self.coarse_stride.max(4),
+            // A wide stage must move the guess along every direction.
+            degeneracy_threshold: 0.0,
+            translation_tolerance: self.translation_tolerance.max(WIDE_TRANSLATION_TOLERANCE),
+            rotation_tolerance: self.rotation_tolerance.max(WIDE_ROTATION_TOLERANCE),
             ..*self
         })
     }
@@ -208,6 +217,12 @@ impl IcpConfig {
         )
     }
 }
+
+/// An alignment [`IcpConfig::within`] a reach converges once a step moves less than this
+/// (metres) ...
+const WIDE_TRANSLATION_TOLERANCE: f64 = 1e-3;
+/// ... and turns less than this (radians).
+const WIDE_ROTATION_TOLERANCE: f64 = 1e-3;
 
 /// "Finite and not negative", the range of voxel sizes and tolerances.
 pub(crate) const NON_NEGATIVE: &str = "finite and not negative";

@@ -13,6 +13,8 @@ use crate::target::PreparedTarget;
 /// One correspondence: source point moved by the current pose, its target point, and the target
 /// normal when available.
 pub(crate) struct Pair {
+    /// The source point's index.
+    pub(crate) slot: usize,
     pub(crate) p: Point3<f64>,
     pub(crate) q: Point3<f64>,
     pub(crate) n: Option<Vector3<f64>>,
@@ -69,7 +71,7 @@ pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
 /// Each source point moved by `pose` and its target point within reach, through `cache`
 /// (slot = source index), into `pairs`: the nearest target point when the cache answers one
 /// neighbour, the mean of its neighbours when it answers more.
-fn correspondences(
+pub(crate) fn correspondences(
     source: &[Point3<f64>],
     target: &PreparedTarget,
     pose: &Pose3,
@@ -97,7 +99,7 @@ fn correspondences(
             });
             Point3::from(sum / nearest.len() as f64)
         };
-        pairs.push(Pair { p, q, n });
+        pairs.push(Pair { slot, p, q, n });
     }
 }
 
@@ -112,13 +114,14 @@ fn coarse_correspondences(
     pairs: &mut Vec<Pair>,
 ) {
     pairs.clear();
-    for s in source.iter().step_by(stride) {
+    for (slot, s) in source.iter().enumerate().step_by(stride) {
         let p = pose * s;
         let Some(i) = target.nearest_one(&p, max_distance) else {
             continue;
         };
         if let Some(n) = target.pairing_normal(i) {
             pairs.push(Pair {
+                slot,
                 p,
                 q: target.points[i],
                 n,
@@ -252,18 +255,7 @@ pub(crate) fn align<S: IcpStep>(
     }
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
-    let inliers = weights.iter().filter(|&&w| w > 0.0).count();
-    let sq: f64 = pairs
-        .iter()
-        .zip(&weights)
-        .filter(|(_, w)| **w > 0.0)
-        .map(|(p, _)| S::residual(p).powi(2))
-        .sum();
-    let rmse = if inliers > 0 {
-        (sq / inliers as f64).sqrt()
-    } else {
-        f64::INFINITY
-    };
+    let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, S::residual);
     let information = S::information(&pairs, &weights);
     Ok(Alignment {
         pose,
@@ -275,6 +267,27 @@ pub(crate) fn align<S: IcpStep>(
         min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
         information,
     })
+}
+
+/// The pairs with a weight above zero, and their RMS residual (infinite without any).
+pub(crate) fn inliers_and_rmse(
+    pairs: &[Pair],
+    weights: &[f64],
+    residual: impl Fn(&Pair) -> f64,
+) -> (usize, f64) {
+    let (inliers, sq) = pairs
+        .iter()
+        .zip(weights)
+        .filter(|(_, w)| **w > 0.0)
+        .fold((0, 0.0), |(n, sq), (p, _)| {
+            (n + 1, sq + residual(p).powi(2))
+        });
+    let rmse = if inliers > 0 {
+        (sq / inliers as f64).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    (inliers, rmse)
 }
 
 /// Smallest eigenvalue of an information matrix over its largest (0 when it is not positive).

@@ -62,6 +62,7 @@ mod place_index;
 mod point_to_plane;
 mod point_to_point;
 mod scan_context;
+mod sweep;
 mod sym3;
 mod target;
 mod voxel_hash_map;

@@ -2,7 +2,8 @@
 
 use nalgebra::{Matrix6, Point3, Vector6};
 use slam_core::{
-    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError, Registrator,
+    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError,
+    Registrator, SweepAlignment,
 };
 
 use crate::config::IcpConfig;
@@ -102,6 +103,22 @@ impl Registrator for PointToPlaneIcp {
         reach: &Reach,
     ) -> Result<Alignment, RegistrationError> {
         align::<GaussNewtonPlane>(&self.config.within(reach)?, 1, source, target, initial)
+    }
+
+    /// Point-to-plane registration of the sweep together with the correction to the velocity
+    /// it was deskewed with (see the crate docs' sweep section).
+    fn align_sweep(
+        &self,
+        sweep: &PointCloud,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Option<Result<SweepAlignment, RegistrationError>> {
+        Some(crate::sweep::align_sweep(
+            &self.config,
+            sweep,
+            target,
+            initial,
+        ))
     }
 }
 

@@ -60,4 +60,4 @@ pub use slam::{
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
-pub use traits::registrator::{Alignment, MapRegistrator, Reach, Registrator};
+pub use traits::registrator::{Alignment, MapRegistrator, Reach, Registrator, SweepAlignment};

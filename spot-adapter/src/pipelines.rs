@@ -57,23 +57,21 @@ fn assemble<R: MapRegistrator>(
     )
 }
 
-/// The trackers' `IcpConfig::min_planarity`: target points pair only where their neighbourhood
-/// is a plane (middle PCA eigenvalue at least a fifth of the largest). Neighbourhoods along a
-/// LiDAR ring have normals across the ring that pull a scan back towards where the map was
-/// seen from: LiDAR-only on building 1 with a blank north corridor, the SLAM odometry measured
-/// 0.92-0.94 of the distance walked along that corridor and the lap ended 1.34 m off; with this
-/// setting it measures 1.00 everywhere and the lap ends 1.1 cm off, with no loop.
-pub const PLANE_LIKE: f64 = 0.2;
-
-/// Point-to-plane ICP for tracking a scan against a map from a guess centimetres off (the
-/// SLAM odometry's, and the navigator's localisation): Tukey 10 cm, pairs within 0.5 m, plane-like
-/// target neighbourhoods only ([`PLANE_LIKE`]), no coarse stage.
+/// Point-to-plane ICP for tracking a scan against a map (the SLAM odometry's fine stage after the
+/// tracker's coarse ones, and the navigator's localisation): Tukey 10 cm, pairs within 0.5 m,
+/// every target normal, no coarse stage of its own.
+///
+/// Every normal: pairing only plane-like target neighbourhoods (`IcpConfig::min_planarity`
+/// 0.2) kept the scan-to-scan odometry this crate had before from sliding along a blank
+/// corridor, but with every scan registered against the local map it drops what fixes the
+/// motion along a corridor (door frames, corners): LiDAR-only, the seed-3 lap slid 9 cm in one
+/// scan and ended 6-9 cm ATE (0.9 cm with every normal), the hand-held OS1-128 walk 9.2 cm
+/// (2.6 cm); the blank corridor holds either way.
 #[must_use]
 pub fn point_to_plane_tracker() -> PointToPlaneIcp {
     PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.1 },
-            min_planarity: PLANE_LIKE,
             max_correspondence_distance: 0.5,
             coarse_stride: 1,
             ..IcpConfig::default()
@@ -96,10 +94,6 @@ pub fn point_to_plane_tracker() -> PointToPlaneIcp {
 pub fn point_to_plane_localiser() -> PointToPlaneIcp {
     let mut icp = point_to_plane_tracker();
     icp.config.target_voxel = 0.1;
-    // A map made of every scan of a walk is dense: the ring rows that bias scan-to-map
-    // tracking are rare in it, and leaving out what is not a plane (edges, furniture) costs
-    // goals: with `PLANE_LIKE` here the robot reached 10 of 20 random goals on building 5.
-    icp.config.min_planarity = 0.0;
     // A walk into a part of the map not seen yet would compute its normals in that cycle.
     icp.config.normals_up_front = true;
     // A navigator needs centimetres: steps of a tenth of a millimetre chase pairs that swap

@@ -102,6 +102,12 @@ pub struct GraphSlamConfig {
     /// without times, and scans more than a second after the previous one, are used as they
     /// are.
     pub deskew: bool,
+    /// Without odometry, register each swept scan (one with per-point times) a second time,
+    /// deskewed with the motion its own sweep shows (its two halves registered apart) instead
+    /// of the constant velocity of the last two scans, when that fits better. Costs about two
+    /// more registrations a scan; needed where the sensor shakes faster than the scans come (a
+    /// hand-held LiDAR recorded at 2 Hz). On by default.
+    pub sweep_motion: bool,
     /// Run one loop-closure step inside [`GraphSlam::process`](super::GraphSlam::process) after
     /// each new keyframe. When false the caller schedules
     /// [`GraphSlam::loop_closure_step`](super::GraphSlam::loop_closure_step) itself.
@@ -130,6 +136,7 @@ impl Default for GraphSlamConfig {
             map_voxel_size: 0.05,
             min_scan_points: 100,
             deskew: true,
+            sweep_motion: true,
             inline_loop_closure: true,
         }
     }

@@ -136,6 +136,10 @@ impl TrackOutcome {
     }
 }
 
+/// How much larger a share of the scan a retry must match to replace a registration that was
+/// taken but suspect.
+const CLEARLY_MORE: f64 = 0.05;
+
 /// A registration from one guess, or why it was refused (with the alignment a check refused).
 type Attempt = Result<Alignment, (FallbackReason, Option<Box<Alignment>>)>;
 
@@ -304,8 +308,11 @@ impl Tracker {
         let chosen = self.arbitrate(&attempts);
         let (index, alignment, recovered) = match chosen {
             Some((i, a)) if self.suspect(&a) => {
+                // A retry replaces a registration that was taken only when it matches clearly
+                // more: along a corridor a pose slid by a few centimetres can match a little
+                // more by chance.
                 match self.retry(registrator, source, target, &prediction) {
-                    Some(b) if fits_better(&b, &a) => (0, b, true),
+                    Some(b) if b.inlier_ratio > a.inlier_ratio + CLEARLY_MORE => (0, b, true),
                     _ => (i, a, false),
                 }
             }
@@ -399,7 +406,9 @@ impl Tracker {
     }
 
     /// The best registration of the prediction at the widest reach and turned either side, if
-    /// any is taken.
+    /// any is taken: the prediction first, then the headings nearest it on both sides, farther
+    /// ones only while the best so far is suspect (most sudden turns are found by the first
+    /// tries; each costs a whole coarse-to-fine registration).
     fn retry<R: Registrator>(
         &self,
         registrator: &R,
@@ -409,18 +418,21 @@ impl Tracker {
     ) -> Option<Alignment> {
         let widest = self.config.reach.max;
         let step = self.config.retry_turn_step;
-        let turns = (1..=self.config.retry_turns).flat_map(|k| {
+        let mut best: Option<Alignment> = None;
+        for k in 0..=self.config.retry_turns {
             #[allow(clippy::cast_precision_loss)]
             let a = k as f64 * step;
-            [a, -a]
-        });
-        let mut best: Option<Alignment> = None;
-        for angle in std::iter::once(0.0).chain(turns) {
-            let guess = turned(prediction, angle);
-            if let Ok(a) = self.attempt(registrator, source, target, &guess, widest)
-                && best.as_ref().is_none_or(|b| fits_better(&a, b))
-            {
-                best = Some(a);
+            let angles: &[f64] = if k == 0 { &[0.0] } else { &[a, -a] };
+            for &angle in angles {
+                let guess = turned(prediction, angle);
+                if let Ok(a) = self.attempt(registrator, source, target, &guess, widest)
+                    && best.as_ref().is_none_or(|b| fits_better(&a, b))
+                {
+                    best = Some(a);
+                }
+            }
+            if best.as_ref().is_some_and(|b| !self.suspect(b)) {
+                break;
             }
         }
         best
@@ -436,18 +448,23 @@ impl Tracker {
         guess: &Pose3,
         reach: f64,
     ) -> Attempt {
-        let start = if reach > self.config.reach.min {
-            let wide = Reach {
-                distance: reach,
-                kernel: reach * self.config.coarse_kernel,
+        // Coarse to fine: the reach halves stage by stage down to the smallest, so that a
+        // guess far off is pulled in by far pairs first and each narrower kernel starts inside
+        // its own basin (one wide stage straight into the fine one left 0.2 m slips along
+        // corridors after sudden turns).
+        let mut start = *guess;
+        let mut r = reach;
+        while r > self.config.reach.min {
+            let stage = Reach {
+                distance: r,
+                kernel: r * self.config.coarse_kernel,
             };
-            registrator
-                .align_within(source, target, guess, &wide)
+            start = registrator
+                .align_within(source, target, &start, &stage)
                 .map_err(|e| (reason_of(&e), None))?
-                .pose
-        } else {
-            *guess
-        };
+                .pose;
+            r *= 0.5;
+        }
         if !pose3_is_finite(&start) {
             return Err((FallbackReason::NonFinitePose, None));
         }
@@ -467,5 +484,250 @@ impl Tracker {
             return Err((FallbackReason::CorrectionTooLarge, Some(Box::new(a))));
         }
         Ok(a)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Matrix6;
+
+    use super::*;
+    use crate::cloud::PointCloud;
+
+    /// A registrator whose basin is a cone: from a guess within `width` radians of heading of
+    /// `answer` it finds `answer` (matching `share` of the scan); from farther it converges to a
+    /// wrong pose matching little, or fails.
+    struct Basin {
+        answer: Pose3,
+        width: f64,
+        share: f64,
+        /// The share the wrong minimum matches.
+        wrong_share: f64,
+    }
+
+    fn alignment(pose: Pose3, inlier_ratio: f64) -> Alignment {
+        Alignment {
+            pose,
+            converged: true,
+            iterations: 3,
+            inliers: 100,
+            inlier_ratio,
+            rmse: 0.01,
+            information: Matrix6::identity(),
+            min_eigenvalue_ratio: 1.0,
+        }
+    }
+
+    impl Registrator for Basin {
+        type Source = ();
+        type Target = ();
+        fn prepare_source(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+            Ok(())
+        }
+        fn prepare_target(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+            Ok(())
+        }
+        fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
+            let off = (guess.inverse() * self.answer).rotation.angle();
+            if off <= self.width {
+                Ok(alignment(self.answer, self.share))
+            } else if off <= 2.0 * self.width {
+                // A wrong minimum near the guess.
+                Ok(alignment(*guess, self.wrong_share))
+            } else {
+                Err(RegistrationError::TooFewCorrespondences {
+                    found: 3,
+                    required: 20,
+                })
+            }
+        }
+        fn align_within(
+            &self,
+            s: &(),
+            t: &(),
+            guess: &Pose3,
+            _: &Reach,
+        ) -> Result<Alignment, RegistrationError> {
+            self.align(s, t, guess)
+        }
+    }
+
+    fn yawed(degrees: f64) -> Pose3 {
+        turned(&Pose3::identity(), degrees.to_radians())
+    }
+
+    #[test]
+    fn a_turn_beyond_the_basin_is_recovered_from_a_turned_heading() {
+        let mut tracker = Tracker::new(TrackerConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+        let scan = Basin {
+            answer: yawed(0.0),
+            width: 12f64.to_radians(),
+            share: 0.9,
+            wrong_share: 0.35,
+        };
+        // Warm up: predictions right, 90 % matched.
+        for _ in 0..5 {
+            assert!(
+                tracker
+                    .track(&scan, &(), Some(&()), &[yawed(1.0)], 10.0)
+                    .tracked()
+            );
+        }
+        // A sudden turn: the prediction 50 degrees off. From it the registration fails; from
+        // the heading turned by 40 or 60 degrees it finds the answer.
+        let turn = Basin {
+            answer: yawed(50.0),
+            ..scan
+        };
+        let outcome = tracker.track(&turn, &(), Some(&()), &[yawed(0.0)], 10.0);
+        assert!(outcome.tracked() && outcome.recovered, "{outcome:?}");
+        assert!((outcome.pose.rotation.angle().to_degrees() - 50.0).abs() < 1e-9);
+        assert_eq!(tracker.health().recovered, 1);
+        // The reach widened after the turn.
+        assert!(tracker.reach() > 3.0, "{}", tracker.reach());
+        // A wrong minimum matching much less than usual is suspect and retried too.
+        let near = Basin {
+            answer: yawed(20.0),
+            ..scan
+        };
+        let outcome = tracker.track(&near, &(), Some(&()), &[yawed(-2.0)], 10.0);
+        assert!(
+            outcome.recovered && outcome.alignment.is_some(),
+            "{outcome:?}"
+        );
+        assert!((outcome.pose.rotation.angle().to_degrees() - 20.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn without_retries_a_lost_scan_falls_back_with_its_reason_and_losses_are_counted() {
+        let config = TrackerConfig {
+            retry: false,
+            ..TrackerConfig::default()
+        };
+        let mut tracker = Tracker::new(config).unwrap_or_else(|e| panic!("{e}"));
+        let far = Basin {
+            answer: yawed(90.0),
+            width: 10f64.to_radians(),
+            share: 0.9,
+            wrong_share: 0.2,
+        };
+        for k in 1..=4 {
+            let outcome = tracker.track(&far, &(), Some(&()), &[yawed(0.0)], 10.0);
+            assert_eq!(
+                outcome.fallback,
+                Some(FallbackReason::TooFewCorrespondences)
+            );
+            assert_eq!(outcome.pose, yawed(0.0), "the prediction is kept");
+            assert_eq!(tracker.health().consecutive_fallbacks, k);
+        }
+        assert!(tracker.is_lost());
+        assert_eq!(
+            tracker.health().losses,
+            1,
+            "counted once per run of fallbacks"
+        );
+        let outcome = tracker.track(&far, &(), None, &[yawed(0.0)], 10.0);
+        assert_eq!(outcome.fallback, Some(FallbackReason::NoTarget));
+        // A wrong minimum matching too little is refused, with the refused alignment kept.
+        let wrong = Basin {
+            answer: yawed(15.0),
+            ..far
+        };
+        let outcome = tracker.track(&wrong, &(), Some(&()), &[yawed(0.0)], 10.0);
+        assert_eq!(outcome.fallback, Some(FallbackReason::TooFewInliers));
+        assert!(outcome.refused.is_some());
+        assert_eq!(tracker.health().fallbacks.total(), 6);
+        assert!(tracker.health().fallback_ratio() > 0.99);
+    }
+
+    #[test]
+    fn every_bad_setting_is_refused_by_name() {
+        let d = TrackerConfig::default();
+        let cases = [
+            (
+                TrackerConfig {
+                    coarse_kernel: 0.0,
+                    ..d
+                },
+                "TrackerConfig::coarse_kernel",
+            ),
+            (
+                TrackerConfig {
+                    coarse_kernel: f64::NAN,
+                    ..d
+                },
+                "TrackerConfig::coarse_kernel",
+            ),
+            (
+                TrackerConfig {
+                    min_inlier_ratio: -0.1,
+                    ..d
+                },
+                "TrackerConfig::min_inlier_ratio",
+            ),
+            (
+                TrackerConfig {
+                    min_inlier_ratio: 1.5,
+                    ..d
+                },
+                "TrackerConfig::min_inlier_ratio",
+            ),
+            (
+                TrackerConfig {
+                    suspect_ratio: f64::NAN,
+                    ..d
+                },
+                "TrackerConfig::suspect_ratio",
+            ),
+            (
+                TrackerConfig {
+                    max_translation_correction: 0.0,
+                    ..d
+                },
+                "TrackerConfig::max_translation_correction",
+            ),
+            (
+                TrackerConfig {
+                    max_rotation_correction: -1.0,
+                    ..d
+                },
+                "TrackerConfig::max_rotation_correction",
+            ),
+            (
+                TrackerConfig {
+                    arbitration_distance: f64::INFINITY,
+                    ..d
+                },
+                "TrackerConfig::arbitration_distance",
+            ),
+            (
+                TrackerConfig {
+                    retry_turn_step: 0.0,
+                    ..d
+                },
+                "TrackerConfig::retry_turn_step",
+            ),
+            (
+                TrackerConfig { lost_after: 0, ..d },
+                "TrackerConfig::lost_after",
+            ),
+            (
+                TrackerConfig {
+                    reach: ReachConfig {
+                        sigmas: 0.0,
+                        ..d.reach
+                    },
+                    ..d
+                },
+                "ReachConfig::sigmas",
+            ),
+        ];
+        for (config, setting) in cases {
+            assert_eq!(
+                Tracker::new(config).err().map(|e| e.setting),
+                Some(setting),
+                "{config:?}"
+            );
+        }
     }
 }

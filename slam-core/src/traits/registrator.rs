@@ -1,6 +1,6 @@
 //! The `Registrator` trait: align a source cloud to a target cloud.
 
-use nalgebra::Matrix6;
+use nalgebra::{Matrix6, Vector6};
 
 use crate::cloud::PointCloud;
 use crate::error::RegistrationError;
@@ -51,6 +51,16 @@ impl Reach {
             && self.kernel.is_finite()
             && self.kernel > 0.0
     }
+}
+
+/// A sweep registered with its own motion ([`Registrator::align_sweep`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepAlignment {
+    /// The alignment; its pose is the sensor's at time 0 of the sweep.
+    pub alignment: Alignment,
+    /// The correction to the velocity the sweep was deskewed with (a twist per second in the
+    /// sensor frame, `[v; w]`): the sweep's own motion is that velocity plus this.
+    pub velocity_correction: Vector6<f64>,
 }
 
 /// A registration backend. Preparing a cloud (k-d tree, normals, features) is separate from
@@ -138,6 +148,27 @@ pub trait Registrator {
         initial: &Pose3,
         reach: &Reach,
     ) -> Result<Alignment, RegistrationError>;
+
+    /// Registers a sweep whose points carry times (seconds since the sweep began, the cloud's
+    /// `time` channel) and that was deskewed with a constant velocity that may be off, estimating
+    /// its pose at time 0 together with the correction to that velocity: where a sensor shakes
+    /// faster than its scans come, only a sweep's own points show how it moved during it.
+    /// `initial` is the pose at time 0 to start from.
+    ///
+    /// `None`, the default, when the backend cannot (a caller then keeps its registration from
+    /// [`Registrator::align`]).
+    ///
+    /// # Errors
+    /// As [`Registrator::align`].
+    fn align_sweep(
+        &self,
+        sweep: &PointCloud,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Option<Result<SweepAlignment, RegistrationError>> {
+        let _ = (sweep, target, initial);
+        None
+    }
 }
 
 /// A registrator that can build a target from prepared sources placed at poses: the local map of

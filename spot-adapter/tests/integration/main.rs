@@ -25,3 +25,4 @@ mod point_cloud2_fuzz;
 mod recording;
 mod simulator;
 mod slam_loop;
+mod tracking;
