@@ -184,6 +184,8 @@ pub(crate) fn align<S: IcpStep>(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
+    let thinned = thin_source(source, config.max_source_points);
+    let source = thinned.as_deref().unwrap_or(source);
     let mut pairs = Vec::with_capacity(source.len());
     let mut pose = *initial;
     let mut converged = false;
@@ -266,6 +268,16 @@ pub(crate) fn align<S: IcpStep>(
         rmse,
         min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
         information,
+    })
+}
+
+/// Every `k`-th point of `source`, the smallest `k` that leaves at most `max` (0: no limit);
+/// `None` when it is within the limit already. A voxelised scan lists its voxels in the order
+/// the sweep first met them, so a stride keeps them spread over the whole scan.
+pub(crate) fn thin_source<T: Copy>(source: &[T], max: usize) -> Option<Vec<T>> {
+    (max > 0 && source.len() > max).then(|| {
+        let k = source.len().div_ceil(max);
+        source.iter().step_by(k).copied().collect()
     })
 }
 

@@ -104,4 +104,9 @@ impl MapRegistrator for PointToPointIcp {
     ) -> Result<Self::Target, RegistrationError> {
         self.prepare_target(&merge_sources(parts))
     }
+
+    /// [`IcpConfig::source_voxel`] when above zero: the source is the scan's voxel centroids.
+    fn source_voxel(&self) -> Option<f32> {
+        (self.config.source_voxel > 0.0).then_some(self.config.source_voxel)
+    }
 }

@@ -18,7 +18,7 @@ use slam_core::{
 };
 
 use crate::config::IcpConfig;
-use crate::icp::{Pair, correspondences, inliers_and_rmse, min_eigenvalue_ratio};
+use crate::icp::{Pair, correspondences, inliers_and_rmse, min_eigenvalue_ratio, thin_source};
 use crate::neighbour_cache::NeighbourCache;
 use crate::target::PreparedTarget;
 
@@ -80,6 +80,13 @@ pub(crate) fn align_sweep(
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
     let (points, times) = sweep_points(config, sweep)?;
+    let (points, times) = match (
+        thin_source(&points, config.max_source_points),
+        thin_source(&times, config.max_source_points),
+    ) {
+        (Some(p), Some(t)) => (p, t),
+        _ => (points, times),
+    };
     let mut pose = *initial;
     let mut correction = Vector6::zeros();
     let mut moved = vec![Point3::origin(); points.len()];
@@ -166,6 +173,9 @@ fn normal_equations(
     weights: &mut Vec<f64>,
 ) -> (SMatrix<f64, 12, 12>, SVector<f64, 12>) {
     weights.clear();
+    // `Ad(P)` for each point's pose `P = T0 exp(t c)` is `Ad(T0)` to first order in the small
+    // correction: one adjoint an iteration instead of one a point.
+    let ad_t = se3_adjoint(pose).transpose();
     let mut h = SMatrix::<f64, 12, 12>::zeros();
     let mut b = SVector::<f64, 12>::zeros();
     let mut sum_w = 0.0;
@@ -181,8 +191,7 @@ fn normal_equations(
         let c = pair.p.coords.cross(&n);
         let j = Vector6::new(n.x, n.y, n.z, c.x, c.y, c.z);
         let t = times[pair.slot];
-        let ad = se3_adjoint(&(pose * se3_exp(&(correction * t))));
-        let jc = (ad.transpose() * j) * t;
+        let jc = (ad_t * j) * t;
         let mut row = SVector::<f64, 12>::zeros();
         row.fixed_rows_mut::<6>(0).copy_from(&j);
         row.fixed_rows_mut::<6>(6).copy_from(&jc);

@@ -85,8 +85,9 @@ pub struct GraphSlamConfig {
     /// slip there, ATE 0.12 m after the loop against 0.40 m with the fixed sigmas). The price:
     /// a chain soft along a corridor is soft along one of identical rooms too, and with
     /// [`loop_max_drift_rate`](Self::loop_max_drift_rate) off, graduated non-convexity then
-    /// keeps a consistent set of look-alike loops a few rooms long (it weighs every one out
-    /// with the fixed sigmas). Keep the drift gate on when you choose it.
+    /// keeps consistent sets of look-alike loops a few rooms long more often (with the fixed
+    /// sigmas it can too: small turns within their noise bend a lap a room's length). Keep the
+    /// drift gate on.
     pub odometry_information: EdgeInformation,
     /// Information of loop-closure edges: by default the refinement's own `J^T W J` (scale 1).
     /// On the simulated laps this ends where fixed 2 cm / 0.3° sigmas do (scales 1 to 100 give

@@ -52,8 +52,10 @@ struct Keyframe<S, C> {
 
 /// A scan made ready for the odometry.
 struct Prepared<S> {
-    /// Deskewed, finite points (LiDAR frame).
+    /// Deskewed, finite points (LiDAR frame), at the map's voxel when `thinned` is given.
     cloud: PointCloud,
+    /// The scan thinned to the map's voxel before deskewing, when the backend takes it so.
+    thinned: Option<PointCloud>,
     /// How it was deskewed, when it was.
     sweep: Option<Sweep>,
     /// Prepared for the odometry registrator.
@@ -456,15 +458,21 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Ok(p) => p,
             Err(skipped) => return skipped,
         };
+        // A swept scan is registered with its own motion, then deskewed anew with it for the
+        // map: at 2 Hz a hand's shake is faster than the scans, and the velocity between two
+        // scans says little about the 0.1 s of one sweep.
         let (mut pose, mut reg_info) = self.register(&prepared, &[predicted]);
         let mut prepared = prepared;
-        if swept && self.config.sweep_motion && reg_info.is_some() {
+        if swept
+            && self.config.sweep_motion
+            && reg_info.is_some()
+            && let Some((at, information, correction)) = self.sweep_motion(&prepared, &pose)
+        {
+            // The second scan has no velocity yet: its sweep's own motion is all there is.
             let v = velocity.unwrap_or_else(Vector6::zeros);
-            if let Some((refined, at, information)) = self.refine_sweep(scan, &prepared, v, &pose) {
-                prepared = refined;
-                pose = at;
-                reg_info = Some(information);
-            }
+            prepared = self.redeskew(scan, prepared, v + correction);
+            pose = at;
+            reg_info = Some(information);
         }
         let mut delta = self.keyframe_pose(last).inverse() * pose;
         delta.rotation.renormalize();
@@ -666,46 +674,55 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         (pose, outcome.alignment.map(|a| a.information))
     }
 
-    /// The scan registered again with the motion its own sweep shows
-    /// ([`Registrator::align_sweep`](crate::Registrator::align_sweep)), and deskewed anew with
-    /// `velocity` (the constant-velocity guess it was deskewed with) plus the correction found.
-    /// At 2 Hz a hand's shake is faster than the scans: the velocity between two scans says
-    /// little about the 0.1 s of one sweep. `None` when the backend cannot, or the result is
-    /// not taken (too few inliers, a non-finite pose, a correction beyond 10 rad/s or 10 m/s).
-    fn refine_sweep(
+    /// The scan registered again from `pose` (its registration) together with its sweep's own
+    /// motion ([`Registrator::align_sweep`](crate::Registrator::align_sweep)): the pose at the
+    /// sweep's start, its information, and the correction to the velocity it was deskewed with.
+    /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
+    /// pose).
+    fn sweep_motion(
         &self,
-        scan: &ScanInput<'_>,
         prepared: &Prepared<R::Source>,
-        velocity: Vector6<f64>,
         pose: &Pose3,
-    ) -> Option<(Prepared<R::Source>, Pose3, Matrix6<f64>)> {
+    ) -> Option<(Pose3, Matrix6<f64>, Vector6<f64>)> {
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
             .align_sweep(&prepared.cloud, map, pose)?
             .ok()?;
         let a = sweep.alignment;
-        let c = sweep.velocity_correction;
-        let plausible = c.fixed_rows::<3>(0).norm() <= 10.0 && c.fixed_rows::<3>(3).norm() <= 10.0;
-        if !(plausible
-            && pose3_is_finite(&a.pose)
-            && a.inlier_ratio >= self.config.tracker.min_inlier_ratio)
-        {
-            return None;
-        }
-        let mut cloud = deskew(scan.cloud, &(velocity + c))?;
-        cloud.remove_non_finite();
-        let source = self.odometry.prepare_source(&cloud).ok()?;
-        Some((
-            Prepared {
-                extent: prepared.extent,
+        (pose3_is_finite(&a.pose) && a.inlier_ratio >= self.config.tracker.min_inlier_ratio)
+            .then_some((a.pose, a.information, sweep.velocity_correction))
+    }
+
+    /// `prepared` deskewed anew with `velocity` (the one its sweep was registered with), and
+    /// prepared again for the map; as it was when the correction is implausible (beyond 10 rad/s
+    /// or 10 m/s) or the scan cannot be prepared.
+    fn redeskew(
+        &self,
+        scan: &ScanInput<'_>,
+        prepared: Prepared<R::Source>,
+        velocity: Vector6<f64>,
+    ) -> Prepared<R::Source> {
+        let plausible = velocity.fixed_rows::<3>(0).norm() <= 10.0
+            && velocity.fixed_rows::<3>(3).norm() <= 10.0;
+        let base = prepared.thinned.as_ref().unwrap_or(scan.cloud);
+        let again = plausible
+            .then(|| deskew(base, &velocity))
+            .flatten()
+            .and_then(|mut cloud| {
+                cloud.remove_non_finite();
+                let source = self.odometry.prepare_source(&cloud).ok()?;
+                Some((cloud, source))
+            });
+        match again {
+            Some((cloud, source)) => Prepared {
+                sweep: Sweep::of(base, velocity),
                 cloud,
-                sweep: Sweep::of(scan.cloud, velocity + c),
                 source,
+                ..prepared
             },
-            a.pose,
-            a.information,
-        ))
+            None => prepared,
+        }
     }
 
     /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted
@@ -746,12 +763,28 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         velocity: Option<Vector6<f64>>,
         started: Instant,
     ) -> Result<Prepared<R::Source>, ScanOutcome> {
-        let deskewed = velocity.and_then(|v| deskew(scan.cloud, &v).map(|c| (c, v)));
-        let sweep = deskewed
-            .as_ref()
-            .and_then(|(_, v)| Sweep::of(scan.cloud, *v));
-        let mut cloud = deskewed.map_or_else(|| scan.cloud.clone(), |(c, _)| c);
-        let dropped = cloud.remove_non_finite();
+        // A backend that only thins the scan by voxel gets it thinned once, to the map's voxel,
+        // before anything else: deskewing, registering and keeping a dense scan then cost what
+        // its voxels cost, not what its points cost (an OS1-128 sweep: 131,072 points).
+        let voxel = self.config.map_voxel_size;
+        let thinned = self
+            .odometry
+            .source_voxel()
+            .filter(|&v| v >= voxel)
+            .and_then(|_| scan.cloud.voxel_downsample(voxel).ok());
+        let base = thinned.as_ref().unwrap_or(scan.cloud);
+        let deskewed = velocity.and_then(|v| deskew(base, &v).map(|c| (c, v)));
+        let sweep = deskewed.as_ref().and_then(|(_, v)| Sweep::of(base, *v));
+        let mut cloud = deskewed.map_or_else(|| base.clone(), |(c, _)| c);
+        let dropped = match thinned {
+            Some(_) => scan
+                .cloud
+                .points()
+                .iter()
+                .filter(|p| !p.iter().all(|v| v.is_finite()))
+                .count(),
+            None => cloud.remove_non_finite(),
+        };
         if cloud.len() < self.config.min_scan_points {
             return Err(self.skip(SkipReason::TooFewPoints, started));
         }
@@ -762,6 +795,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Ok(Prepared {
             extent: scan_extent(&cloud),
             cloud,
+            thinned,
             sweep,
             source,
         })
@@ -781,15 +815,20 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     ) -> ScanOutcome {
         let Prepared {
             cloud,
+            thinned,
             source,
             sweep,
             ..
         } = prepared;
         // The map keeps the scan at its voxel; the loop check and place recognition read that
         // thinned scan too (a dense scan's 130,000 points voxelised once, not three times).
-        let cloud = cloud
-            .voxel_downsample(self.config.map_voxel_size)
-            .unwrap_or(cloud);
+        let cloud = if thinned.is_some() {
+            cloud
+        } else {
+            cloud
+                .voxel_downsample(self.config.map_voxel_size)
+                .unwrap_or(cloud)
+        };
         let Ok(coarse) = self.loop_coarse.prepare_source(&cloud) else {
             return self.skip(SkipReason::PreparationFailed, started);
         };

@@ -193,6 +193,15 @@ pub trait MapRegistrator: Registrator {
         source
     }
 
+    /// The voxel (metres) [`Registrator::prepare_source`] thins a scan to, when that is all it
+    /// does with the scan's layout: a caller may then hand it a scan already thinned to a finer
+    /// voxel (the engine thins a dense scan once, to its map voxel, and deskews, registers and
+    /// keeps that). `None`, the default, when the backend needs the scan as the sensor gave it
+    /// (LOAM's features run along each ring in firing order).
+    fn source_voxel(&self) -> Option<f32> {
+        None
+    }
+
     /// An empty map that parts can be added to ([`MapRegistrator::add_to_map`]) and removed from
     /// ([`MapRegistrator::remove_from_map`]) one at a time, so that a sliding window of keyframes
     /// is updated in place; or `None`, the default, when this backend builds maps only whole with

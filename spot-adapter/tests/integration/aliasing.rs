@@ -53,8 +53,10 @@ fn lap(seed: u64, aliased: bool, places: bool, config: GraphSlamConfig) -> Lap {
 
 /// Look-alike rooms are proposed and pass the geometric check, yet the final graph keeps only
 /// loops that the ground truth confirms, and the map is as accurate as without place
-/// recognition. (Seed 3 behaves the same: 11 wrong loops through the geometric check, none
-/// kept, ATE 1.0 cm.)
+/// recognition. The drift gate is what holds: with it off, graduated non-convexity weighs every
+/// wrong loop out on building 2 but keeps a run of 7 on building 1, each one room (11.7 m) off
+/// and all agreeing with one another, which bend the graph within the odometry's noise (ATE
+/// 4.1 m); that run is printed, not asserted.
 fn no_wrong_loop_survives(seed: u64) {
     let with = lap(seed, true, true, slam_config());
     let without = lap(seed, true, false, slam_config());
@@ -88,14 +90,6 @@ fn no_wrong_loop_survives(seed: u64) {
         "the repeated rooms fooled no geometric check: no aliasing to defend against"
     );
     assert_eq!(kept_wrong(&with), 0, "{:?}", with.loops);
-    // Without the gate the wrong loops reach the graph, and graduated non-convexity weighs
-    // every one of them out.
-    assert_eq!(kept_wrong(&ungated), 0, "{:?}", ungated.loops);
-    assert!(
-        ungated.ate <= 0.05,
-        "ATE {} m without the drift gate",
-        ungated.ate
-    );
     assert!(with.report.loops_beyond_drift >= 1);
     assert!(with.ate <= 0.05, "ATE {} m", with.ate);
     assert!(
