@@ -410,10 +410,11 @@ impl Tracker {
     /// both sides, farther ones only while the best so far is suspect (most sudden turns are
     /// found by the first tries; each costs a whole coarse-to-fine registration).
     ///
-    /// The prediction at both reaches: a wide one pulls in a scan turned far from its guess,
-    /// but in a corridor its far pairs can also slide a scan that was nearly right metres along
-    /// it (measured on a simulated hand-held walk: 5.4 m, refused as too large a correction,
-    /// after which only a wrong 56° turn registered); the initial reach finds that scan.
+    /// The prediction at both reaches, the initial one when the widest gave nothing or a suspect
+    /// fit: a wide reach pulls in a scan turned far from its guess, but in a corridor its far
+    /// pairs can also slide a scan that was nearly right metres along it (measured on a
+    /// simulated hand-held walk: 5.4 m, refused as too large a correction, after which only a
+    /// wrong 56° turn registered); the initial reach finds that scan.
     fn retry<R: Registrator>(
         &self,
         registrator: &R,
@@ -429,11 +430,14 @@ impl Tracker {
             #[allow(clippy::cast_precision_loss)]
             let a = k as f64 * step;
             let tries: &[(f64, f64)] = if k == 0 {
-                &[(0.0, narrow), (0.0, widest)]
+                &[(0.0, widest), (0.0, narrow)]
             } else {
                 &[(a, widest), (-a, widest)]
             };
             for &(angle, reach) in tries {
+                if k == 0 && reach < widest && best.as_ref().is_some_and(|b| !self.suspect(b)) {
+                    break;
+                }
                 let guess = turned(prediction, angle);
                 if let Ok(a) = self.attempt(registrator, source, target, &guess, reach)
                     && best.as_ref().is_none_or(|b| fits_better(&a, b))
