@@ -266,9 +266,11 @@ fn an_odometry_jump_is_detected_and_the_lap_stays_accurate() {
 /// middle of the 44 m corridor shows neither end: the scan-to-scan odometry this crate had
 /// before slipped along it there and that lap ended 3.5 m off (the `slam` example, seed 1).
 /// Every scan registered against the local map, with the tracker's retries of scans that
-/// match much less than usual, holds there too: both laps end within 5 cm with no loop.
+/// match much less than usual, holds there too: both laps end within 5 cm (measured 2.1 and
+/// 2.0 cm, ATE 1.4 and 1.3 cm), and the loops they close are found by position (the estimate
+/// never drifts beyond the 0.5 m search), with no place recognition.
 #[test]
-fn a_lidar_only_lap_through_a_blank_corridor_holds_without_loops() {
+fn a_lidar_only_lap_through_a_blank_corridor_holds_without_place_recognition() {
     for range in [100.0, 25.0] {
         let lap = run_blank_corridor_lap(point_to_plane_slam(slam_config()).unwrap(), range);
         eprintln!(
