@@ -361,8 +361,8 @@ fn os1_128_steps_match_the_reference_poses() {
     }
 }
 
-/// Point-to-plane with only plane-like target neighbourhoods (`min_planarity` 0.2, the
-/// pipelines' setting) on the three real sets, within the bounds of the tests above: random
+/// Point-to-plane with only plane-like target neighbourhoods (`min_planarity` 0.2, the slam
+/// bench ablation `p2plane-plane-like`) on the three real sets, within the bounds of the tests above: random
 /// halves of an HDL-32E scan; the OS1-128 steps; and the HDL-32E pair from identity and from
 /// 1 m / 10 degrees off, within 0.35 degrees and 3.5 cm of both published references, which
 /// themselves differ by 0.23 degrees and 1.9 cm (it ends 0.31 degrees from `small_gicp`'s and

@@ -103,11 +103,13 @@ pub struct GraphSlamConfig {
     /// without times, and scans more than a second after the previous one, are used as they
     /// are.
     pub deskew: bool,
-    /// Without odometry, register each swept scan (one with per-point times) a second time,
-    /// deskewed with the motion its own sweep shows (its two halves registered apart) instead
-    /// of the constant velocity of the last two scans, when that fits better. Costs about two
-    /// more registrations a scan; needed where the sensor shakes faster than the scans come (a
-    /// hand-held LiDAR recorded at 2 Hz). On by default.
+    /// Without odometry, register each swept scan (one with per-point times) a second time
+    /// together with the velocity over its sweep
+    /// ([`Registrator::align_sweep`](crate::Registrator::align_sweep), for backends that offer
+    /// it), and deskew it anew with that velocity instead of the constant velocity of the last
+    /// two scans; taken when it matches at least the tracker's `min_inlier_ratio`. Costs about
+    /// one more registration a scan; needed where the sensor shakes faster than the scans come
+    /// (a hand-held LiDAR recorded at 2 Hz). On by default.
     pub sweep_motion: bool,
     /// Run one loop-closure step inside [`GraphSlam::process`](super::GraphSlam::process) after
     /// each new keyframe. When false the caller schedules
