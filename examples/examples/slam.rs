@@ -168,6 +168,16 @@ struct Args {
         allow_negative_numbers = true
     )]
     lidar_range: Option<f64>,
+    /// Simulate a gyro on the body drifting this many degrees a second: each sample carries
+    /// the orientation integrated from it, and without odometry the engine predicts the turn
+    /// between two scans from it.
+    #[arg(
+        long,
+        value_name = "DEG_PER_S",
+        conflicts_with = "recording",
+        allow_negative_numbers = true
+    )]
+    gyro_drift: Option<f64>,
     /// How stiff the odometry edges are: fixed sigmas (the default), or fixed sigmas softened
     /// where the registration was weak (see `EdgeInformation::FixedAndRegistration`).
     #[arg(long, value_enum, value_name = "KIND", default_value_t = OdometryInformation::Fixed)]
@@ -299,6 +309,7 @@ fn slam(args: &Args) -> Result<()> {
         if let Some(range) = args.lidar_range {
             sim_config.lidar.max_range = range;
         }
+        sim_config.gyro_drift = args.gyro_drift.map(f64::to_radians);
         let sim = SimulatedSpot::corridor_loop(&sim_config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
@@ -392,8 +403,11 @@ fn simulation_description(args: &Args) -> String {
     let range = args
         .lidar_range
         .map_or_else(String::new, |r| format!(", LiDAR range {r} m"));
+    let gyro = args
+        .gyro_drift
+        .map_or_else(String::new, |d| format!(", a gyro drifting {d} deg/s"));
     format!(
-        "simulated corridor lap, seed {}{}{}{range}",
+        "simulated corridor lap, seed {}{}{}{range}{gyro}",
         args.seed,
         if args.skewed { ", skewed scans" } else { "" },
         if args.blank_corridor {

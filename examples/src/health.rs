@@ -60,6 +60,8 @@ pub struct HealthSummary {
     pub lost: bool,
     /// Odometry steps the registration contradicted (the robot's odometry was wrong there).
     pub odometry_faults: usize,
+    /// LiDAR-only scans whose turn since the last one the gyro predicted.
+    pub gyro_predictions: usize,
     /// Optimiser runs that failed (the graph was kept as it was).
     pub optimizer_failures: usize,
     /// Skipped scans.
@@ -96,6 +98,7 @@ impl HealthSummary {
             losses: tracking.losses,
             lost: fallback_share > LOST_SHARE || tracking.losses > 0,
             odometry_faults: report.odometry_faults,
+            gyro_predictions: report.gyro_predictions,
             optimizer_failures: report.optimizer_failures,
             skipped,
             skipped_by_reason: by_reason(skips),
@@ -139,7 +142,7 @@ fn listed(map: &BTreeMap<String, usize>) -> String {
 pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
     let health = HealthSummary::new(report);
     out!(
-        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} optimiser failures",
+        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} turns predicted by the gyro; {} optimiser failures",
         health.fallbacks,
         health.scans,
         100.0 * health.fallback_share,
@@ -147,6 +150,7 @@ pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
         health.recovered,
         health.losses,
         health.odometry_faults,
+        health.gyro_predictions,
         health.optimizer_failures
     )?;
     out!(

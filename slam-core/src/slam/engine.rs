@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{Matrix6, Vector6};
+use nalgebra::{Matrix6, UnitQuaternion, Vector6};
 
 use super::config::{EdgeInformation, GraphSlamConfig};
 use super::deskew::deskew;
@@ -32,6 +32,11 @@ pub struct ScanInput<'a> {
     pub body_t_lidar: Pose3,
     /// Points in the LiDAR frame.
     pub cloud: &'a PointCloud,
+    /// The body's orientation at `stamp` integrated from a gyro (`start_R_body`, drifting
+    /// slowly), when the source has one. Without odometry, the rotation between two scans that
+    /// both have one predicts the next scan's orientation instead of the constant velocity of
+    /// the last two: a hand-held sensor turns faster and less evenly than any extrapolation.
+    pub gyro_orientation: Option<UnitQuaternion<f64>>,
 }
 
 /// A keyframe: a node of the graph with what the engine keeps of its scan.
@@ -152,6 +157,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Every accepted scan.
     scan_poses: Vec<ScanPose>,
     last_stamp: f64,
+    /// The gyro orientation of the last scan taken (its stamp and `start_R_body`).
+    last_gyro: Option<(f64, UnitQuaternion<f64>)>,
     /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
     last_odometry: Option<StampedPose>,
     /// Place recognition over keyframe scans, when set: loops sought by appearance too.
@@ -191,6 +198,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             last_place_attempt: None,
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
+            last_gyro: None,
             last_odometry: None,
             places: None,
             report: SlamReport::default(),
@@ -329,6 +337,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// Feed one scan. Bad input (out-of-order stamps, non-finite odometry, empty or tiny scans) is
     /// skipped and counted in the report, never fatal.
     pub fn process(&mut self, scan: &ScanInput<'_>) -> ScanOutcome {
+        let outcome = self.process_scan(scan);
+        // The gyro pairs with the last scan whose pose was kept.
+        if self.last_stamp.to_bits() == scan.stamp.to_bits() {
+            self.last_gyro = scan
+                .gyro_orientation
+                .filter(|q| q.coords.iter().all(|v| v.is_finite()))
+                .map(|q| (scan.stamp, q));
+        }
+        outcome
+    }
+
+    /// [`Self::process`] but for the gyro's bookkeeping.
+    fn process_scan(&mut self, scan: &ScanInput<'_>) -> ScanOutcome {
         let started = Instant::now();
         self.report.scans += 1;
         if !scan.stamp.is_finite() || scan.stamp <= self.last_stamp {
@@ -454,6 +475,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let (predicted, velocity) = self
             .motion_prior(scan.stamp)
             .unwrap_or_else(|| (self.keyframe_pose(last), None));
+        let (predicted, velocity) = self.gyro_prior(scan, predicted, velocity);
         let prepared = match self.prepare(scan, velocity.filter(|_| swept), started) {
             Ok(p) => p,
             Err(skipped) => return skipped,
@@ -723,6 +745,41 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             },
             None => prepared,
         }
+    }
+
+    /// `predicted` and `velocity` with their rotation taken from the gyro when this scan and the
+    /// last one both have a gyro orientation: the last scan's orientation turned by the body's
+    /// rotation between the two (in the LiDAR frame), the angular velocity that rotation over
+    /// the time between them; translation as predicted.
+    fn gyro_prior(
+        &mut self,
+        scan: &ScanInput<'_>,
+        predicted: Pose3,
+        velocity: Option<Vector6<f64>>,
+    ) -> (Pose3, Option<Vector6<f64>>) {
+        let (Some((then, g0)), Some(g1), Some(last)) = (
+            self.last_gyro,
+            scan.gyro_orientation,
+            self.scan_poses.last(),
+        ) else {
+            return (predicted, velocity);
+        };
+        let dt = scan.stamp - then;
+        if dt.is_nan() || dt <= 0.0 || !g1.coords.iter().all(|v| v.is_finite()) {
+            return (predicted, velocity);
+        }
+        let mount = scan.body_t_lidar.rotation;
+        let turn = mount.inverse() * g0.inverse() * g1 * mount;
+        let x1 = self.keyframe_pose(last.keyframe) * last.keyframe_t_lidar;
+        let mut rotation = x1.rotation * turn;
+        rotation.renormalize();
+        self.report.gyro_predictions += 1;
+        let velocity = velocity.map(|mut v| {
+            v.fixed_rows_mut::<3>(3)
+                .copy_from(&(turn.scaled_axis() / dt));
+            v
+        });
+        (Pose3::from_parts(predicted.translation, rotation), velocity)
     }
 
     /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted

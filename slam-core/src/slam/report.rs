@@ -96,6 +96,10 @@ pub struct SlamReport {
     /// constant-velocity extrapolation, and the scan registered from the extrapolation fitted
     /// better than from the odometry's guess (or only it registered), so that pose was kept.
     pub odometry_faults: usize,
+    /// LiDAR-only scans whose predicted orientation came from the gyro
+    /// ([`ScanInput::gyro_orientation`](crate::ScanInput::gyro_orientation)) instead of the
+    /// constant velocity.
+    pub gyro_predictions: usize,
     /// Skipped scans: a non-finite keyframe pose ([`SkipReason::NonFinitePose`]).
     pub skipped_non_finite_pose: usize,
     /// Loop candidates tried.

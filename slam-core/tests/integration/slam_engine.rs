@@ -359,6 +359,7 @@ fn loop_closure_removes_odometry_drift() {
             odom_t_body: Some(*od),
             body_t_lidar,
             cloud: &cloud,
+            gyro_orientation: None,
         });
         if matches!(outcome, ScanOutcome::Keyframe { .. }) {
             keyframes += 1;
@@ -373,7 +374,8 @@ fn loop_closure_removes_odometry_drift() {
             stamp: 0.0,
             odom_t_body: Some(far),
             body_t_lidar,
-            cloud: &empty
+            cloud: &empty,
+            gyro_orientation: None,
         }),
         ScanOutcome::Skipped(slam_core::SkipReason::OutOfOrderStamp)
     );
@@ -383,7 +385,8 @@ fn loop_closure_removes_odometry_drift() {
             stamp: 1e6,
             odom_t_body: Some(nan),
             body_t_lidar,
-            cloud: &empty
+            cloud: &empty,
+            gyro_orientation: None,
         }),
         ScanOutcome::Skipped(_)
     ));
@@ -392,7 +395,8 @@ fn loop_closure_removes_odometry_drift() {
             stamp: 1e6 + 1.0,
             odom_t_body: Some(far),
             body_t_lidar,
-            cloud: &empty
+            cloud: &empty,
+            gyro_orientation: None,
         }),
         ScanOutcome::Skipped(_)
     ));
@@ -603,6 +607,7 @@ fn local_map_slid_in_place_equals_rebuilt() {
             odom_t_body: Some(odom),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
+            gyro_orientation: None,
         };
         assert_eq!(
             rebuilt.process(&input),
@@ -663,6 +668,7 @@ fn lap_with_odometry_jump(
             odom_t_body: Some(odom),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
+            gyro_orientation: None,
         });
     }
     let end = slam.current_lidar_pose().unwrap();
@@ -821,6 +827,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
             odom_t_body: Some(*gt),
             body_t_lidar: Pose3::identity(),
             cloud: &cloud,
+            gyro_orientation: None,
         });
     }
     // Points 500 m away match nothing, so no registration can stand in for the odometry.
@@ -834,6 +841,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
         odom_t_body: Some(odom),
         body_t_lidar: Pose3::identity(),
         cloud: &far,
+        gyro_orientation: None,
     };
     // Finite odometry: a keyframe at about 1.8e308 m (kept, unregistered)...
     assert!(matches!(

@@ -27,7 +27,7 @@ pub struct Sample {
 }
 
 impl Sample {
-    /// The sample as the Graph-SLAM engine's input (ground truth and gyro left out).
+    /// The sample as the Graph-SLAM engine's input (ground truth left out).
     #[must_use]
     pub fn scan_input(&self) -> ScanInput<'_> {
         ScanInput {
@@ -35,11 +35,13 @@ impl Sample {
             odom_t_body: Some(self.odom_t_body),
             body_t_lidar: self.body_t_lidar,
             cloud: &self.cloud,
+            gyro_orientation: self.gyro_orientation,
         }
     }
 
     /// The sample as the engine's input without its odometry: the engine tracks the scan by
-    /// registration alone (for a source with no odometry, or to leave the robot's out).
+    /// registration alone (for a source with no odometry, or to leave the robot's out), its
+    /// orientation predicted by the gyro when the sample has one.
     #[must_use]
     pub fn lidar_only_input(&self) -> ScanInput<'_> {
         ScanInput {

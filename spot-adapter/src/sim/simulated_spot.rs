@@ -51,7 +51,15 @@ pub struct SimulationConfig {
     /// sweep), as a real spinning LiDAR sees it; `false` (the default) casts the whole turn from
     /// the pose at the sample's stamp, so no deskewing is needed, and every point's `time` is 0.
     pub motion_distortion: bool,
+    /// A gyro on the body: each sample carries the orientation integrated from it
+    /// ([`Sample::gyro_orientation`]), the true one drifting at this rate (rad/s) about a fixed
+    /// tilted axis, as an uncalibrated bias makes it drift. `None` (the default): no gyro.
+    pub gyro_drift: Option<f64>,
 }
+
+/// The axis the simulated gyro drifts about (unit): tilted, so that the drift shows in roll and
+/// pitch as well as heading.
+const GYRO_DRIFT_AXIS: [f64; 3] = [0.36, -0.48, 0.8];
 
 impl Default for SimulationConfig {
     fn default() -> Self {
@@ -66,6 +74,7 @@ impl Default for SimulationConfig {
             limits: MotionLimits::default(),
             gait_sway: GaitSway::default(),
             motion_distortion: false,
+            gyro_drift: None,
         }
     }
 }
@@ -108,6 +117,7 @@ pub struct SimulatedSpot {
     truth: Vec<StampedPose>,
     next: usize,
     motion_distortion: bool,
+    gyro_drift: Option<f64>,
 }
 
 /// How the body moves between the samples.
@@ -162,6 +172,7 @@ impl SimulatedSpot {
         let lidar = SpinningLidar::new(config.lidar.clone())?;
         let sway = &config.gait_sway;
         require_non_negative(&[
+            ("gyro_drift", config.gyro_drift.unwrap_or(0.0)),
             ("gait_sway.height", sway.height),
             ("gait_sway.tilt", sway.tilt),
             ("gait_sway.frequency", sway.frequency),
@@ -225,6 +236,7 @@ impl SimulatedSpot {
             truth,
             next: 0,
             motion_distortion: config.motion_distortion,
+            gyro_drift: config.gyro_drift,
         })
     }
 
@@ -352,13 +364,23 @@ impl Iterator for SimulatedSpot {
                 &mut self.noise,
             ),
         };
+        let gyro_orientation = self
+            .gyro_drift
+            .zip(self.truth.first())
+            .map(|(rate, first)| {
+                let [x, y, z] = GYRO_DRIFT_AXIS;
+                let drift = nalgebra::Vector3::new(x, y, z) * (rate * (stamp - first.stamp));
+                first.pose.rotation.inverse()
+                    * world_t_body.rotation
+                    * nalgebra::UnitQuaternion::from_scaled_axis(drift)
+            });
         Some(Sample {
             stamp,
             odom_t_body,
             body_t_lidar: self.body_t_lidar,
             cloud,
             ground_truth: Some(world_t_body),
-            gyro_orientation: None,
+            gyro_orientation,
         })
     }
 

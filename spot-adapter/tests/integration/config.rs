@@ -205,6 +205,13 @@ fn hand(set: impl Fn(&mut HandheldConfig, f64)) -> impl Fn(&mut SimulationConfig
 
 #[test]
 fn bad_motion_settings_are_rejected() {
+    // Zero is a gyro that does not drift.
+    refuses(
+        "gyro_drift",
+        &NAN_NEGATIVE,
+        |c: &mut SimulationConfig, v| c.gyro_drift = Some(v),
+        simulate,
+    );
     refuses(
         "fast_turns.acceleration",
         &NAN_NEGATIVE_ZERO,
