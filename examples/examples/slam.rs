@@ -309,6 +309,13 @@ fn slam(args: &Args) -> Result<()> {
         if let Some(range) = args.lidar_range {
             sim_config.lidar.max_range = range;
         }
+        if let Some(drift) = args.gyro_drift {
+            // Checked here, in the unit given: the simulator names the setting in rad/s.
+            anyhow::ensure!(
+                drift.is_finite() && drift >= 0.0,
+                "--gyro-drift {drift}: must be finite and non-negative (degrees a second)"
+            );
+        }
         sim_config.gyro_drift = args.gyro_drift.map(f64::to_radians);
         let sim = SimulatedSpot::corridor_loop(&sim_config)?;
         let body_t_lidar = sim.body_t_lidar();

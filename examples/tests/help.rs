@@ -113,6 +113,7 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
             "--no-odometry",
             "--blank-corridor",
             "--lidar-range",
+            "--gyro-drift",
             "--odometry-information",
             "--loop-drift-rate",
             "--out",
@@ -271,6 +272,7 @@ fn slam_rejects_a_malformed_seed() {
 fn slam_refuses_simulator_options_with_a_recording() {
     rejected("slam", &["scans", "--blank-corridor"], "--blank-corridor");
     rejected("slam", &["scans", "--lidar-range", "25"], "--lidar-range");
+    rejected("slam", &["scans", "--gyro-drift", "0.2"], "--gyro-drift");
     rejected("slam", &["scans", "--skewed"], "--skewed");
     rejected("slam", &["scans", "--sensor", "os1-128"], "--sensor");
     rejected("slam", &["scans", "--motion", "handheld"], "--motion");
@@ -304,6 +306,9 @@ fn slam_fails_naming(args: &[&str], setting: &str) {
 fn slam_refuses_a_bad_lidar_range_or_drift_rate() {
     for range in ["-5", "0", "nan", "inf"] {
         slam_fails_naming(&["--lidar-range", range], "max_range");
+    }
+    for drift in ["-1", "nan", "inf"] {
+        slam_fails_naming(&["--gyro-drift", drift], "--gyro-drift");
     }
     for rate in ["-1", "nan"] {
         slam_fails_naming(&["--loop-drift-rate", rate], "loop_max_drift_rate");
