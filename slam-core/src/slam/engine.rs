@@ -159,6 +159,9 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     last_stamp: f64,
     /// The gyro orientation of the last scan taken (its stamp and `start_R_body`).
     last_gyro: Option<(f64, UnitQuaternion<f64>)>,
+    /// The RMS error of the last scan's registration by the tracker (its sweep's own must beat
+    /// it, [`GraphSlamConfig::sweep_min_gain`]).
+    last_fit: Option<f64>,
     /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
     last_odometry: Option<StampedPose>,
     /// Place recognition over keyframe scans, when set: loops sought by appearance too.
@@ -199,6 +202,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
             last_gyro: None,
+            last_fit: None,
             last_odometry: None,
             places: None,
             report: SlamReport::default(),
@@ -693,6 +697,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // or rounding compounds scan after scan.
         let mut pose = outcome.pose;
         pose.rotation.renormalize();
+        self.last_fit = outcome.alignment.as_ref().map(|a| a.rmse);
         (pose, outcome.alignment.map(|a| a.information))
     }
 
@@ -700,7 +705,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// motion ([`Registrator::align_sweep`](crate::Registrator::align_sweep)): the pose at the
     /// sweep's start, its information, and the correction to the velocity it was deskewed with.
     /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
-    /// pose).
+    /// pose, too small a gain over the scan's registration: `GraphSlamConfig::sweep_min_gain`).
     fn sweep_motion(
         &self,
         prepared: &Prepared<R::Source>,
@@ -712,7 +717,13 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .align_sweep(&prepared.cloud, map, pose)?
             .ok()?;
         let a = sweep.alignment;
-        (pose3_is_finite(&a.pose) && a.inlier_ratio >= self.config.tracker.min_inlier_ratio)
+        let gain = self.config.sweep_min_gain;
+        let better = self
+            .last_fit
+            .is_none_or(|rmse| a.rmse <= rmse * (1.0 - gain));
+        (pose3_is_finite(&a.pose)
+            && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
+            && better)
             .then_some((a.pose, a.information, sweep.velocity_correction))
     }
 

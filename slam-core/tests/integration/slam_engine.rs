@@ -735,7 +735,28 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 9] = [
+    let cases: [(GraphSlamConfig, &str); 12] = [
+        (
+            GraphSlamConfig {
+                sweep_min_gain: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_gain: -0.1,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_gain: 1.0,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_gain",
+        ),
         (
             GraphSlamConfig {
                 loop_max_drift_rate: f64::NAN,
