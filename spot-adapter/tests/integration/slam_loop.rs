@@ -101,26 +101,11 @@ fn deskewed_scans_meet_the_accuracy_targets() {
 #[test]
 fn a_skewed_lidar_only_lap_meets_the_targets() {
     let lap = |gain: f64| {
-        let mut config = SimulationConfig::with_seed(3);
-        config.motion_distortion = true;
-        let sim = SimulatedSpot::corridor_loop(&config).unwrap();
-        let body_t_lidar = sim.body_t_lidar();
-        let truth = sim.ground_truth();
-        let mut slam = point_to_plane_slam(GraphSlamConfig {
+        let config = GraphSlamConfig {
             sweep_min_gain: gain,
             ..slam_config()
-        })
-        .unwrap();
-        for sample in sim {
-            slam.process(&sample.lidar_only_input());
-        }
-        let (e, _) = TrajectoryEvaluation::of_lidar_trajectory(
-            slam.scan_trajectory(),
-            &body_t_lidar,
-            &truth,
-        )
-        .unwrap();
-        (e.ate.rmse, e.segments.unwrap().translation)
+        };
+        skewed_lap(config, true)
     };
     let (ate, drift) = lap(slam_config().sweep_min_gain);
     let (every_ate, every_drift) = lap(0.0);
@@ -136,23 +121,33 @@ fn a_skewed_lidar_only_lap_meets_the_targets() {
 
 /// The segment drift of the seed-3 lap with motion-distorted scans, not deskewed.
 fn run_skewed_lap_without_deskew() -> f64 {
-    let mut config = SimulationConfig::with_seed(3);
-    config.motion_distortion = true;
-    let sim = SimulatedSpot::corridor_loop(&config).unwrap();
-    let body_t_lidar = sim.body_t_lidar();
-    let truth = sim.ground_truth();
-    let mut slam = point_to_plane_slam(GraphSlamConfig {
+    let config = GraphSlamConfig {
         deskew: false,
         ..slam_config()
-    })
-    .unwrap();
+    };
+    skewed_lap(config, false).1
+}
+
+/// The seed-3 lap with motion-distorted scans through point-to-plane SLAM with `config`, the
+/// robot's odometry left out when `lidar_only`: ATE (m) and segment drift (fraction).
+fn skewed_lap(config: GraphSlamConfig, lidar_only: bool) -> (f64, f64) {
+    let mut sim_config = SimulationConfig::with_seed(3);
+    sim_config.motion_distortion = true;
+    let sim = SimulatedSpot::corridor_loop(&sim_config).unwrap();
+    let body_t_lidar = sim.body_t_lidar();
+    let truth = sim.ground_truth();
+    let mut slam = point_to_plane_slam(config).unwrap();
     for sample in sim {
-        slam.process(&sample.scan_input());
+        if lidar_only {
+            slam.process(&sample.lidar_only_input());
+        } else {
+            slam.process(&sample.scan_input());
+        }
     }
     let (e, _) =
         TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
             .unwrap();
-    e.segments.unwrap().translation
+    (e.ate.rmse, e.segments.unwrap().translation)
 }
 
 /// Loops by appearance: with the search by position cut down to 1 mm (as if the estimate had
