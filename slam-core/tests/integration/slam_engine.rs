@@ -884,3 +884,36 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
     assert_eq!(slam.graph().node_count(), slam.keyframe_count());
     assert_eq!(slam.graph().edge_count(), slam.keyframe_count() - 1);
 }
+
+/// A gyro orientation that is not finite (a corrupt IMU message) is ignored: the run is the
+/// one without a gyro, bit for bit, and no scan counts as gyro-predicted; a finite one predicts
+/// every LiDAR-only scan after the first.
+#[test]
+fn a_non_finite_gyro_is_ignored_and_a_finite_one_predicts_each_turn() {
+    let world = hall();
+    let truth = loop_poses();
+    let n = 12;
+    let run = |gyro: &dyn Fn(usize) -> Option<nalgebra::UnitQuaternion<f64>>| {
+        let mut slam = brute_engine(no_loop_config()).unwrap();
+        for (k, pose) in truth.iter().take(n).enumerate() {
+            let cloud = scan(&world, pose);
+            slam.process(&ScanInput {
+                stamp: k as f64 * 0.2,
+                odom_t_body: None,
+                body_t_lidar: Pose3::identity(),
+                cloud: &cloud,
+                gyro_orientation: gyro(k),
+            });
+        }
+        (slam.scan_trajectory(), slam.report().gyro_predictions)
+    };
+    let (plain, none) = run(&|_| None);
+    let nan =
+        nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(f64::NAN, 0.0, 0.0, 0.0));
+    let (corrupt, counted) = run(&|_| Some(nan));
+    assert_eq!(none, 0);
+    assert_eq!(counted, 0);
+    assert_eq!(plain, corrupt);
+    let (_, predicted) = run(&|k| Some(truth[0].rotation.inverse() * truth[k].rotation));
+    assert_eq!(predicted, n - 1);
+}
