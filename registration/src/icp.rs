@@ -8,7 +8,7 @@ use slam_core::{
 
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{NeighbourCache, Neighbours};
-use crate::target::PreparedTarget;
+use crate::target::{PreparedTarget, TargetIndex};
 
 /// One correspondence: source point moved by the current pose, its target point, and the target
 /// normal when available.
@@ -73,7 +73,7 @@ pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
 /// neighbour, the mean of its neighbours when it answers more.
 pub(crate) fn correspondences(
     source: &[Point3<f64>],
-    target: &PreparedTarget,
+    target: &TargetIndex,
     pose: &Pose3,
     cache: &mut NeighbourCache,
     pairs: &mut Vec<Pair>,
@@ -108,7 +108,7 @@ pub(crate) fn correspondences(
 fn coarse_correspondences(
     source: &[Point3<f64>],
     stride: usize,
-    target: &PreparedTarget,
+    target: &TargetIndex,
     pose: &Pose3,
     max_distance: f64,
     pairs: &mut Vec<Pair>,
@@ -184,6 +184,7 @@ pub(crate) fn align<S: IcpStep>(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
+    let target = target.index()?;
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
     let mut pairs = Vec::with_capacity(source.len());

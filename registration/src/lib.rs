@@ -66,6 +66,7 @@ mod sweep;
 mod sym3;
 mod target;
 mod voxel_hash_map;
+mod voxel_window;
 
 pub use config::IcpConfig;
 pub use kernel::IcpKernel;

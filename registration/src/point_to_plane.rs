@@ -81,7 +81,7 @@ impl Registrator for PointToPlaneIcp {
             self.config.min_correspondences,
         )?;
         if self.config.normals_up_front {
-            target.compute_all_normals();
+            target.index()?.compute_all_normals();
         }
         Ok(target)
     }
@@ -133,5 +133,29 @@ impl MapRegistrator for PointToPlaneIcp {
     /// [`IcpConfig::source_voxel`] when above zero: the source is the scan's voxel centroids.
     fn source_voxel(&self) -> Option<f32> {
         (self.config.source_voxel > 0.0).then_some(self.config.source_voxel)
+    }
+
+    /// With a [`IcpConfig::target_voxel`] above zero (and a valid configuration), a map kept
+    /// as per-voxel sums: a keyframe enters and leaves at the cost of its own points, and the
+    /// k-d tree is rebuilt over the voxel centroids on the first alignment after a change.
+    /// It holds the points [`MapRegistrator::target_from_sources`] would (up to rounding).
+    fn empty_map(&self) -> Option<Self::Target> {
+        let c = &self.config;
+        (c.target_voxel > 0.0 && c.validate().is_ok()).then(|| {
+            PreparedTarget::window(
+                c.target_voxel,
+                Some((c.normal_neighbours, c.min_planarity)),
+                c.normals_up_front,
+                c.min_correspondences,
+            )
+        })
+    }
+
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
+        map.add_part(key, source, pose);
+    }
+
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
+        map.remove_part(key);
     }
 }

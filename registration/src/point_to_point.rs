@@ -109,4 +109,20 @@ impl MapRegistrator for PointToPointIcp {
     fn source_voxel(&self) -> Option<f32> {
         (self.config.source_voxel > 0.0).then_some(self.config.source_voxel)
     }
+
+    /// As [`PointToPlaneIcp`](crate::PointToPlaneIcp)'s: with a
+    /// [`IcpConfig::target_voxel`] above zero, a map of per-voxel sums updated in place.
+    fn empty_map(&self) -> Option<Self::Target> {
+        let c = &self.config;
+        (c.target_voxel > 0.0 && c.validate().is_ok())
+            .then(|| PreparedTarget::window(c.target_voxel, None, false, c.min_correspondences))
+    }
+
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
+        map.add_part(key, source, pose);
+    }
+
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
+        map.remove_part(key);
+    }
 }

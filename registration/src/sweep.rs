@@ -79,6 +79,7 @@ pub(crate) fn align_sweep(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
+    let target = target.index()?;
     let (points, times) = sweep_points(config, sweep)?;
     let (points, times) = match (
         thin_source(&points, config.max_source_points),

@@ -10,9 +10,26 @@ use slam_core::{Degeneracy, PointCloud, Pose3, RegistrationError};
 use crate::config::IcpConfig;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
+use crate::voxel_window::VoxelWindow;
+
+/// A prepared target: its points indexed for queries, or, for a local map updated in place
+/// ([`MapRegistrator::empty_map`](slam_core::MapRegistrator::empty_map)), the voxel window
+/// they come from, indexed again on the first query after each change.
+pub struct PreparedTarget {
+    index: OnceCell<Result<TargetIndex, RegistrationError>>,
+    window: Option<Box<Window>>,
+}
+
+/// A window of placed sources and how its index is built.
+struct Window {
+    voxels: VoxelWindow,
+    normals: Option<(usize, f64)>,
+    normals_up_front: bool,
+    min_points: usize,
+}
 
 /// Target points, their k-d tree and (optionally) unit normals.
-pub struct PreparedTarget {
+pub(crate) struct TargetIndex {
     pub(crate) points: Vec<Point3<f64>>,
     /// In f32: half the memory traffic of f64 per query; targets span far less than the
     /// kilometres where f32 would lose millimetres.
@@ -31,9 +48,91 @@ struct NormalCache {
 
 impl std::fmt::Debug for PreparedTarget {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let points = match (self.index.get(), &self.window) {
+            (Some(Ok(index)), _) => index.points.len(),
+            (_, Some(w)) => w.voxels.len(),
+            _ => 0,
+        };
         f.debug_struct("PreparedTarget")
-            .field("points", &self.points.len())
+            .field("points", &points)
+            .field("in_place", &self.window.is_some())
             .finish_non_exhaustive()
+    }
+}
+
+impl PreparedTarget {
+    /// A target of `points` (see [`TargetIndex::new`]).
+    pub(crate) fn new(
+        points: Vec<Point3<f64>>,
+        normals: Option<(usize, f64)>,
+        min_points: usize,
+    ) -> Result<Self, RegistrationError> {
+        let index = TargetIndex::new(points, normals, min_points)?;
+        Ok(Self {
+            index: OnceCell::from(Ok(index)),
+            window: None,
+        })
+    }
+
+    /// An empty local map of voxel centroids (`voxel` metres, finite and positive) that
+    /// sources are added to and removed from in place.
+    pub(crate) fn window(
+        voxel: f32,
+        normals: Option<(usize, f64)>,
+        normals_up_front: bool,
+        min_points: usize,
+    ) -> Self {
+        Self {
+            index: OnceCell::new(),
+            window: Some(Box::new(Window {
+                voxels: VoxelWindow::new(voxel),
+                normals,
+                normals_up_front,
+                min_points,
+            })),
+        }
+    }
+
+    /// Adds `source` moved by `pose` under `key` to an in-place map (replacing what `key`
+    /// held); a target prepared whole is left as it is.
+    pub(crate) fn add_part(&mut self, key: u32, source: &[Point3<f64>], pose: &Pose3) {
+        if let Some(w) = self.window.as_mut() {
+            w.voxels.add(key, source, pose);
+            self.index = OnceCell::new();
+        }
+    }
+
+    /// Removes what `key` added to an in-place map.
+    pub(crate) fn remove_part(&mut self, key: u32) {
+        if let Some(w) = self.window.as_mut() {
+            w.voxels.remove(key);
+            self.index = OnceCell::new();
+        }
+    }
+
+    /// The indexed points, built now when an in-place map changed since the last query.
+    ///
+    /// # Errors
+    /// Too few points, or points that do not span a plane (see [`TargetIndex::new`]).
+    pub(crate) fn index(&self) -> Result<&TargetIndex, RegistrationError> {
+        self.index
+            .get_or_init(|| {
+                let Some(w) = self.window.as_ref() else {
+                    // A target prepared whole is built when prepared.
+                    return Err(RegistrationError::TooFewPoints {
+                        what: "target",
+                        points: 0,
+                        required: 1,
+                    });
+                };
+                let index = TargetIndex::new(w.voxels.centroids(), w.normals, w.min_points)?;
+                if w.normals_up_front {
+                    index.compute_all_normals();
+                }
+                Ok(index)
+            })
+            .as_ref()
+            .map_err(Clone::clone)
     }
 }
 
@@ -75,7 +174,7 @@ fn spread_dimensions(points: &[Point3<f64>]) -> usize {
     sigma.iter().filter(|&&s| s > tolerance).count()
 }
 
-impl PreparedTarget {
+impl TargetIndex {
     /// Build the tree (and normals from `normals.0` nearest points, kept where the
     /// neighbourhood's planarity reaches `normals.1`, when asked).
     /// Coincident or collinear points are refused ([`Degeneracy::DegenerateTarget`]).
@@ -215,7 +314,7 @@ fn pca_normal(
         .then(|| eigen.vectors.column(0).into_owned())
 }
 
-impl PreparedTarget {
+impl TargetIndex {
     /// The index of the target point nearest to `q` within `max_distance`.
     #[allow(clippy::cast_possible_truncation)]
     pub(crate) fn nearest_one(&self, q: &Point3<f64>, max_distance: f64) -> Option<usize> {
@@ -228,7 +327,7 @@ impl PreparedTarget {
     }
 }
 
-impl NearestSearch for PreparedTarget {
+impl NearestSearch for TargetIndex {
     #[allow(clippy::cast_possible_truncation)]
     fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
         out.clear();
@@ -253,16 +352,21 @@ impl NearestSearch for PreparedTarget {
 }
 
 impl PreparedTarget {
-    /// Number of target points.
+    /// Number of target points (an in-place map's voxels; 0 for one too small to align
+    /// against).
     #[must_use]
     pub fn len(&self) -> usize {
-        self.points.len()
+        match (&self.window, self.index()) {
+            (Some(w), _) => w.voxels.len(),
+            (None, Ok(index)) => index.points.len(),
+            (None, Err(_)) => 0,
+        }
     }
 
     /// Whether the target has no points.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
+        self.len() == 0
     }
 }
 
@@ -310,12 +414,12 @@ mod tests {
                 points.push(Point3::new(3.0 + jitter, a, b + 0.3 * a));
             }
         }
-        let lazy = PreparedTarget::new(points.clone(), Some((10, 0.0)), 3).unwrap();
-        let eager = PreparedTarget::new(points, Some((10, 0.0)), 3).unwrap();
+        let lazy = TargetIndex::new(points.clone(), Some((10, 0.0)), 3).unwrap();
+        let eager = TargetIndex::new(points, Some((10, 0.0)), 3).unwrap();
         eager.compute_all_normals();
         let cache = eager.normals.as_ref().unwrap();
         assert!(cache.cells.iter().all(|c| c.get().is_some()));
-        for i in 0..lazy.len() {
+        for i in 0..lazy.points.len() {
             assert_eq!(lazy.normal(i), eager.normal(i), "point {i}");
         }
         // A wall's normal is its axis (either sign).
@@ -338,8 +442,8 @@ mod tests {
             let wobble = 0.002 * f64::from(i % 3);
             points.push(Point3::new(f64::from(i) * 0.25, 10.0 + wobble, 0.0));
         }
-        let every = PreparedTarget::new(points.clone(), Some((10, 0.0)), 3).unwrap();
-        let planes = PreparedTarget::new(points, Some((10, 0.2)), 3).unwrap();
+        let every = TargetIndex::new(points.clone(), Some((10, 0.0)), 3).unwrap();
+        let planes = TargetIndex::new(points, Some((10, 0.2)), 3).unwrap();
         for i in 0..row {
             let n = planes.normal(i).expect("a floor point has a normal");
             assert!(n.z.abs() > 0.999, "{n:?}");
@@ -350,5 +454,56 @@ mod tests {
             assert_eq!(planes.normal(i), None, "row point {i}");
             assert_eq!(planes.pairing_normal(i), None, "row point {i}");
         }
+    }
+
+    /// An in-place local map slid over keyframes aligns a scan to the pose a map built whole
+    /// from the same keyframes gives, and an empty one refuses to align with a named error.
+    #[test]
+    fn an_in_place_map_aligns_as_the_map_built_whole() {
+        use slam_core::{MapRegistrator, Registrator};
+        // A room: floor, two walls and a box, sampled every 5 cm.
+        let mut room = Vec::new();
+        for i in 0..80 {
+            for j in 0..60 {
+                let (a, b) = (f64::from(i) * 0.05, f64::from(j) * 0.05);
+                room.push(Point3::new(a, b, 0.0));
+                room.push(Point3::new(a, 0.0, b * 0.5));
+                room.push(Point3::new(0.0, b, a * 0.3));
+                if i < 10 && j < 10 {
+                    room.push(Point3::new(2.0 + a, 1.5, b));
+                }
+            }
+        }
+        let icp = crate::PointToPlaneIcp::default();
+        assert!(icp.empty_map().unwrap().index().is_err());
+        let cloud = PointCloud::from_points(room.iter().map(|p| p.cast::<f32>()).collect());
+        let source = icp.prepare_source(&cloud).unwrap();
+        let poses: Vec<Pose3> = (0..5)
+            .map(|k| {
+                Pose3::new(
+                    nalgebra::Vector3::new(0.02 * f64::from(k), 0.0, 0.0),
+                    nalgebra::Vector3::zeros(),
+                )
+            })
+            .collect();
+        let mut in_place = icp.empty_map().unwrap();
+        for (k, pose) in (0u32..).zip(&poses) {
+            icp.add_to_map(&mut in_place, k, &source, pose);
+            if let Some(old) = k.checked_sub(3) {
+                icp.remove_from_map(&mut in_place, old);
+            }
+        }
+        let parts: Vec<_> = poses[2..].iter().map(|p| (&source, *p)).collect();
+        let whole = icp.target_from_sources(&parts).unwrap();
+        assert_eq!(in_place.len(), whole.len());
+        let guess = Pose3::new(
+            nalgebra::Vector3::new(0.1, -0.05, 0.03),
+            nalgebra::Vector3::new(0.0, 0.0, 0.03),
+        );
+        let a = icp.align(&source, &in_place, &guess).unwrap();
+        let b = icp.align(&source, &whole, &guess).unwrap();
+        let apart = a.pose.inverse() * b.pose;
+        assert!(apart.translation.vector.norm() < 1e-4, "{apart:?}");
+        assert!(apart.rotation.angle() < 1e-4, "{apart:?}");
     }
 }

@@ -53,10 +53,14 @@ fn a_static_scan_folder_runs_lidar_only_without_drifting() {
     }
     let trajectory = slam.scan_trajectory();
     assert_eq!(trajectory.len(), 10);
+    // The map is thinned to a finer voxel than the scan (`point_to_plane_tracker`), so the
+    // scan's centroids do not sit on the map's own: a few hundredths of a degree remain
+    // (measured 0.02°; 0 when both voxels were 0.25 m).
     for (i, p) in trajectory.iter().enumerate() {
         let t = p.pose.translation.vector.norm();
         assert!(t < 1e-3, "scan {i}: {t} m from the start");
-        assert!(p.pose.rotation.angle() < 1e-4);
+        let angle = p.pose.rotation.angle();
+        assert!(angle < 1e-3, "scan {i}: {angle} rad");
     }
     assert_eq!(slam.report().fallbacks(), 0, "{:?}", slam.report().tracking);
 }

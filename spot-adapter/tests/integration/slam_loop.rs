@@ -94,10 +94,10 @@ fn deskewed_scans_meet_the_accuracy_targets() {
 /// LiDAR-only on the same skewed lap: each sweep deskewed with the constant velocity of the
 /// last two scans, its own motion over the sweep taken only where it fits clearly better
 /// (`GraphSlamConfig::sweep_min_gain`). Spot's walk is smooth, so it almost never does, and the
-/// lap meets the targets (measured ATE 1.5 cm, segment drift 0.14 %). Taking each sweep's own
+/// lap meets the targets (measured ATE 0.8 cm, segment drift 0.09 %). Taking each sweep's own
 /// motion whenever it fits no worse (a gain of 0) lets the noise of its twelve unknowns into the
-/// deskew: segment drift 0.27 %, beyond the 0.2 % target (ATE 2.0 cm; taking it even where it
-/// fits worse, 4.9 cm and 0.48 %).
+/// deskew: segment drift 0.17 %, nearly twice as much (ATE 1.2 cm; with the map thinned to the
+/// scan's own voxel, 0.27 % against 0.14 %).
 #[test]
 fn a_skewed_lidar_only_lap_meets_the_targets() {
     let lap = |gain: f64| {
@@ -114,8 +114,8 @@ fn a_skewed_lidar_only_lap_meets_the_targets() {
     );
     assert!(ate <= 0.03 && drift <= 0.002, "ATE {ate} m, drift {drift}");
     assert!(
-        every_drift > 0.002,
-        "segment drift {every_drift} with a gain of 0"
+        every_drift > 1.5 * drift,
+        "segment drift {every_drift} with a gain of 0, {drift} with the default"
     );
 }
 

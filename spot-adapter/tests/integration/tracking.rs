@@ -116,7 +116,7 @@ fn turns_of_fifty_degrees_between_scans_are_tracked() {
     assert!(largest_turn > 45.0, "{largest_turn} degrees");
     let now = lidar_only(slam_config(), &samples, &body_t_lidar);
     eprintln!("adaptive reach: {now:?}");
-    // 6.4 cm measured: at 0.6 m a step the tracker slides a few centimetres along corridors
+    // 6.7 cm measured: at 0.6 m a step the tracker slides a few centimetres along corridors
     // now and then (at 5 Hz the same lap ends 1.4 cm ATE).
     assert!(now.ate <= 0.10 && now.height.abs() <= 0.05, "{now:?}");
     assert!(now.worst_step_deg <= 2.0 && now.fallbacks == 0, "{now:?}");
@@ -145,7 +145,7 @@ fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
     eprintln!("adaptive reach, sweep motion: {now:?}");
     assert_eq!(now.fallbacks, 0, "{now:?}");
     assert!(now.worst_step_deg <= 2.0, "{now:?}");
-    // Measured: 2.3 cm ATE, 0.6 degrees of roll or pitch at worst, 6.5 cm lower than the truth
+    // Measured: 2.9 cm ATE, 0.5 degrees of roll or pitch at worst, 4.6 cm lower than the truth
     // after the 45 m walked (no loop closes in these 40 s; the whole lap ends within 1 cm).
     assert!(now.ate <= 0.05 && now.tilt_deg <= 1.0, "{now:?}");
     assert!(now.height.abs() <= 0.10, "{now:?}");
@@ -157,8 +157,9 @@ fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
 /// A gyro's rotation between two scans predicts the next scan's orientation
 /// (`ScanInput::gyro_orientation`): Spot's lap with scans skewed by walking (12 cm a sweep),
 /// kept at one scan in five (turns of up to 52° between scans), with a gyro drifting 0.2°/s.
-/// Measured: ATE 5.9 cm, the end at the start's height, 3 scans recovered by a retry; from the
-/// constant velocity alone ATE 9.1 cm, 0.13 m of height drift, 8 recovered.
+/// Measured: ATE 5.7 cm, the end at the start's height, 3 scans recovered by a retry, no step
+/// more than 0.3° off; from the constant velocity alone ATE 8.0 cm, 2.6 cm of height drift, 11
+/// recovered and two steps more than 2° off (4.1° at worst).
 #[test]
 fn a_gyro_predicts_the_turns_between_scans() {
     let mut config = SimulationConfig::with_seed(1);
@@ -172,7 +173,10 @@ fn a_gyro_predicts_the_turns_between_scans() {
     eprintln!("gyro: {with:?}");
     assert_eq!(with.gyro_predictions, samples.len() - 1, "{with:?}");
     assert!(with.ate <= 0.08 && with.fallbacks == 0, "{with:?}");
-    assert!(with.height.abs() <= 0.05, "{with:?}");
+    assert!(
+        with.height.abs() <= 0.05 && with.worst_step_deg <= 1.0,
+        "{with:?}"
+    );
     let no_gyro: Vec<Sample> = samples
         .into_iter()
         .map(|s| Sample {
@@ -186,7 +190,7 @@ fn a_gyro_predicts_the_turns_between_scans() {
     assert!(
         without.ate > with.ate
             && without.recovered > with.recovered
-            && without.height.abs() > 2.0 * with.height.abs().max(0.02),
+            && without.worst_step_deg > 2.0,
         "{without:?}"
     );
 }

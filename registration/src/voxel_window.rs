@@ -1,0 +1,166 @@
+//! The voxel centroids of a sliding window of placed sources, kept as per-voxel sums so that a
+//! source enters and leaves in time proportional to its own points, not the window's.
+
+use nalgebra::{Point3, Vector3};
+use rustc_hash::FxHashMap;
+use slam_core::Pose3;
+
+/// Integer voxel coordinates.
+type VoxelKey = [i64; 3];
+
+/// One source's points as added: each moved point with its voxel.
+type Part = Vec<(VoxelKey, Vector3<f64>)>;
+
+/// Running sum of one voxel's points.
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    sum: Vector3<f64>,
+    count: u32,
+}
+
+/// Points of sources placed in the world, thinned to one centroid per cubic voxel: the same
+/// points (up to rounding and order) as merging the window's sources and voxel-averaging the
+/// result, which is what a local map rebuilt whole holds.
+#[derive(Clone, Debug)]
+pub(crate) struct VoxelWindow {
+    /// One over the voxel size.
+    inv: f64,
+    cells: FxHashMap<VoxelKey, Cell>,
+    /// Each key's moved points with their voxels, to subtract exactly what was added.
+    parts: FxHashMap<u32, Part>,
+}
+
+impl VoxelWindow {
+    /// An empty window with voxels of `voxel` metres (finite and positive, checked by the
+    /// caller's configuration).
+    pub(crate) fn new(voxel: f32) -> Self {
+        Self {
+            inv: 1.0 / f64::from(voxel),
+            cells: FxHashMap::default(),
+            parts: FxHashMap::default(),
+        }
+    }
+
+    /// Adds `points` moved by `pose` under `key`, replacing what `key` held. Points that are
+    /// not finite once moved (a non-finite pose) are left out: they have no voxel.
+    pub(crate) fn add(&mut self, key: u32, points: &[Point3<f64>], pose: &Pose3) {
+        self.remove(key);
+        let inv = self.inv;
+        // `as` saturates: a point 2^63 voxels out shares the edge voxel, where f32 k-d tree
+        // coordinates could not tell it apart anyway.
+        #[allow(clippy::cast_possible_truncation)]
+        let voxel = |v: f64| (v * inv).floor() as i64;
+        let mut part = Vec::with_capacity(points.len());
+        for p in points {
+            let w = (pose * p).coords;
+            if !w.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            let k = [voxel(w.x), voxel(w.y), voxel(w.z)];
+            let cell = self.cells.entry(k).or_insert(Cell {
+                sum: Vector3::zeros(),
+                count: 0,
+            });
+            cell.sum += w;
+            cell.count += 1;
+            part.push((k, w));
+        }
+        self.parts.insert(key, part);
+    }
+
+    /// Removes what was added under `key` (nothing when it holds nothing). A voxel left empty
+    /// is dropped, so no rounding lingers in it.
+    pub(crate) fn remove(&mut self, key: u32) {
+        let Some(part) = self.parts.remove(&key) else {
+            return;
+        };
+        for (k, w) in part {
+            if let Some(cell) = self.cells.get_mut(&k) {
+                cell.count -= 1;
+                if cell.count == 0 {
+                    self.cells.remove(&k);
+                } else {
+                    cell.sum -= w;
+                }
+            }
+        }
+    }
+
+    /// The voxel centroids.
+    pub(crate) fn centroids(&self) -> Vec<Point3<f64>> {
+        self.cells
+            .values()
+            .map(|c| Point3::from(c.sum / f64::from(c.count)))
+            .collect()
+    }
+
+    /// Number of occupied voxels.
+    pub(crate) fn len(&self) -> usize {
+        self.cells.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use slam_core::PointCloud;
+
+    fn sorted(mut v: Vec<Point3<f64>>) -> Vec<Point3<f64>> {
+        v.sort_by(|a, b| {
+            a.iter()
+                .zip(b.iter())
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        v
+    }
+
+    /// The window after adds and removes holds the centroids that voxelising the remaining
+    /// sources merged (the independent whole computation) gives.
+    #[test]
+    fn a_slid_window_holds_the_centroids_of_its_sources_merged() {
+        let parts: Vec<(Vec<Point3<f64>>, Pose3)> = (0..6)
+            .map(|k| {
+                let pts = (0..400)
+                    .map(|i| {
+                        let f = f64::from(i);
+                        Point3::new((f * 0.37).sin() * 3.0, (f * 0.11).cos() * 2.0, f * 0.004)
+                    })
+                    .collect();
+                let pose = Pose3::new(
+                    Vector3::new(0.13 * f64::from(k), -0.07 * f64::from(k), 0.01),
+                    Vector3::new(0.0, 0.0, 0.05 * f64::from(k)),
+                );
+                (pts, pose)
+            })
+            .collect();
+        let mut window = VoxelWindow::new(0.25);
+        for (k, (pts, pose)) in (0u32..).zip(&parts) {
+            window.add(k, pts, pose);
+            if let Some(old) = k.checked_sub(3) {
+                window.remove(old);
+            }
+        }
+        // Re-adding a key replaces it.
+        window.add(5, &parts[5].0, &parts[5].1);
+        let merged: Vec<Point3<f32>> = parts[3..]
+            .iter()
+            .flat_map(|(pts, pose)| pts.iter().map(move |p| (pose * p).cast::<f32>()))
+            .collect();
+        let whole = PointCloud::from_points(merged)
+            .voxel_downsample(0.25)
+            .unwrap();
+        let whole: Vec<Point3<f64>> = whole.points().iter().map(|p| p.cast()).collect();
+        let (got, want) = (sorted(window.centroids()), sorted(whole));
+        assert_eq!(got.len(), want.len());
+        assert_eq!(window.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).norm() < 1e-5, "{g} vs {w}");
+        }
+        for k in 3..6 {
+            window.remove(k);
+        }
+        assert_eq!(window.len(), 0);
+    }
+}
