@@ -458,9 +458,10 @@ mod tests {
 
     /// An in-place local map slid over keyframes aligns a scan to the pose a map built whole
     /// from the same keyframes gives, and an empty one refuses to align with a named error.
-    #[test]
-    fn an_in_place_map_aligns_as_the_map_built_whole() {
-        use slam_core::{MapRegistrator, Registrator};
+    fn in_place_aligns_as_whole<R>(icp: &R)
+    where
+        R: slam_core::MapRegistrator<Source = Vec<Point3<f64>>, Target = PreparedTarget>,
+    {
         // A room: floor, two walls and a box, sampled every 5 cm.
         let mut room = Vec::new();
         for i in 0..80 {
@@ -474,8 +475,16 @@ mod tests {
                 }
             }
         }
-        let icp = crate::PointToPlaneIcp::default();
-        assert!(icp.empty_map().unwrap().index().is_err());
+        let empty = icp.empty_map().unwrap();
+        assert!(empty.is_empty());
+        assert!(matches!(
+            empty.index(),
+            Err(RegistrationError::TooFewPoints {
+                what: "target",
+                points: 0,
+                ..
+            })
+        ));
         let cloud = PointCloud::from_points(room.iter().map(|p| p.cast::<f32>()).collect());
         let source = icp.prepare_source(&cloud).unwrap();
         let poses: Vec<Pose3> = (0..5)
@@ -486,24 +495,48 @@ mod tests {
                 )
             })
             .collect();
-        let mut in_place = icp.empty_map().unwrap();
+        let mut in_place = empty;
+        let guess = Pose3::new(
+            nalgebra::Vector3::new(0.1, -0.05, 0.03),
+            nalgebra::Vector3::new(0.0, 0.0, 0.03),
+        );
         for (k, pose) in (0u32..).zip(&poses) {
             icp.add_to_map(&mut in_place, k, &source, pose);
             if let Some(old) = k.checked_sub(3) {
                 icp.remove_from_map(&mut in_place, old);
             }
+            // Aligned after every change: each query sees the map as it is now.
+            let first = k.saturating_sub(2) as usize;
+            let parts: Vec<_> = poses[first..=k as usize]
+                .iter()
+                .map(|p| (&source, *p))
+                .collect();
+            let whole = icp.target_from_sources(&parts).unwrap();
+            assert_eq!(in_place.len(), whole.len(), "keyframe {k}");
+            let a = icp.align(&source, &in_place, &guess).unwrap();
+            let b = icp.align(&source, &whole, &guess).unwrap();
+            let apart = a.pose.inverse() * b.pose;
+            assert!(
+                apart.translation.vector.norm() < 1e-4,
+                "keyframe {k}: {apart:?}"
+            );
+            assert!(apart.rotation.angle() < 1e-4, "keyframe {k}: {apart:?}");
         }
-        let parts: Vec<_> = poses[2..].iter().map(|p| (&source, *p)).collect();
-        let whole = icp.target_from_sources(&parts).unwrap();
-        assert_eq!(in_place.len(), whole.len());
-        let guess = Pose3::new(
-            nalgebra::Vector3::new(0.1, -0.05, 0.03),
-            nalgebra::Vector3::new(0.0, 0.0, 0.03),
-        );
-        let a = icp.align(&source, &in_place, &guess).unwrap();
-        let b = icp.align(&source, &whole, &guess).unwrap();
-        let apart = a.pose.inverse() * b.pose;
-        assert!(apart.translation.vector.norm() < 1e-4, "{apart:?}");
-        assert!(apart.rotation.angle() < 1e-4, "{apart:?}");
+    }
+
+    #[test]
+    fn an_in_place_map_aligns_as_the_map_built_whole() {
+        in_place_aligns_as_whole(&crate::PointToPlaneIcp::default());
+        in_place_aligns_as_whole(&crate::PointToPointIcp::default());
+    }
+
+    #[test]
+    fn without_a_target_voxel_the_map_is_built_whole() {
+        use slam_core::MapRegistrator;
+        let mut icp = crate::PointToPlaneIcp::default();
+        icp.config.target_voxel = 0.0;
+        assert!(icp.empty_map().is_none());
+        icp.config.target_voxel = f32::NAN;
+        assert!(icp.empty_map().is_none());
     }
 }
