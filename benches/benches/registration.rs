@@ -62,6 +62,15 @@ fn bench_backend<R: Registrator>(
 }
 
 fn registration(c: &mut Criterion) {
+    // Single thread, as the peer: the ICP backends search correspondences on rayon's pool,
+    // which this bench holds to one worker.
+    if let Err(e) = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build_global()
+    {
+        eprintln!("registration: cannot hold the thread pool to one thread ({e}); skipping");
+        return;
+    }
     let Some((source, target)) = pair() else {
         eprintln!("registration: test data missing; skipping");
         return;

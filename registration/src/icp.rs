@@ -2,16 +2,18 @@
 //! from the backend, convergence tests, and the final report.
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
+use rayon::prelude::*;
 use slam_core::{
     Alignment, Degeneracy, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat,
 };
 
 use crate::config::IcpConfig;
-use crate::neighbour_cache::{NeighbourCache, Neighbours};
+use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
 
 /// One correspondence: source point moved by the current pose, its target point, and the target
 /// normal when available.
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Pair {
     /// The source point's index.
     pub(crate) slot: usize,
@@ -68,43 +70,9 @@ pub(crate) fn point_jacobian(p: &Point3<f64>) -> nalgebra::Matrix3x6<f64> {
     j
 }
 
-/// Each source point moved by `pose` and its target point within reach, through `cache`
-/// (slot = source index), into `pairs`: the nearest target point when the cache answers one
-/// neighbour, the mean of its neighbours when it answers more.
-pub(crate) fn correspondences(
-    source: &[Point3<f64>],
-    target: &TargetIndex,
-    pose: &Pose3,
-    cache: &mut NeighbourCache,
-    pairs: &mut Vec<Pair>,
-) {
-    pairs.clear();
-    let mut nearest = Vec::with_capacity(4);
-    for (slot, s) in source.iter().enumerate() {
-        let p = pose * s;
-        if cache.nearest(slot, target, &p, &mut nearest) == Neighbours::TooFew {
-            continue;
-        }
-        let Some(i) = nearest.first().map(|c| c.id as usize) else {
-            continue;
-        };
-        let Some(n) = target.pairing_normal(i) else {
-            continue;
-        };
-        let q = if nearest.len() == 1 {
-            target.points[i]
-        } else {
-            let sum = nearest.iter().fold(Vector3::zeros(), |m, c| {
-                m + target.points[c.id as usize].coords
-            });
-            Point3::from(sum / nearest.len() as f64)
-        };
-        pairs.push(Pair { slot, p, q, n });
-    }
-}
-
 /// Each coarse-stage source point moved by `pose` and its nearest target point within reach
-/// (one plain search each), into `pairs`.
+/// (one plain search each), into `pairs`, in source order (searched in chunks on the machine's
+/// cores).
 fn coarse_correspondences(
     source: &[Point3<f64>],
     stride: usize,
@@ -114,21 +82,35 @@ fn coarse_correspondences(
     pairs: &mut Vec<Pair>,
 ) {
     pairs.clear();
-    for (slot, s) in source.iter().enumerate().step_by(stride) {
-        let p = pose * s;
-        let Some(i) = target.nearest_one(&p, max_distance) else {
-            continue;
-        };
-        if let Some(n) = target.pairing_normal(i) {
-            pairs.push(Pair {
-                slot,
-                p,
-                q: target.points[i],
-                n,
-            });
-        }
+    let found: Vec<Vec<Pair>> = source
+        .par_chunks(COARSE_CHUNK * stride)
+        .enumerate()
+        .map(|(c, chunk)| {
+            chunk
+                .iter()
+                .enumerate()
+                .step_by(stride)
+                .filter_map(|(i, s)| {
+                    let p = pose * s;
+                    let t = target.nearest_one(&p, max_distance)?;
+                    let n = target.pairing_normal(t)?;
+                    Some(Pair {
+                        slot: c * COARSE_CHUNK * stride + i,
+                        p,
+                        q: target.points[t],
+                        n,
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    for part in found {
+        pairs.extend(part);
     }
 }
+
+/// Coarse-stage points searched a chunk.
+const COARSE_CHUNK: usize = 64;
 
 /// The coarse stage ends once an update moves less than this (metres) ...
 const COARSE_TRANSLATION: f64 = 0.01;
@@ -185,6 +167,19 @@ pub(crate) fn align<S: IcpStep>(
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
     let target = target.index()?;
+    // On a worker of the thread pool: each iteration's search then forks onto the other
+    // workers directly, not through the pool's queue from outside (a wake-up each time).
+    rayon::scope(|_| align_indexed::<S>(config, pair_points, source, target, initial))
+}
+
+/// [`align`] once the target is indexed.
+fn align_indexed<S: IcpStep>(
+    config: &IcpConfig,
+    pair_points: usize,
+    source: &[Point3<f64>],
+    target: &TargetIndex,
+    initial: &Pose3,
+) -> Result<Alignment, RegistrationError> {
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
     let mut pairs = Vec::with_capacity(source.len());
@@ -224,16 +219,16 @@ pub(crate) fn align<S: IcpStep>(
     let first_radius =
         (0.5 * config.max_correspondence_distance).max(2.0 * f64::from(config.target_voxel));
     let k = pair_points;
-    let mut cache = NeighbourCache::new(
+    let mut matcher = Matcher::new(
         source.len(),
         k,
         (2 * k).max(4),
         config.max_correspondence_distance,
-    )
-    .with_first_radius(first_radius);
+        first_radius,
+    );
     for _ in 0..config.max_iterations {
         iterations += 1;
-        correspondences(source, target, &pose, &mut cache, &mut pairs);
+        matcher.correspondences(source, target, &pose, &mut pairs);
         if pairs.len() < config.min_correspondences {
             return Err(RegistrationError::TooFewCorrespondences {
                 found: pairs.len(),
@@ -249,7 +244,7 @@ pub(crate) fn align<S: IcpStep>(
     // Composed step after step from the caller's guess: keep the quaternion unit.
     pose.rotation.renormalize();
     // Report at the final pose.
-    correspondences(source, target, &pose, &mut cache, &mut pairs);
+    matcher.correspondences(source, target, &pose, &mut pairs);
     if pairs.len() < config.min_correspondences {
         return Err(RegistrationError::TooFewCorrespondences {
             found: pairs.len(),

@@ -57,6 +57,7 @@ mod kernel;
 mod lidar_layout;
 mod loam;
 mod loam_features;
+mod matcher;
 mod neighbour_cache;
 mod place_index;
 mod point_to_plane;

@@ -12,15 +12,16 @@
 //! sweep does not constrain (along a corridor) keeps the velocity it was deskewed with.
 
 use nalgebra::{Point3, SMatrix, SVector, Vector6};
+use rayon::prelude::*;
 use slam_core::{
     Alignment, Degeneracy, PointCloud, Pose3, RegistrationError, SweepAlignment, pose3_is_finite,
     se3_adjoint, se3_exp,
 };
 
 use crate::config::IcpConfig;
-use crate::icp::{Pair, correspondences, inliers_and_rmse, min_eigenvalue_ratio, thin_source};
-use crate::neighbour_cache::NeighbourCache;
-use crate::target::PreparedTarget;
+use crate::icp::{Pair, inliers_and_rmse, min_eigenvalue_ratio, thin_source};
+use crate::matcher::Matcher;
+use crate::target::{PreparedTarget, TargetIndex};
 
 /// The prior on the velocity correction, relative to the pairs' summed weight, for its linear
 /// part (per m/s) ...
@@ -81,6 +82,18 @@ pub(crate) fn align_sweep(
     }
     let target = target.index()?;
     let (points, times) = sweep_points(config, sweep)?;
+    // On a worker of the thread pool, as `icp::align`.
+    rayon::scope(|_| align_sweep_indexed(config, points, times, target, initial))
+}
+
+/// [`align_sweep`] once the target is indexed and the sweep thinned.
+fn align_sweep_indexed(
+    config: &IcpConfig,
+    points: Vec<Point3<f64>>,
+    times: Vec<f64>,
+    target: &TargetIndex,
+    initial: &Pose3,
+) -> Result<SweepAlignment, RegistrationError> {
     let (points, times) = match (
         thin_source(&points, config.max_source_points),
         thin_source(&times, config.max_source_points),
@@ -92,19 +105,27 @@ pub(crate) fn align_sweep(
     let mut correction = Vector6::zeros();
     let mut moved = vec![Point3::origin(); points.len()];
     let mut pairs = Vec::with_capacity(points.len());
-    let mut cache = NeighbourCache::new(points.len(), 1, 4, config.max_correspondence_distance);
+    let mut matcher = Matcher::new(
+        points.len(),
+        1,
+        4,
+        config.max_correspondence_distance,
+        f64::INFINITY,
+    );
     let (mut converged, mut iterations) = (false, 0);
     let mut weights = Vec::with_capacity(points.len());
     // Every point moved by its own pose, paired with the target; too few pairs is an error.
     let matched = |pose: &Pose3,
                    correction: &Vector6<f64>,
                    moved: &mut [Point3<f64>],
-                   cache: &mut NeighbourCache,
+                   matcher: &mut Matcher,
                    pairs: &mut Vec<Pair>| {
-        for ((m, p), &t) in moved.iter_mut().zip(&points).zip(&times) {
-            *m = pose * se3_exp(&(correction * t)) * p;
-        }
-        correspondences(moved, target, &Pose3::identity(), cache, pairs);
+        moved
+            .par_iter_mut()
+            .zip(points.par_iter().zip(times.par_iter()))
+            .with_min_len(256)
+            .for_each(|(m, (p, &t))| *m = pose * se3_exp(&(correction * t)) * p);
+        matcher.correspondences(moved, target, &Pose3::identity(), pairs);
         if pairs.len() < config.min_correspondences {
             return Err(RegistrationError::TooFewCorrespondences {
                 found: pairs.len(),
@@ -115,7 +136,7 @@ pub(crate) fn align_sweep(
     };
     for _ in 0..config.max_iterations {
         iterations += 1;
-        matched(&pose, &correction, &mut moved, &mut cache, &mut pairs)?;
+        matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
         let (h, b) = normal_equations(config, &pairs, &times, &pose, &correction, &mut weights);
         let Some(step) = h.cholesky().map(|c| -c.solve(&b)) else {
             return Err(RegistrationError::Degenerate {
@@ -138,7 +159,7 @@ pub(crate) fn align_sweep(
         }
     }
     pose.rotation.renormalize();
-    matched(&pose, &correction, &mut moved, &mut cache, &mut pairs)?;
+    matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
     let (h, _) = normal_equations(config, &pairs, &times, &pose, &correction, &mut weights);
     let information = h.fixed_view::<6, 6>(0, 0).into_owned();
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, residual);

@@ -1,6 +1,9 @@
 //! A prepared target: points in a k-d tree, with PCA normals for point-to-plane.
 
 use std::cell::OnceCell;
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
 
 use kiddo::kd_tree::ConstructionError;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -42,8 +45,9 @@ struct NormalCache {
     k: std::num::NonZero<usize>,
     /// `IcpConfig::min_planarity`.
     min_planarity: f64,
-    /// `None`: the neighbourhood is not plane-like enough.
-    cells: Vec<OnceCell<Option<Vector3<f64>>>>,
+    /// `None`: the neighbourhood is not plane-like enough. Filled from several threads at once
+    /// during a correspondence search.
+    cells: Vec<OnceLock<Option<Vector3<f64>>>>,
 }
 
 impl std::fmt::Debug for PreparedTarget {
@@ -218,7 +222,7 @@ impl TargetIndex {
         let normals = normals.map(|(k, min_planarity)| NormalCache {
             k: std::num::NonZero::new(k.max(3)).unwrap_or(std::num::NonZero::<usize>::MIN),
             min_planarity,
-            cells: (0..points.len()).map(|_| OnceCell::new()).collect(),
+            cells: (0..points.len()).map(|_| OnceLock::new()).collect(),
         });
         Ok(Self {
             points,
@@ -246,38 +250,14 @@ impl TargetIndex {
             .get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k, cache.min_planarity))
     }
 
-    /// Computes every normal not computed yet, split over the machine's cores (each point's
-    /// normal is the one [`Self::normal`] would give).
+    /// Computes every normal not computed yet, on the machine's cores (each point's normal is
+    /// the one [`Self::normal`] would give).
     pub(crate) fn compute_all_normals(&self) {
-        let Some(cache) = self.normals.as_ref() else {
-            return;
-        };
-        let threads = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-        let chunk = self.points.len().div_ceil(threads).max(1);
-        std::thread::scope(|scope| {
-            let parts: Vec<_> = (0..self.points.len())
-                .step_by(chunk)
-                .map(|start| {
-                    let end = (start + chunk).min(self.points.len());
-                    let (points, tree, k) = (&self.points, &self.tree, cache.k);
-                    let min_planarity = cache.min_planarity;
-                    let part = scope.spawn(move || {
-                        (start..end)
-                            .map(|i| pca_normal(points, tree, i, k, min_planarity))
-                            .collect::<Vec<_>>()
-                    });
-                    (start, part)
-                })
-                .collect();
-            // Each part fills its own range; a part that failed leaves its normals to first use.
-            for (start, part) in parts {
-                if let Ok(normals) = part.join() {
-                    for (cell, n) in cache.cells[start..].iter().zip(normals) {
-                        let _ = cell.set(n);
-                    }
-                }
-            }
-        });
+        if self.normals.is_some() {
+            (0..self.points.len()).into_par_iter().for_each(|i| {
+                self.normal(i);
+            });
+        }
     }
 }
 

@@ -3,9 +3,13 @@
 //! moves 12 cm during a 5 Hz sweep).
 
 use nalgebra::{Point3, Vector6};
+use rayon::prelude::*;
 
 use crate::cloud::PointCloud;
 use crate::geometry::se3_exp;
+
+/// Points a chunk.
+const CHUNK: usize = 1 << 12;
 
 /// Move every point of `cloud` into the sensor frame at the sweep's start (time 0), assuming the
 /// sensor moved with the constant body-frame velocity `twist` (`[v; w]` per second, so that the
@@ -27,21 +31,28 @@ use crate::geometry::se3_exp;
 pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
     let times = cloud.time()?;
     let mut out = cloud.clone();
-    // Points of one column share a firing time and sit next to each other: one exp per run.
-    let mut cached: Option<(f32, crate::Pose3)> = None;
-    for (p, &t) in out.points_mut().iter_mut().zip(times) {
-        let pose = match cached {
-            Some((ct, pose)) if ct.to_bits() == t.to_bits() => pose,
-            _ => {
-                let pose = se3_exp(&(twist * f64::from(t)));
-                cached = Some((t, pose));
-                pose
+    // In chunks on the machine's cores; each point's result does not depend on the chunking.
+    out.points_mut()
+        .par_chunks_mut(CHUNK)
+        .zip(times.par_chunks(CHUNK))
+        .for_each(|(points, times)| {
+            // Points of one column share a firing time and sit next to each other: one exp
+            // per run.
+            let mut cached: Option<(f32, crate::Pose3)> = None;
+            for (p, &t) in points.iter_mut().zip(times) {
+                let pose = match cached {
+                    Some((ct, pose)) if ct.to_bits() == t.to_bits() => pose,
+                    _ => {
+                        let pose = se3_exp(&(twist * f64::from(t)));
+                        cached = Some((t, pose));
+                        pose
+                    }
+                };
+                #[allow(clippy::cast_possible_truncation)]
+                let q: Point3<f32> = (pose * p.cast::<f64>()).cast::<f32>();
+                *p = q;
             }
-        };
-        #[allow(clippy::cast_possible_truncation)]
-        let q: Point3<f32> = (pose * p.cast::<f64>()).cast::<f32>();
-        *p = q;
-    }
+        });
     Some(out)
 }
 
