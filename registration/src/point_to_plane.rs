@@ -29,9 +29,11 @@ fn normal_equations(pairs: &[Pair], weights: &[f64]) -> (Matrix6<f64>, Vector6<f
             continue;
         }
         let j = row(p);
-        h += j * j.transpose() * *w;
-        b += j * (GaussNewtonPlane::residual(p) * w);
+        // Lower triangle only, in place.
+        h.syger(*w, &j, &j, 1.0);
+        b.axpy(GaussNewtonPlane::residual(p) * w, &j, 1.0);
     }
+    h.fill_upper_triangle_with_lower_triangle();
     (h, b)
 }
 

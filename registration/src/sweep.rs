@@ -217,9 +217,11 @@ fn normal_equations(
         let mut row = SVector::<f64, 12>::zeros();
         row.fixed_rows_mut::<6>(0).copy_from(&j);
         row.fixed_rows_mut::<6>(6).copy_from(&jc);
-        h += row * row.transpose() * w;
-        b += row * (r * w);
+        // Lower triangle only, in place: a 12x12 product per pair dominated the sweep.
+        h.syger(w, &row, &row, 1.0);
+        b.axpy(r * w, &row, 1.0);
     }
+    h.fill_upper_triangle_with_lower_triangle();
     // Keep the correction near zero where the pairs do not constrain it.
     for i in 6..12 {
         let prior = if i < 9 { LINEAR_PRIOR } else { ANGULAR_PRIOR } * sum_w.max(1.0);
