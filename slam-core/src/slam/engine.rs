@@ -61,6 +61,9 @@ struct Prepared<S> {
     cloud: PointCloud,
     /// The scan thinned to the map's voxel before deskewing, when the backend takes it so.
     thinned: Option<PointCloud>,
+    /// `cloud` thinned again to the odometry's source voxel when `thinned` is given: what the
+    /// source is prepared from and the sweep's motion is found on (voxelised once, not twice).
+    coarse: Option<PointCloud>,
     /// How it was deskewed, when it was.
     sweep: Option<Sweep>,
     /// Prepared for the odometry registrator.
@@ -714,7 +717,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
-            .align_sweep(&prepared.cloud, map, pose)?
+            .align_sweep(prepared.coarse.as_ref().unwrap_or(&prepared.cloud), map, pose)?
             .ok()?;
         let a = sweep.alignment;
         let gain = self.config.sweep_min_gain;
@@ -744,13 +747,18 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .flatten()
             .and_then(|mut cloud| {
                 cloud.remove_non_finite();
-                let source = self.odometry.prepare_source(&cloud).ok()?;
-                Some((cloud, source))
+                let coarse = self.coarse(&cloud, prepared.thinned.is_some());
+                let source = self
+                    .odometry
+                    .prepare_source(coarse.as_ref().unwrap_or(&cloud))
+                    .ok()?;
+                Some((cloud, coarse, source))
             });
         match again {
-            Some((cloud, source)) => Prepared {
+            Some((cloud, coarse, source)) => Prepared {
                 sweep: Sweep::of(base, velocity),
                 cloud,
+                coarse,
                 source,
                 ..prepared
             },
@@ -822,6 +830,13 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Some((pose, velocity))
     }
 
+    /// `cloud` (deskewed, at the map's voxel when `thinned`) at the odometry's source voxel,
+    /// when the scan was thinned for it.
+    fn coarse(&self, cloud: &PointCloud, thinned: bool) -> Option<PointCloud> {
+        let voxel = self.odometry.source_voxel().filter(|_| thinned)?;
+        cloud.voxel_downsample(voxel).ok()
+    }
+
     /// A scan made ready: deskewed with `velocity` (when given), non-finite points dropped,
     /// prepared for the odometry; the skip outcome (counted) when too few points are left or
     /// the registrator refuses it.
@@ -856,7 +871,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if cloud.len() < self.config.min_scan_points {
             return Err(self.skip(SkipReason::TooFewPoints, started));
         }
-        let Ok(source) = self.odometry.prepare_source(&cloud) else {
+        let coarse = self.coarse(&cloud, thinned.is_some());
+        let Ok(source) = self
+            .odometry
+            .prepare_source(coarse.as_ref().unwrap_or(&cloud))
+        else {
             return Err(self.skip(SkipReason::PreparationFailed, started));
         };
         self.report.dropped_points += dropped;
@@ -864,6 +883,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             extent: scan_extent(&cloud),
             cloud,
             thinned,
+            coarse,
             sweep,
             source,
         })
