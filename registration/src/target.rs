@@ -140,13 +140,30 @@ impl PreparedTarget {
     }
 }
 
-/// Finite points of `cloud` as f64, voxel-filtered when `voxel > 0`.
+/// Finite points of `cloud` as f64, voxel-filtered when `voxel > 0`. A finite point too far out
+/// for a voxel key (more than 2^62 voxels from the origin: a garbled return, not a
+/// measurement) is dropped with the non-finite ones, so that it cannot turn the thinning off
+/// for the whole cloud.
 pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> {
     if voxel > 0.0 {
         // Points only (the channels would be averaged for nothing); the downsampling skips
         // non-finite points itself.
         let c = PointCloud::from_points(cloud.points().to_vec());
-        if let Ok(down) = c.voxel_downsample(voxel) {
+        let down = match c.voxel_downsample(voxel) {
+            Ok(down) => Some(down),
+            Err(slam_core::CloudError::VoxelOutOfRange { .. }) => {
+                let reach = f64::from(voxel) * VOXEL_KEY_RANGE;
+                let kept = cloud
+                    .points()
+                    .iter()
+                    .filter(|p| p.iter().all(|v| f64::from(v.abs()) < reach))
+                    .copied()
+                    .collect();
+                PointCloud::from_points(kept).voxel_downsample(voxel).ok()
+            }
+            Err(_) => None,
+        };
+        if let Some(down) = down {
             return down.points().iter().map(|p| p.cast::<f64>()).collect();
         }
     }
@@ -158,18 +175,44 @@ pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> 
         .collect()
 }
 
-/// How many directions `points` spread along (0 to 3): the eigenvalues of their covariance
-/// whose standard deviation exceeds both 1e-6 of the largest one and what f32 storage can
-/// resolve at their distance from the origin (plus 1e-6 m).
-#[allow(clippy::cast_precision_loss)]
+/// Voxels from the origin within which every voxel key fits (2^62, half the keys' range).
+const VOXEL_KEY_RANGE: f64 = 4.611_686_018_427_388e18;
+
+/// Share of the points, nearest the median point, whose spread decides whether a target is
+/// degenerate: a few absurd points must not hide the spread of the rest.
+const SPREAD_SHARE: f64 = 0.9;
+
+/// How many directions `points` spread along (0 to 3): the eigenvalues of the covariance of
+/// the 90 % of them nearest their coordinate-wise median whose standard deviation exceeds both
+/// 1e-6 of the largest one and what f32 storage can resolve at their distance from the origin
+/// (plus 1e-6 m).
+#[allow(
+    clippy::cast_precision_loss,
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss
+)]
 fn spread_dimensions(points: &[Point3<f64>]) -> usize {
     if points.is_empty() {
         return 0;
     }
-    let n = points.len() as f64;
-    let mean = points.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n;
-    let cov = points.iter().fold(Matrix3::zeros(), |m, p| {
-        let d = p.coords - mean;
+    let median = |axis: usize| {
+        let mut v: Vec<f64> = points.iter().map(|p| p[axis]).collect();
+        let mid = v.len() / 2;
+        *v.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    let centre = Vector3::new(median(0), median(1), median(2));
+    let mut near: Vec<(f64, usize)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| ((p.coords - centre).norm_squared(), i))
+        .collect();
+    let keep = ((near.len() as f64 * SPREAD_SHARE).ceil() as usize).clamp(1, near.len());
+    near.select_nth_unstable_by(keep - 1, |a, b| a.0.total_cmp(&b.0));
+    let near = &near[..keep];
+    let n = near.len() as f64;
+    let mean = near.iter().map(|&(_, i)| points[i].coords).sum::<Vector3<f64>>() / n;
+    let cov = near.iter().fold(Matrix3::zeros(), |m, &(_, i)| {
+        let d = points[i].coords - mean;
         m + d * d.transpose()
     }) / n;
     let sigma = symmetric_eigen3(&cov).values.map(|v| v.max(0.0).sqrt());
@@ -518,5 +561,65 @@ mod tests {
         assert!(icp.empty_map().is_none());
         icp.config.target_voxel = f32::NAN;
         assert!(icp.empty_map().is_none());
+    }
+
+    /// A room's points, plus `extra`.
+    fn room_with(extra: &[Point3<f32>]) -> PointCloud {
+        let mut room = Vec::new();
+        for i in 0..80 {
+            for j in 0..60 {
+                let (a, b) = (i as f32 * 0.05, j as f32 * 0.05);
+                room.push(Point3::new(a, b, 0.0));
+                room.push(Point3::new(a, 0.0, b * 0.5));
+                room.push(Point3::new(0.0, b, a * 0.3));
+                if i < 10 && j < 10 {
+                    room.push(Point3::new(2.0 + a, 1.5, b));
+                }
+            }
+        }
+        room.extend_from_slice(extra);
+        PointCloud::from_points(room)
+    }
+
+    #[test]
+    fn one_absurd_point_leaves_a_scan_registering_as_without_it() {
+        use slam_core::Registrator;
+        // A return a driver garbled into 1e30 m, one far-away point in a real range (1e5 m)
+        // and one at 1e12 m (beyond any voxel key at 1 nm, but finite).
+        let absurd = [
+            Point3::new(1e30, 0.0, 0.0),
+            Point3::new(0.0, -1e5, 3.0),
+            Point3::new(2e12, 1.0, 1.0),
+        ];
+        let guess = Pose3::new(
+            nalgebra::Vector3::new(0.1, -0.05, 0.03),
+            nalgebra::Vector3::new(0.0, 0.0, 0.03),
+        );
+        for icp in [
+            crate::PointToPlaneIcp::default(),
+            crate::PointToPlaneIcp {
+                config: IcpConfig {
+                    source_voxel: 0.0,
+                    target_voxel: 0.0,
+                    ..IcpConfig::default()
+                },
+            },
+        ] {
+            let clean = room_with(&[]);
+            let dirty = room_with(&absurd);
+            let want = icp
+                .align(
+                    &icp.prepare_source(&clean).unwrap(),
+                    &icp.prepare_target(&clean).unwrap(),
+                    &guess,
+                )
+                .unwrap();
+            let source = icp.prepare_source(&dirty).unwrap();
+            let target = icp.prepare_target(&dirty).unwrap_or_else(|e| panic!("{e}"));
+            let got = icp.align(&source, &target, &guess).unwrap();
+            let apart = want.pose.inverse() * got.pose;
+            assert!(apart.translation.vector.norm() < 1e-6, "{apart:?}");
+            assert!(apart.rotation.angle() < 1e-6, "{apart:?}");
+        }
     }
 }
