@@ -210,7 +210,11 @@ fn spread_dimensions(points: &[Point3<f64>]) -> usize {
     near.select_nth_unstable_by(keep - 1, |a, b| a.0.total_cmp(&b.0));
     let near = &near[..keep];
     let n = near.len() as f64;
-    let mean = near.iter().map(|&(_, i)| points[i].coords).sum::<Vector3<f64>>() / n;
+    let mean = near
+        .iter()
+        .map(|&(_, i)| points[i].coords)
+        .sum::<Vector3<f64>>()
+        / n;
     let cov = near.iter().fold(Matrix3::zeros(), |m, &(_, i)| {
         let d = points[i].coords - mean;
         m + d * d.transpose()

@@ -102,6 +102,34 @@ struct ScanPose {
     sweep: Option<Sweep>,
 }
 
+/// Voxels from the sensor within which every voxel key fits (2^62, half the keys' range).
+const VOXEL_KEY_RANGE: f64 = 4.611_686_018_427_388e18;
+
+/// `cloud` thinned to `voxel` and how many finite points were dropped first for lying beyond
+/// any voxel key (a garbled return 1e30 m out would otherwise fail the thinning of the whole
+/// scan); no cloud when it cannot be thinned.
+fn thin(cloud: &PointCloud, voxel: f32) -> (Option<PointCloud>, usize) {
+    match cloud.voxel_downsample(voxel) {
+        Ok(thinned) => (Some(thinned), 0),
+        Err(CloudError::VoxelOutOfRange { .. }) => {
+            let reach = f64::from(voxel) * VOXEL_KEY_RANGE;
+            let near = cloud.filtered(|_, p| !p.iter().any(|v| f64::from(v.abs()) >= reach));
+            let far = cloud
+                .points()
+                .iter()
+                .filter(|p| p.iter().all(|v| v.is_finite()))
+                .count()
+                - near
+                    .points()
+                    .iter()
+                    .filter(|p| p.iter().all(|v| v.is_finite()))
+                    .count();
+            (near.voxel_downsample(voxel).ok(), far)
+        }
+        Err(_) => (None, 0),
+    }
+}
+
 /// The motion a scan was deskewed with.
 #[derive(Clone, Copy, Debug)]
 struct Sweep {
@@ -717,7 +745,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
-            .align_sweep(prepared.coarse.as_ref().unwrap_or(&prepared.cloud), map, pose)?
+            .align_sweep(
+                prepared.coarse.as_ref().unwrap_or(&prepared.cloud),
+                map,
+                pose,
+            )?
             .ok()?;
         let a = sweep.alignment;
         let gain = self.config.sweep_min_gain;
@@ -850,22 +882,23 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // before anything else: deskewing, registering and keeping a dense scan then cost what
         // its voxels cost, not what its points cost (an OS1-128 sweep: 131,072 points).
         let voxel = self.config.map_voxel_size;
-        let thinned = self
-            .odometry
-            .source_voxel()
-            .filter(|&v| v >= voxel)
-            .and_then(|_| scan.cloud.voxel_downsample(voxel).ok());
+        let (thinned, far) = match self.odometry.source_voxel().filter(|&v| v >= voxel) {
+            Some(_) => thin(scan.cloud, voxel),
+            None => (None, 0),
+        };
         let base = thinned.as_ref().unwrap_or(scan.cloud);
         let deskewed = velocity.and_then(|v| deskew(base, &v).map(|c| (c, v)));
         let sweep = deskewed.as_ref().and_then(|(_, v)| Sweep::of(base, *v));
         let mut cloud = deskewed.map_or_else(|| base.clone(), |(c, _)| c);
         let dropped = match thinned {
-            Some(_) => scan
-                .cloud
-                .points()
-                .iter()
-                .filter(|p| !p.iter().all(|v| v.is_finite()))
-                .count(),
+            Some(_) => {
+                far + scan
+                    .cloud
+                    .points()
+                    .iter()
+                    .filter(|p| !p.iter().all(|v| v.is_finite()))
+                    .count()
+            }
             None => cloud.remove_non_finite(),
         };
         if cloud.len() < self.config.min_scan_points {

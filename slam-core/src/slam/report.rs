@@ -86,7 +86,8 @@ pub struct SlamReport {
     pub skipped_preparation: usize,
     /// Skipped scans: a first timed scan waiting for the velocity to deskew it.
     pub skipped_awaiting_velocity: usize,
-    /// Non-finite points dropped from otherwise usable scans.
+    /// Non-finite points dropped from otherwise usable scans, and finite ones too far out for
+    /// the map's voxel keys (2^62 voxels from the sensor: garbled returns, not measurements).
     pub dropped_points: usize,
     /// How the odometry's registrations went: scans tracked, recovered on a second try, fallbacks
     /// to the prediction by reason, losses of track (see [`TrackingHealth`]).

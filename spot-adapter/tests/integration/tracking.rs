@@ -273,18 +273,38 @@ fn garage_frames() -> Vec<(f64, PointCloud)> {
         .collect()
 }
 
-#[test]
-fn a_standing_sensor_stays_put() {
-    // Real scans of a sensor that did not move: every pose must stay at the first.
+/// The real garage frames fed LiDAR-only, each with `extra` points added; each scan's pose
+/// and the points the engine dropped.
+fn standing(extra: &[nalgebra::Point3<f32>]) -> (Vec<slam_core::io::StampedPose>, usize) {
     let frames = garage_frames();
     assert!(frames.len() >= 10);
     let mut slam = point_to_plane_slam(slam_config()).unwrap();
     for (stamp, cloud) in &frames {
+        // The extra points with the channels the frame has (ring 0, intensity 0, time 0).
+        let (mut points, ring, intensity, time) = cloud.clone().into_parts();
+        points.extend_from_slice(extra);
+        let mut cloud = PointCloud::from_points(points);
+        let pad = |v: Option<Vec<f32>>| {
+            v.map(|mut v| {
+                v.resize(v.len() + extra.len(), 0.0);
+                v
+            })
+        };
+        if let Some(mut r) = ring {
+            r.resize(r.len() + extra.len(), 0);
+            cloud = cloud.with_ring(r).unwrap();
+        }
+        if let Some(i) = pad(intensity) {
+            cloud = cloud.with_intensity(i).unwrap();
+        }
+        if let Some(t) = pad(time) {
+            cloud = cloud.with_time(t).unwrap();
+        }
         let sample = Sample {
             stamp: *stamp,
             odom_t_body: Pose3::identity(),
             body_t_lidar: Pose3::identity(),
-            cloud: cloud.clone(),
+            cloud,
             ground_truth: None,
             gyro_orientation: None,
         };
@@ -292,6 +312,13 @@ fn a_standing_sensor_stays_put() {
     }
     let trajectory = slam.scan_trajectory();
     assert_eq!(trajectory.len(), frames.len());
+    (trajectory, slam.report().dropped_points)
+}
+
+#[test]
+fn a_standing_sensor_stays_put() {
+    // Real scans of a sensor that did not move: every pose must stay at the first.
+    let (trajectory, _) = standing(&[]);
     let start = trajectory[0].pose;
     for p in &trajectory {
         let d = start.inverse() * p.pose;
@@ -305,8 +332,24 @@ fn a_standing_sensor_stays_put() {
     let end = start.inverse() * trajectory[trajectory.len() - 1].pose;
     eprintln!(
         "{} frames: ends {:.4} m and {:.3} degrees from the start",
-        frames.len(),
+        trajectory.len(),
         end.translation.vector.norm(),
         end.rotation.angle().to_degrees()
     );
+    // The same frames, each with a garbled return 1e30 m out (beyond any voxel key: it made
+    // the thinning fail, then the whole scan degenerate) and one 1e5 m out: the same poses,
+    // and the garbled ones counted as dropped.
+    let (absurd, dropped) = standing(&[
+        nalgebra::Point3::new(1e30, 0.0, 0.0),
+        nalgebra::Point3::new(0.0, -1e5, 3.0),
+    ]);
+    assert_eq!(dropped, trajectory.len());
+    for (a, b) in trajectory.iter().zip(&absurd) {
+        let d = a.pose.inverse() * b.pose;
+        assert!(
+            d.translation.vector.norm() < 1e-4 && d.rotation.angle() < 1e-4,
+            "{}: {d:?}",
+            a.stamp
+        );
+    }
 }
