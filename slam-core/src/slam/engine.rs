@@ -937,6 +937,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let Prepared {
             cloud,
             thinned,
+            coarse: thinned_source,
             source,
             sweep,
             ..
@@ -950,7 +951,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .voxel_downsample(self.config.map_voxel_size)
                 .unwrap_or(cloud)
         };
-        let Ok(coarse) = self.loop_coarse.prepare_source(&cloud) else {
+        // The loop check's source from the scan already thinned to its voxel when the odometry
+        // thins to the same one (an OS1-128 keyframe's 41,000 points not voxelised again).
+        let same_voxel = self
+            .loop_coarse
+            .source_voxel()
+            .is_some_and(|v| Some(v) == self.odometry.source_voxel());
+        let loop_cloud = thinned_source.filter(|_| same_voxel);
+        let Ok(coarse) = self
+            .loop_coarse
+            .prepare_source(loop_cloud.as_ref().unwrap_or(&cloud))
+        else {
             return self.skip(SkipReason::PreparationFailed, started);
         };
         let index = self.keyframes.len();
