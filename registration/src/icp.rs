@@ -166,19 +166,47 @@ pub(crate) fn align<S: IcpStep>(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
-    let target = target.index()?;
+    let index = target.index()?;
     // On a worker of the thread pool: each iteration's search then forks onto the other
     // workers directly, not through the pool's queue from outside (a wake-up each time).
-    rayon::scope(|_| align_indexed::<S>(config, pair_points, source, target, initial))
+    let (result, used) =
+        rayon::scope(|_| align_indexed::<S>(config, pair_points, source, index, initial));
+    if let Some((points, matcher)) = used {
+        target.keep_matcher(
+            &points,
+            config.max_correspondence_distance,
+            pair_points,
+            matcher,
+        );
+    }
+    result
 }
 
-/// [`align`] once the target is indexed.
+/// The source points an alignment paired and the neighbour cache it left.
+type Used = Option<(Vec<Point3<f64>>, Matcher)>;
+
+/// [`align`] once the target is indexed, with the points it paired and the neighbour cache it
+/// left (for the next alignment of the same points).
 fn align_indexed<S: IcpStep>(
     config: &IcpConfig,
     pair_points: usize,
     source: &[Point3<f64>],
     target: &TargetIndex,
     initial: &Pose3,
+) -> (Result<Alignment, RegistrationError>, Used) {
+    let mut used = None;
+    let result = align_indexed_into::<S>(config, pair_points, source, target, initial, &mut used);
+    (result, used)
+}
+
+/// [`align_indexed`], leaving the points and the cache in `used`.
+fn align_indexed_into<S: IcpStep>(
+    config: &IcpConfig,
+    pair_points: usize,
+    source: &[Point3<f64>],
+    target: &TargetIndex,
+    initial: &Pose3,
+    used: &mut Used,
 ) -> Result<Alignment, RegistrationError> {
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
@@ -251,6 +279,7 @@ fn align_indexed<S: IcpStep>(
             required: config.min_correspondences,
         });
     }
+    *used = Some((source.to_vec(), matcher));
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, S::residual);

@@ -80,20 +80,8 @@ pub(crate) fn align_sweep(
     if !pose3_is_finite(initial) {
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
-    let target = target.index()?;
+    let index = target.index()?;
     let (points, times) = sweep_points(config, sweep)?;
-    // On a worker of the thread pool, as `icp::align`.
-    rayon::scope(|_| align_sweep_indexed(config, points, times, target, initial))
-}
-
-/// [`align_sweep`] once the target is indexed and the sweep thinned.
-fn align_sweep_indexed(
-    config: &IcpConfig,
-    points: Vec<Point3<f64>>,
-    times: Vec<f64>,
-    target: &TargetIndex,
-    initial: &Pose3,
-) -> Result<SweepAlignment, RegistrationError> {
     let (points, times) = match (
         thin_source(&points, config.max_source_points),
         thin_source(&times, config.max_source_points),
@@ -101,17 +89,36 @@ fn align_sweep_indexed(
         (Some(p), Some(t)) => (p, t),
         _ => (points, times),
     };
+    // The scan's own registration usually paired these same points against this target just
+    // before: its neighbours start this one (the same answers as fresh searches).
+    let matcher = target
+        .take_matcher(&points, config.max_correspondence_distance, 1)
+        .unwrap_or_else(|| {
+            Matcher::new(
+                points.len(),
+                1,
+                4,
+                config.max_correspondence_distance,
+                f64::INFINITY,
+            )
+        });
+    // On a worker of the thread pool, as `icp::align`.
+    rayon::scope(|_| align_sweep_indexed(config, &points, &times, matcher, index, initial))
+}
+
+/// [`align_sweep`] once the target is indexed and the sweep thinned.
+fn align_sweep_indexed(
+    config: &IcpConfig,
+    points: &[Point3<f64>],
+    times: &[f64],
+    mut matcher: Matcher,
+    target: &TargetIndex,
+    initial: &Pose3,
+) -> Result<SweepAlignment, RegistrationError> {
     let mut pose = *initial;
     let mut correction = Vector6::zeros();
     let mut moved = vec![Point3::origin(); points.len()];
     let mut pairs = Vec::with_capacity(points.len());
-    let mut matcher = Matcher::new(
-        points.len(),
-        1,
-        4,
-        config.max_correspondence_distance,
-        f64::INFINITY,
-    );
     let (mut converged, mut iterations) = (false, 0);
     let mut weights = Vec::with_capacity(points.len());
     // Every point moved by its own pose, paired with the target; too few pairs is an error.
@@ -137,7 +144,7 @@ fn align_sweep_indexed(
     for _ in 0..config.max_iterations {
         iterations += 1;
         matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
-        let (h, b) = normal_equations(config, &pairs, &times, &pose, &correction, &mut weights);
+        let (h, b) = normal_equations(config, &pairs, times, &pose, &correction, &mut weights);
         let Some(step) = h.cholesky().map(|c| -c.solve(&b)) else {
             return Err(RegistrationError::Degenerate {
                 cause: Degeneracy::SingularNormalEquations,
@@ -160,7 +167,7 @@ fn align_sweep_indexed(
     }
     pose.rotation.renormalize();
     matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
-    let (h, _) = normal_equations(config, &pairs, &times, &pose, &correction, &mut weights);
+    let (h, _) = normal_equations(config, &pairs, times, &pose, &correction, &mut weights);
     let information = h.fixed_view::<6, 6>(0, 0).into_owned();
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, residual);
     #[allow(clippy::cast_precision_loss)]

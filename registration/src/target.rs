@@ -1,6 +1,6 @@
 //! A prepared target: points in a k-d tree, with PCA normals for point-to-plane.
 
-use std::cell::OnceCell;
+use std::cell::{OnceCell, RefCell};
 use std::sync::OnceLock;
 
 use rayon::prelude::*;
@@ -11,6 +11,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use slam_core::{Degeneracy, PointCloud, Pose3, RegistrationError};
 
 use crate::config::IcpConfig;
+use crate::matcher::Matcher;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
 use crate::voxel_window::VoxelWindow;
@@ -21,6 +22,19 @@ use crate::voxel_window::VoxelWindow;
 pub struct PreparedTarget {
     index: OnceCell<Result<TargetIndex, RegistrationError>>,
     window: Option<Box<Window>>,
+    /// The neighbours the last alignment against this target found, for the next alignment of
+    /// the same source points (a sweep's motion found right after the scan's registration).
+    last_matcher: RefCell<Option<MatcherMemo>>,
+}
+
+/// An alignment's neighbour cache with what it is valid for.
+struct MatcherMemo {
+    /// The source points, in order, whose slots it holds.
+    points: Vec<Point3<f64>>,
+    /// The reach and the neighbours a pair reads.
+    max_distance: f64,
+    pair_points: usize,
+    matcher: Matcher,
 }
 
 /// A window of placed sources and how its index is built.
@@ -75,6 +89,7 @@ impl PreparedTarget {
         Ok(Self {
             index: OnceCell::from(Ok(index)),
             window: None,
+            last_matcher: RefCell::new(None),
         })
     }
 
@@ -88,6 +103,7 @@ impl PreparedTarget {
     ) -> Self {
         Self {
             index: OnceCell::new(),
+            last_matcher: RefCell::new(None),
             window: Some(Box::new(Window {
                 voxels: VoxelWindow::new(voxel),
                 normals,
@@ -103,6 +119,7 @@ impl PreparedTarget {
         if let Some(w) = self.window.as_mut() {
             w.voxels.add(key, source, pose);
             self.index = OnceCell::new();
+            self.last_matcher = RefCell::new(None);
         }
     }
 
@@ -111,6 +128,7 @@ impl PreparedTarget {
         if let Some(w) = self.window.as_mut() {
             w.voxels.remove(key);
             self.index = OnceCell::new();
+            self.last_matcher = RefCell::new(None);
         }
     }
 
@@ -137,6 +155,41 @@ impl PreparedTarget {
             })
             .as_ref()
             .map_err(Clone::clone)
+    }
+}
+
+impl PreparedTarget {
+    /// Keeps `matcher`, the neighbour cache an alignment of `points` (`pair_points` a pair,
+    /// within `max_distance`) built against this target, for [`Self::take_matcher`].
+    pub(crate) fn keep_matcher(
+        &self,
+        points: &[Point3<f64>],
+        max_distance: f64,
+        pair_points: usize,
+        matcher: Matcher,
+    ) {
+        *self.last_matcher.borrow_mut() = Some(MatcherMemo {
+            points: points.to_vec(),
+            max_distance,
+            pair_points,
+            matcher,
+        });
+    }
+
+    /// The kept neighbour cache when it was built for exactly `points` with the same reach and
+    /// pair size since the target last changed: its answers are those of fresh searches
+    /// ([`crate::neighbour_cache`]), so reusing it changes no result, only the searches run.
+    pub(crate) fn take_matcher(
+        &self,
+        points: &[Point3<f64>],
+        max_distance: f64,
+        pair_points: usize,
+    ) -> Option<Matcher> {
+        let memo = self.last_matcher.borrow_mut().take()?;
+        (memo.points == points
+            && memo.max_distance.to_bits() == max_distance.to_bits()
+            && memo.pair_points == pair_points)
+            .then_some(memo.matcher)
     }
 }
 
