@@ -342,4 +342,42 @@ mod tests {
         assert!(r1 < 0.2 && w_err < 5.0, "{r1} degrees, {w_err} deg/s");
         assert!(t1 < 0.02, "{t1} m");
     }
+
+    #[test]
+    fn a_sweep_after_the_scans_registration_ends_where_it_ends_alone() {
+        // The registration leaves its neighbours in the target for the sweep of the same
+        // points: the sweep must end exactly where it ends on a target without them.
+        let icp = PointToPlaneIcp {
+            config: IcpConfig {
+                kernel: IcpKernel::Tukey { k: 0.2 },
+                source_voxel: 0.1,
+                ..IcpConfig::default()
+            },
+        };
+        let map = sweep(&Pose3::identity(), &Vector6::zeros());
+        let start = pose3_from_xyz_rpy(0.3, -0.2, 0.1, 0.02, -0.01, 0.3);
+        let twist = Vector6::new(1.2, 0.0, 0.3, 0.3, 0.0, 1.0);
+        let deskewed = slam_core::deskew(&sweep(&start, &twist), &(twist * 0.8))
+            .unwrap_or_else(|| panic!("the sweep has times"));
+        let guess = start * pose3_from_xyz_rpy(0.05, 0.03, 0.0, 0.0, 0.0, 0.02);
+        let used = icp.prepare_target(&map).unwrap_or_else(|e| panic!("{e}"));
+        let source = icp
+            .prepare_source(&deskewed)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let registered = icp
+            .align(&source, &used, &guess)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let after = icp
+            .align_sweep(&deskewed, &used, &registered.pose)
+            .unwrap_or_else(|| panic!("point-to-plane aligns sweeps"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let fresh = icp.prepare_target(&map).unwrap_or_else(|e| panic!("{e}"));
+        let alone = icp
+            .align_sweep(&deskewed, &fresh, &registered.pose)
+            .unwrap_or_else(|| panic!("point-to-plane aligns sweeps"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(after.alignment.pose, alone.alignment.pose);
+        assert_eq!(after.velocity_correction, alone.velocity_correction);
+        assert_eq!(after.alignment.inliers, alone.alignment.inliers);
+    }
 }
