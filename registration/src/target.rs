@@ -194,29 +194,15 @@ impl PreparedTarget {
 }
 
 /// Finite points of `cloud` as f64, voxel-filtered when `voxel > 0`. A finite point too far out
-/// for a voxel key (more than 2^62 voxels from the origin: a garbled return, not a
-/// measurement) is dropped with the non-finite ones, so that it cannot turn the thinning off
-/// for the whole cloud.
+/// for a voxel key (a garbled return, not a measurement) is dropped with the non-finite ones
+/// ([`PointCloud::voxel_downsample_keyable`]), so that it cannot turn the thinning off for the
+/// whole cloud.
 pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> {
     if voxel > 0.0 {
         // Points only (the channels would be averaged for nothing); the downsampling skips
         // non-finite points itself.
         let c = PointCloud::from_points(cloud.points().to_vec());
-        let down = match c.voxel_downsample(voxel) {
-            Ok(down) => Some(down),
-            Err(slam_core::CloudError::VoxelOutOfRange { .. }) => {
-                let reach = f64::from(voxel) * VOXEL_KEY_RANGE;
-                let kept = cloud
-                    .points()
-                    .iter()
-                    .filter(|p| p.iter().all(|v| f64::from(v.abs()) < reach))
-                    .copied()
-                    .collect();
-                PointCloud::from_points(kept).voxel_downsample(voxel).ok()
-            }
-            Err(_) => None,
-        };
-        if let Some(down) = down {
+        if let Ok((down, _)) = c.voxel_downsample_keyable(voxel) {
             return down.points().iter().map(|p| p.cast::<f64>()).collect();
         }
     }
@@ -227,9 +213,6 @@ pub(crate) fn finite_points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> 
         .map(|p| p.cast::<f64>())
         .collect()
 }
-
-/// Voxels from the origin within which every voxel key fits (2^62, half the keys' range).
-const VOXEL_KEY_RANGE: f64 = 4.611_686_018_427_388e18;
 
 /// Share of the points, nearest the median point, whose spread decides whether a target is
 /// degenerate: a few absurd points must not hide the spread of the rest.

@@ -17,6 +17,9 @@ struct Accumulator {
     ring: u16,
 }
 
+/// Voxels from the origin within which every voxel key fits (2^62, half the keys' range).
+const KEYABLE_VOXELS: f64 = 4.611_686_018_427_388e18;
+
 /// 2^63, exact in f64: the first voxel coordinate an i64 key cannot hold.
 const TWO_POW_63: f64 = (1u64 << 63) as f64;
 
@@ -117,6 +120,44 @@ impl PointCloud {
             }
         }
         Ok(acc)
+    }
+
+    /// [`Self::voxel_downsample`], but a finite point too far out for any voxel key (more than
+    /// 2^62 voxels from the origin: a garbled return such as 1e30 m, not a measurement) is
+    /// dropped instead of refusing the whole cloud; returns the thinned cloud and how many such
+    /// points were dropped, for the caller to report.
+    ///
+    /// ```
+    /// use nalgebra::Point3;
+    /// use slam_core::PointCloud;
+    /// let cloud = PointCloud::from_points(vec![
+    ///     Point3::new(0.01, 0.0, 0.0),
+    ///     Point3::new(1e30, 0.0, 0.0),
+    /// ]);
+    /// assert!(cloud.voxel_downsample(0.1).is_err());
+    /// let (down, dropped) = cloud.voxel_downsample_keyable(0.1)?;
+    /// assert_eq!((down.len(), dropped), (1, 1));
+    /// # Ok::<(), slam_core::CloudError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`CloudError::InvalidVoxelSize`] unless `voxel_size` is finite and positive.
+    pub fn voxel_downsample_keyable(
+        &self,
+        voxel_size: f32,
+    ) -> Result<(PointCloud, usize), CloudError> {
+        match self.voxel_downsample(voxel_size) {
+            Err(CloudError::VoxelOutOfRange { .. }) => {
+                let reach = f64::from(voxel_size) * KEYABLE_VOXELS;
+                let far = |p: &Point3<f32>| {
+                    p.iter().all(|v| v.is_finite()) && p.iter().any(|v| f64::from(v.abs()) >= reach)
+                };
+                let dropped = self.points().iter().filter(|p| far(p)).count();
+                let near = self.filtered(|_, p| !far(p));
+                Ok((near.voxel_downsample(voxel_size)?, dropped))
+            }
+            other => other.map(|down| (down, 0)),
+        }
     }
 
     /// Downsample to one point per cubic voxel of side `voxel_size` metres, at the centroid of the
@@ -297,5 +338,33 @@ mod tests {
             c.voxel_downsample(1e-3),
             Err(CloudError::VoxelOutOfRange { index: 1, .. })
         ));
+    }
+
+    #[test]
+    fn points_beyond_any_voxel_key_are_dropped_and_counted_not_the_cloud() {
+        let c = PointCloud::from_points(vec![
+            Point3::new(0.01, 0.0, 0.0),
+            Point3::new(0.03, 0.0, 0.0),
+            Point3::new(f32::NAN, 0.0, 0.0),
+            Point3::new(0.0, -1e30, 0.0),
+            Point3::new(2e12, 0.0, 0.0),
+            Point3::new(0.5, 0.0, 0.0),
+        ])
+        .with_time(vec![0.0, 0.2, 0.1, 0.1, 0.1, 0.3])
+        .unwrap();
+        // At 1 mm voxels 2e12 m is 2e15 voxels out (a key); 1e30 m is not.
+        let (down, dropped) = c.voxel_downsample_keyable(1e-3).unwrap();
+        assert_eq!(dropped, 1, "the NaN is not counted, the far finite point is");
+        assert_eq!(down.len(), 4);
+        // The rest thins as without the far point (times averaged as usual).
+        let without = c.filtered(|i, _| i != 3).voxel_downsample(1e-3).unwrap();
+        assert_eq!(down, without);
+        // A clean cloud: the plain thinning, nothing dropped.
+        let clean = c.filtered(|i, _| i < 2);
+        assert_eq!(
+            clean.voxel_downsample_keyable(0.1).unwrap(),
+            (clean.voxel_downsample(0.1).unwrap(), 0)
+        );
+        assert!(c.voxel_downsample_keyable(0.0).is_err());
     }
 }

@@ -102,34 +102,6 @@ struct ScanPose {
     sweep: Option<Sweep>,
 }
 
-/// Voxels from the sensor within which every voxel key fits (2^62, half the keys' range).
-const VOXEL_KEY_RANGE: f64 = 4.611_686_018_427_388e18;
-
-/// `cloud` thinned to `voxel` and how many finite points were dropped first for lying beyond
-/// any voxel key (a garbled return 1e30 m out would otherwise fail the thinning of the whole
-/// scan); no cloud when it cannot be thinned.
-fn thin(cloud: &PointCloud, voxel: f32) -> (Option<PointCloud>, usize) {
-    match cloud.voxel_downsample(voxel) {
-        Ok(thinned) => (Some(thinned), 0),
-        Err(CloudError::VoxelOutOfRange { .. }) => {
-            let reach = f64::from(voxel) * VOXEL_KEY_RANGE;
-            let near = cloud.filtered(|_, p| !p.iter().any(|v| f64::from(v.abs()) >= reach));
-            let far = cloud
-                .points()
-                .iter()
-                .filter(|p| p.iter().all(|v| v.is_finite()))
-                .count()
-                - near
-                    .points()
-                    .iter()
-                    .filter(|p| p.iter().all(|v| v.is_finite()))
-                    .count();
-            (near.voxel_downsample(voxel).ok(), far)
-        }
-        Err(_) => (None, 0),
-    }
-}
-
 /// The motion a scan was deskewed with.
 #[derive(Clone, Copy, Debug)]
 struct Sweep {
@@ -883,7 +855,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // its voxels cost, not what its points cost (an OS1-128 sweep: 131,072 points).
         let voxel = self.config.map_voxel_size;
         let (thinned, far) = match self.odometry.source_voxel().filter(|&v| v >= voxel) {
-            Some(_) => thin(scan.cloud, voxel),
+            // A garbled return beyond any voxel key is dropped and counted, not allowed to
+            // fail the thinning of the whole scan.
+            Some(_) => scan
+                .cloud
+                .voxel_downsample_keyable(voxel)
+                .map_or((None, 0), |(thinned, far)| (Some(thinned), far)),
             None => (None, 0),
         };
         let base = thinned.as_ref().unwrap_or(scan.cloud);
