@@ -167,13 +167,18 @@ pub(crate) fn align<S: IcpStep>(
         return Err(RegistrationError::NonFiniteInitialGuess);
     }
     let index = target.index()?;
+    let thinned = thin_source(source, config.max_source_points);
+    let source = thinned.as_deref().unwrap_or(source);
     // On a worker of the thread pool: each iteration's search then forks onto the other
     // workers directly, not through the pool's queue from outside (a wake-up each time).
-    let (result, used) =
-        rayon::scope(|_| align_indexed::<S>(config, pair_points, source, index, initial));
-    if let Some((points, matcher)) = used {
+    let mut left = None;
+    let result = rayon::scope(|_| {
+        align_indexed::<S>(config, pair_points, source, index, initial, &mut left)
+    });
+    // The neighbours it found, for a sweep of the same points against the same target.
+    if let Some(matcher) = left {
         target.keep_matcher(
-            &points,
+            source,
             config.max_correspondence_distance,
             pair_points,
             matcher,
@@ -182,34 +187,16 @@ pub(crate) fn align<S: IcpStep>(
     result
 }
 
-/// The source points an alignment paired and the neighbour cache it left.
-type Used = Option<(Vec<Point3<f64>>, Matcher)>;
-
-/// [`align`] once the target is indexed, with the points it paired and the neighbour cache it
-/// left (for the next alignment of the same points).
+/// [`align`] once the target is indexed and the source thinned; the neighbour cache it ends
+/// with goes into `left`.
 fn align_indexed<S: IcpStep>(
     config: &IcpConfig,
     pair_points: usize,
     source: &[Point3<f64>],
     target: &TargetIndex,
     initial: &Pose3,
-) -> (Result<Alignment, RegistrationError>, Used) {
-    let mut used = None;
-    let result = align_indexed_into::<S>(config, pair_points, source, target, initial, &mut used);
-    (result, used)
-}
-
-/// [`align_indexed`], leaving the points and the cache in `used`.
-fn align_indexed_into<S: IcpStep>(
-    config: &IcpConfig,
-    pair_points: usize,
-    source: &[Point3<f64>],
-    target: &TargetIndex,
-    initial: &Pose3,
-    used: &mut Used,
+    left: &mut Option<Matcher>,
 ) -> Result<Alignment, RegistrationError> {
-    let thinned = thin_source(source, config.max_source_points);
-    let source = thinned.as_deref().unwrap_or(source);
     let mut pairs = Vec::with_capacity(source.len());
     let mut pose = *initial;
     let mut converged = false;
@@ -279,7 +266,7 @@ fn align_indexed_into<S: IcpStep>(
             required: config.min_correspondences,
         });
     }
-    *used = Some((source.to_vec(), matcher));
+    *left = Some(matcher);
     weights.clear();
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, S::residual);

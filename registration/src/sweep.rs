@@ -282,15 +282,20 @@ mod tests {
             .unwrap_or_default()
     }
 
-    #[test]
-    fn a_sweep_deskewed_with_a_wrong_velocity_gives_back_its_start_and_the_correction() {
-        let icp = PointToPlaneIcp {
+    /// Point-to-plane ICP as the sweep tests run it: Tukey 20 cm, 10 cm source voxels.
+    fn sweep_icp() -> PointToPlaneIcp {
+        PointToPlaneIcp {
             config: IcpConfig {
                 kernel: IcpKernel::Tukey { k: 0.2 },
                 source_voxel: 0.1,
                 ..IcpConfig::default()
             },
-        };
+        }
+    }
+
+    #[test]
+    fn a_sweep_deskewed_with_a_wrong_velocity_gives_back_its_start_and_the_correction() {
+        let icp = sweep_icp();
         // The map: the room seen from a still sensor, dense.
         let map = sweep(&Pose3::identity(), &Vector6::zeros());
         let target = icp.prepare_target(&map).unwrap_or_else(|e| panic!("{e}"));
@@ -347,13 +352,7 @@ mod tests {
     fn a_sweep_after_the_scans_registration_ends_where_it_ends_alone() {
         // The registration leaves its neighbours in the target for the sweep of the same
         // points: the sweep must end exactly where it ends on a target without them.
-        let icp = PointToPlaneIcp {
-            config: IcpConfig {
-                kernel: IcpKernel::Tukey { k: 0.2 },
-                source_voxel: 0.1,
-                ..IcpConfig::default()
-            },
-        };
+        let icp = sweep_icp();
         let map = sweep(&Pose3::identity(), &Vector6::zeros());
         let start = pose3_from_xyz_rpy(0.3, -0.2, 0.1, 0.02, -0.01, 0.3);
         let twist = Vector6::new(1.2, 0.0, 0.3, 0.3, 0.0, 1.0);

@@ -354,7 +354,10 @@ mod tests {
         .unwrap();
         // At 1 mm voxels 2e12 m is 2e15 voxels out (a key); 1e30 m is not.
         let (down, dropped) = c.voxel_downsample_keyable(1e-3).unwrap();
-        assert_eq!(dropped, 1, "the NaN is not counted, the far finite point is");
+        assert_eq!(
+            dropped, 1,
+            "the NaN is not counted, the far finite point is"
+        );
         assert_eq!(down.len(), 4);
         // The rest thins as without the far point (times averaged as usual).
         let without = c.filtered(|i, _| i != 3).voxel_downsample(1e-3).unwrap();

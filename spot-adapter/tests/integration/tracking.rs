@@ -138,18 +138,24 @@ fn turns_of_fifty_degrees_between_scans_are_tracked() {
     );
 }
 
-#[test]
-fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
-    // An OS1-128 (131,072 rays a sweep) carried by a walking person: 2 Hz scans, each a 0.1 s
-    // sweep distorted by a hand shaking by 3 degrees of roll and pitch and 8 of yaw, turns of
-    // up to 43 degrees between scans. The first 80 scans: 40 s, two corners.
+/// The first `scans` of the hand-held OS1-128 walk (seed 1, sweeps distorted by their motion)
+/// and the LiDAR's pose on the body.
+fn hand_held_walk(scans: usize) -> (Vec<Sample>, Pose3) {
     let mut config = SimulationConfig::with_seed(1);
     config.lidar = LidarConfig::os1_128();
     config.motion = MotionProfile::handheld();
     config.motion_distortion = true;
     let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
-    let samples: Vec<Sample> = sim.take(80).collect();
+    (sim.take(scans).collect(), body_t_lidar)
+}
+
+#[test]
+fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
+    // An OS1-128 (131,072 rays a sweep) carried by a walking person: 2 Hz scans, each a 0.1 s
+    // sweep distorted by a hand shaking by 3 degrees of roll and pitch and 8 of yaw, turns of
+    // up to 43 degrees between scans. The first 80 scans: 40 s, two corners.
+    let (samples, body_t_lidar) = hand_held_walk(80);
     assert!(samples[0].cloud.len() > 80_000);
     let now = lidar_only(slam_config(), &samples, &body_t_lidar);
     eprintln!("adaptive reach, sweep motion: {now:?}");
@@ -172,13 +178,7 @@ fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
 /// rounding only, 2.3 cm). The tracker's 0.2 m map under 0.25 m scans: 2.8 cm both times.
 #[test]
 fn a_micrometre_nudge_leaves_the_hand_held_walk_where_it_was() {
-    let mut config = SimulationConfig::with_seed(1);
-    config.lidar = LidarConfig::os1_128();
-    config.motion = MotionProfile::handheld();
-    config.motion_distortion = true;
-    let sim = SimulatedSpot::corridor_loop(&config).unwrap();
-    let body_t_lidar = sim.body_t_lidar();
-    let samples: Vec<Sample> = sim.take(80).collect();
+    let (samples, body_t_lidar) = hand_held_walk(80);
     let nudged: Vec<Sample> = samples
         .iter()
         .map(|s| {
