@@ -540,8 +540,18 @@ fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         report.keyframes
     )?;
     let loops = Loops::new(report);
+    let rejected = if loops.rejected.is_empty() {
+        "none".to_string()
+    } else {
+        loops
+            .rejected
+            .iter()
+            .map(|(reason, n)| format!("{n} {reason}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     out!(
-        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end)",
+        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end; rejected: {rejected})",
         loops.closed,
         loops.tried,
         loops.by_appearance,

@@ -64,6 +64,9 @@ pub struct HealthSummary {
     pub gyro_predictions: usize,
     /// Optimiser runs that failed (the graph was kept as it was).
     pub optimizer_failures: usize,
+    /// Local maps the odometry's backend could not build (those scans fell back with
+    /// `no_target`).
+    pub local_map_failures: usize,
     /// Skipped scans.
     pub skipped: usize,
     /// Skipped scans by reason (reasons with none left out).
@@ -100,6 +103,7 @@ impl HealthSummary {
             odometry_faults: report.odometry_faults,
             gyro_predictions: report.gyro_predictions,
             optimizer_failures: report.optimizer_failures,
+            local_map_failures: report.local_map_failures,
             skipped,
             skipped_by_reason: by_reason(skips),
         }
@@ -142,7 +146,7 @@ fn listed(map: &BTreeMap<String, usize>) -> String {
 pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
     let health = HealthSummary::new(report);
     out!(
-        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} turns predicted by the gyro; {} optimiser failures",
+        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} turns predicted by the gyro; {} optimiser failures; {} local maps not built",
         health.fallbacks,
         health.scans,
         100.0 * health.fallback_share,
@@ -151,7 +155,8 @@ pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
         health.losses,
         health.odometry_faults,
         health.gyro_predictions,
-        health.optimizer_failures
+        health.optimizer_failures,
+        health.local_map_failures
     )?;
     out!(
         "skipped     {} scans ({})",

@@ -2,11 +2,13 @@
 //! skips, loops, tracking health), its times and, with ground truth, its accuracy. The lines
 //! the example prints are made from these same values, so the two agree.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use slam_core::SlamReport;
+
+use slam_core::{LoopRejection, SlamReport};
 use spot_adapter::eval::{KittiRpe, TrajectoryEvaluation};
 
 use crate::health::HealthSummary;
@@ -63,6 +65,9 @@ pub struct Loops {
     pub by_appearance: usize,
     /// Loops refused because they would move the robot further than it can have drifted.
     pub refused_beyond_drift: usize,
+    /// Candidates rejected, by reason (`coarse_mismatch`, `beyond_drift`, ...; the reasons that
+    /// occurred).
+    pub rejected: BTreeMap<&'static str, usize>,
     /// Loops the back end weighted out in its last run.
     pub weighted_out: usize,
     /// Keyframe scans the place recognizer refused (too few points in its range).
@@ -78,7 +83,13 @@ impl Loops {
             closed: report.loops_closed,
             appearance_candidates: report.place_candidates,
             by_appearance: report.place_loops_closed,
-            refused_beyond_drift: report.loops_beyond_drift,
+            refused_beyond_drift: report.loop_rejections.get(LoopRejection::BeyondDrift),
+            rejected: report
+                .loop_rejections
+                .nonzero()
+                .into_iter()
+                .map(|(reason, n)| (reason.name(), n))
+                .collect(),
             weighted_out: report.loops_weighted_out,
             place_refusals: report.place_refusals,
         }

@@ -54,8 +54,8 @@ pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};
 pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
-    EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, ScanInput, ScanOutcome, SkipReason,
-    SlamReport, deskew,
+    EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, LoopRejection, LoopRejections,
+    ScanInput, ScanOutcome, SkipReason, SlamReport, deskew,
 };
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};

@@ -3,8 +3,65 @@
 
 use nalgebra::{Matrix6, Vector6};
 
+use super::config::EdgeInformation;
 use crate::Pose3;
+use crate::geometry::se3_adjoint;
 use crate::pose_graph::GraphPose;
+
+/// The information of an edge of `kind` ending at `pose` (`map_T_lidar`), from the
+/// registration's own `reg_info` where the kind uses it: fixed sigmas of 5 cm and 1° stand in for
+/// a registration information that is missing or invalid.
+pub(crate) fn edge_information(
+    kind: EdgeInformation,
+    reg_info: Option<&Matrix6<f64>>,
+    pose: &Pose3,
+) -> Matrix6<f64> {
+    // Registration information is for a left perturbation of map_T_lidar; the edge error
+    // perturbs the relative pose on the right: Omega' = Ad(X)^T Omega Ad(X).
+    let in_edge_frame = |info: &Matrix6<f64>, scale: f64| {
+        let ad = se3_adjoint(pose);
+        let m = ad.transpose() * info * ad * scale;
+        (m + m.transpose()) * 0.5
+    };
+    let fallback = || fixed_information(0.05, 1f64.to_radians());
+    match (kind, reg_info) {
+        (EdgeInformation::FromRegistration { scale }, Some(info)) => {
+            let m = in_edge_frame(info, scale);
+            if Pose3::information_is_valid(&m) {
+                m
+            } else {
+                fallback()
+            }
+        }
+        (
+            EdgeInformation::Fixed {
+                translation_sigma,
+                rotation_sigma,
+            },
+            _,
+        )
+        | (
+            EdgeInformation::FixedAndRegistration {
+                translation_sigma,
+                rotation_sigma,
+                ..
+            },
+            None,
+        ) => fixed_information(translation_sigma, rotation_sigma),
+        (
+            EdgeInformation::FixedAndRegistration {
+                translation_sigma,
+                rotation_sigma,
+                scale,
+            },
+            Some(info),
+        ) => {
+            let fixed = fixed_information(translation_sigma, rotation_sigma);
+            combined_information(&fixed, &in_edge_frame(info, scale)).unwrap_or(fixed)
+        }
+        (EdgeInformation::FromRegistration { .. }, None) => fallback(),
+    }
+}
 
 /// Diagonal information from standard deviations (tangent order `[rho; phi]`).
 pub(crate) fn fixed_information(translation_sigma: f64, rotation_sigma: f64) -> Matrix6<f64> {

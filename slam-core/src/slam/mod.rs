@@ -10,15 +10,27 @@
 //! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
 //! optimises the graph. Keyframe scans with a per-point `time` channel are deskewed first, with
 //! the velocity the odometry showed since the previous scan.
+//!
+//! One file a stage: `prediction` (where the scan should be), `scan_preparation` (thinning and
+//! deskewing), `scan_tracking` (registration against the local map, the sweep's own motion),
+//! `local_map`, `keyframes` (what is kept, the trajectories and the map), `loop_closure` (the
+//! candidate queue and the checks, each rejection counted by its [`LoopRejection`]),
+//! `information` (edge information); `engine` holds the state and runs the stages in order.
 
 mod config;
 mod deskew;
 mod engine;
 mod information;
+mod keyframes;
+mod local_map;
+mod loop_closure;
 mod node_index;
+mod prediction;
 mod report;
+mod scan_preparation;
+mod scan_tracking;
 
 pub use config::{EdgeInformation, GraphSlamConfig};
 pub use deskew::deskew;
 pub use engine::{GraphSlam, ScanInput};
-pub use report::{LoopOutcome, ScanOutcome, SkipReason, SlamReport};
+pub use report::{LoopOutcome, LoopRejection, LoopRejections, ScanOutcome, SkipReason, SlamReport};

@@ -65,7 +65,109 @@ pub enum LoopOutcome {
         from: u64,
         /// The newer keyframe.
         to: u64,
+        /// Why.
+        reason: LoopRejection,
     },
+}
+
+/// Why a loop candidate was not closed (the checks in the order a candidate meets them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum LoopRejection {
+    /// The coarse check's target (the old keyframe's neighbourhood) could not be built.
+    CoarseTarget,
+    /// The coarse alignment returned an error.
+    CoarseAlignment,
+    /// The coarse alignment did not converge, or ended at a non-finite pose.
+    CoarseNotConverged,
+    /// The coarse alignment's mean squared error is above
+    /// [`GraphSlamConfig::loop_max_mean_squared_error`](super::GraphSlamConfig).
+    CoarseMismatch,
+    /// The refinement's target could not be built.
+    RefineTarget,
+    /// The refinement returned an error.
+    RefineAlignment,
+    /// The refinement did not converge, or ended at a non-finite pose.
+    RefineNotConverged,
+    /// The refinement moved the coarse pose further than
+    /// [`GraphSlamConfig::loop_max_refine_shift`](super::GraphSlamConfig).
+    RefineShift,
+    /// The loop would move the new keyframe further than the walk since the old one could have
+    /// drifted ([`GraphSlamConfig::loop_max_drift_rate`](super::GraphSlamConfig)): a look-alike
+    /// place.
+    BeyondDrift,
+    /// The pose graph refused the edge (a non-finite measurement or information).
+    EdgeRefused,
+}
+
+impl LoopRejection {
+    /// Every reason, in the order a candidate meets the checks.
+    pub const ALL: [Self; 10] = [
+        Self::CoarseTarget,
+        Self::CoarseAlignment,
+        Self::CoarseNotConverged,
+        Self::CoarseMismatch,
+        Self::RefineTarget,
+        Self::RefineAlignment,
+        Self::RefineNotConverged,
+        Self::RefineShift,
+        Self::BeyondDrift,
+        Self::EdgeRefused,
+    ];
+
+    /// A short name for reports (`beyond_drift`, ...).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::CoarseTarget => "coarse_target",
+            Self::CoarseAlignment => "coarse_alignment",
+            Self::CoarseNotConverged => "coarse_not_converged",
+            Self::CoarseMismatch => "coarse_mismatch",
+            Self::RefineTarget => "refine_target",
+            Self::RefineAlignment => "refine_alignment",
+            Self::RefineNotConverged => "refine_not_converged",
+            Self::RefineShift => "refine_shift",
+            Self::BeyondDrift => "beyond_drift",
+            Self::EdgeRefused => "edge_refused",
+        }
+    }
+}
+
+/// Loop candidates rejected, counted by [`LoopRejection`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct LoopRejections {
+    counts: [usize; LoopRejection::ALL.len()],
+}
+
+impl LoopRejections {
+    /// Counts one rejection.
+    pub fn add(&mut self, reason: LoopRejection) {
+        self.counts[reason as usize] += 1;
+    }
+
+    /// Rejections for `reason`.
+    #[must_use]
+    pub fn get(&self, reason: LoopRejection) -> usize {
+        self.counts[reason as usize]
+    }
+
+    /// Rejections for any reason.
+    #[must_use]
+    pub fn total(&self) -> usize {
+        self.counts.iter().sum()
+    }
+
+    /// The reasons that occurred, with their counts, in [`LoopRejection::ALL`]'s order.
+    #[must_use]
+    pub fn nonzero(&self) -> Vec<(LoopRejection, usize)> {
+        LoopRejection::ALL
+            .iter()
+            .map(|&r| (r, self.get(r)))
+            .filter(|&(_, n)| n > 0)
+            .collect()
+    }
 }
 
 /// Running totals of a [`GraphSlam`](super::GraphSlam).
@@ -113,10 +215,12 @@ pub struct SlamReport {
     pub place_loops_closed: usize,
     /// Keyframe scans the place recognizer refused (too few points in its range).
     pub place_refusals: usize,
-    /// Loops that passed the geometric check but were refused because they would move the new
-    /// keyframe further than the walk since the old one could have drifted
-    /// ([`GraphSlamConfig::loop_max_drift_rate`](super::GraphSlamConfig)): look-alike places.
-    pub loops_beyond_drift: usize,
+    /// Loop candidates rejected, by reason (look-alike places refused as beyond the drift a
+    /// walk could gather are [`LoopRejection::BeyondDrift`]).
+    pub loop_rejections: LoopRejections,
+    /// Local maps the odometry's backend could not build from the keyframes (the scan then fell
+    /// back to its prediction, counted in [`SlamReport::tracking`] as having no target).
+    pub local_map_failures: usize,
     /// Loop edges the optimiser weighted out in its last run (an optimiser that decides
     /// outliers, see [`Optimizer::edge_weights`](crate::Optimizer::edge_weights); 0 with one
     /// that keeps every edge): accepted by the geometric check, yet inconsistent with the rest

@@ -11,12 +11,12 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::io::StampedPose;
-use slam_core::tracking::{ReachConfig, TrackerConfig};
+use slam_core::tracking::{FallbackReason, ReachConfig, TrackerConfig};
 use slam_core::{
     Alignment, EdgeInformation, FactorizationFailure, GraphPose, GraphSlam, GraphSlamConfig,
-    MapRegistrator, OptimizationReport, OptimizeError, Optimizer, PointCloud, Pose3, PoseGraph,
-    Reach, RegistrationError, Registrator, ScanInput, ScanOutcome, StopReason, pose3_from_xyz_rpy,
-    se3_exp, se3_left_jacobian, se3_log,
+    LoopOutcome, LoopRejection, MapRegistrator, OptimizationReport, OptimizeError, Optimizer,
+    PointCloud, Pose3, PoseGraph, Reach, RegistrationError, Registrator, ScanInput, ScanOutcome,
+    StopReason, pose3_from_xyz_rpy, se3_exp, se3_left_jacobian, se3_log,
 };
 
 /// Point-to-point ICP with brute-force nearest neighbours (Arun/Umeyama step).
@@ -314,11 +314,8 @@ fn scan(world: &[Point3<f64>], pose: &Pose3) -> PointCloud {
     )
 }
 
-#[test]
-fn loop_closure_removes_odometry_drift() {
-    let world = hall();
-    let truth = loop_poses();
-    // Odometry with 3 % scale error and a yaw drift of 1 degree per 10 m.
+/// The odometry of `truth` with a 3 % scale error and a yaw drift of 1 degree per 10 m.
+fn drifting_odometry(truth: &[Pose3]) -> Vec<Pose3> {
     let mut odom = vec![truth[0]];
     for w in truth.windows(2) {
         let d = w[0].inverse() * w[1];
@@ -327,7 +324,12 @@ fn loop_closure_removes_odometry_drift() {
             * pose3_from_xyz_rpy(0.0, 0.0, 0.0, 0.0, 0.0, (0.1f64).to_radians() * dist);
         odom.push(odom.last().unwrap() * noisy);
     }
-    let config = GraphSlamConfig {
+    odom
+}
+
+/// Settings for the loop with the test ICP.
+fn loop_config() -> GraphSlamConfig {
+    GraphSlamConfig {
         keyframe_distance: 0.45,
         local_map_keyframes: 10,
         loop_neighbours: 5,
@@ -341,9 +343,16 @@ fn loop_closure_removes_odometry_drift() {
             rotation_sigma: 0.3f64.to_radians(),
         },
         ..GraphSlamConfig::default()
-    };
+    }
+}
+
+#[test]
+fn loop_closure_removes_odometry_drift() {
+    let world = hall();
+    let truth = loop_poses();
+    let odom = drifting_odometry(&truth);
     let mut slam = GraphSlam::try_new(
-        config,
+        loop_config(),
         BruteIcp { max_distance: 0.5 },
         BruteIcp { max_distance: 1.0 },
         BruteIcp { max_distance: 0.5 },
@@ -916,4 +925,144 @@ fn a_non_finite_gyro_is_ignored_and_a_finite_one_predicts_each_turn() {
     assert_eq!(plain, corrupt);
     let (_, predicted) = run(&|k| Some(truth[0].rotation.inverse() * truth[k].rotation));
     assert_eq!(predicted, n - 1);
+}
+
+/// The drifting loop through `config` with the caller running the loop-closure steps (as a
+/// scheduler would): every step's outcome that had a candidate, and the report.
+fn loop_steps(config: &GraphSlamConfig) -> (Vec<LoopOutcome>, slam_core::SlamReport) {
+    let world = hall();
+    let truth = loop_poses();
+    let odom = drifting_odometry(&truth);
+    let mut slam = brute_engine(GraphSlamConfig {
+        inline_loop_closure: false,
+        ..config.clone()
+    })
+    .unwrap();
+    let mut outcomes = Vec::new();
+    for (k, (gt, od)) in truth.iter().zip(&odom).enumerate() {
+        let cloud = scan(&world, gt);
+        slam.process(&ScanInput {
+            stamp: k as f64 * 0.2,
+            odom_t_body: Some(*od),
+            body_t_lidar: Pose3::identity(),
+            cloud: &cloud,
+            gyro_orientation: None,
+        });
+        loop {
+            match slam.loop_closure_step() {
+                LoopOutcome::Idle => break,
+                other => outcomes.push(other),
+            }
+        }
+    }
+    (outcomes, slam.report().clone())
+}
+
+#[test]
+fn every_rejected_loop_is_counted_by_its_reason() {
+    let counted = |outcomes: &[LoopOutcome], reason: LoopRejection| {
+        outcomes
+            .iter()
+            .filter(|o| matches!(o, LoopOutcome::Rejected { reason: r, .. } if *r == reason))
+            .count()
+    };
+    // An acceptance threshold nothing meets: every candidate that converges is a mismatch.
+    let (outcomes, report) = loop_steps(&GraphSlamConfig {
+        loop_max_mean_squared_error: 1e-12,
+        ..loop_config()
+    });
+    eprintln!("{:?}", report.loop_rejections.nonzero());
+    assert_eq!(report.loops_closed, 0);
+    assert!(!outcomes.is_empty());
+    assert_eq!(report.loops_attempted, outcomes.len());
+    assert_eq!(report.loops_attempted, report.loop_rejections.total());
+    for reason in LoopRejection::ALL {
+        assert_eq!(
+            counted(&outcomes, reason),
+            report.loop_rejections.get(reason),
+            "{reason:?}"
+        );
+    }
+    assert_eq!(
+        counted(&outcomes, LoopRejection::CoarseMismatch)
+            + counted(&outcomes, LoopRejection::CoarseNotConverged),
+        outcomes.len(),
+        "{:?}",
+        report.loop_rejections.nonzero()
+    );
+    assert!(report.loop_rejections.get(LoopRejection::CoarseMismatch) >= 1);
+}
+
+/// `BruteIcp` whose local map can never be built.
+struct NoMapIcp(BruteIcp);
+
+impl Registrator for NoMapIcp {
+    type Source = Prepared;
+    type Target = Prepared;
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Prepared, RegistrationError> {
+        self.0.prepare_source(cloud)
+    }
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<Prepared, RegistrationError> {
+        self.0.prepare_target(cloud)
+    }
+    fn align(
+        &self,
+        s: &Prepared,
+        t: &Prepared,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError> {
+        self.0.align(s, t, initial)
+    }
+    fn align_within(
+        &self,
+        s: &Prepared,
+        t: &Prepared,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        self.0.align_within(s, t, initial, reach)
+    }
+}
+
+impl MapRegistrator for NoMapIcp {
+    fn target_from_sources(
+        &self,
+        _parts: &[(&Prepared, Pose3)],
+    ) -> Result<Prepared, RegistrationError> {
+        Err(RegistrationError::TooFewPoints {
+            what: "target",
+            points: 0,
+            required: 1,
+        })
+    }
+}
+
+#[test]
+fn a_local_map_the_backend_cannot_build_is_counted_and_each_scan_falls_back() {
+    let world = hall();
+    let truth = loop_poses();
+    let mut slam = GraphSlam::try_new(
+        no_loop_config(),
+        NoMapIcp(BruteIcp { max_distance: 0.5 }),
+        BruteIcp { max_distance: 1.0 },
+        NoMapIcp(BruteIcp { max_distance: 0.5 }),
+        DenseGaussNewton,
+    )
+    .unwrap();
+    for (k, gt) in truth.iter().take(20).enumerate() {
+        let cloud = scan(&world, gt);
+        slam.process(&ScanInput {
+            stamp: k as f64 * 0.2,
+            odom_t_body: Some(*gt),
+            body_t_lidar: Pose3::identity(),
+            cloud: &cloud,
+            gyro_orientation: None,
+        });
+    }
+    let report = slam.report();
+    let no_target = report.tracking.fallbacks.get(FallbackReason::NoTarget);
+    assert!(report.keyframes > 2, "{report:?}");
+    // Every keyframe after the first asked for the map, and each refusal was counted.
+    assert_eq!(report.local_map_failures, report.keyframes - 1);
+    assert_eq!(no_target, report.local_map_failures);
 }

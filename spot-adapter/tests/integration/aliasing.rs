@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 
-use slam_core::{GraphSlamConfig, Pose3};
+use slam_core::{GraphSlamConfig, LoopRejection, Pose3};
 use spot_adapter::eval::TrajectoryEvaluation;
 use spot_adapter::pipelines::{point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -76,7 +76,7 @@ fn no_wrong_loop_survives(seed: u64) {
         "seed {seed}: {} place candidates, {} refused beyond the drift, {} loops closed, {} weighted out, ATE {:.4} m (without place recognition {:.4} m); \
          without the drift gate {} wrong loops in the graph, {} kept, ATE {:.3} m",
         with.report.place_candidates,
-        with.report.loops_beyond_drift,
+        with.report.loop_rejections.get(LoopRejection::BeyondDrift),
         with.report.loops_closed,
         with.report.loops_weighted_out,
         with.ate,
@@ -90,7 +90,7 @@ fn no_wrong_loop_survives(seed: u64) {
         "the repeated rooms fooled no geometric check: no aliasing to defend against"
     );
     assert_eq!(kept_wrong(&with), 0, "{:?}", with.loops);
-    assert!(with.report.loops_beyond_drift >= 1);
+    assert!(with.report.loop_rejections.get(LoopRejection::BeyondDrift) >= 1);
     assert!(with.ate <= 0.05, "ATE {} m", with.ate);
     assert!(
         with.ate <= without.ate + 0.01,

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used)]
 
 use slam_core::io::StampedPose;
-use slam_core::{GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3};
+use slam_core::{GraphSlam, GraphSlamConfig, LoopRejection, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::eval::{
     DEFAULT_MAX_STAMP_DIFFERENCE, INDOOR_SEGMENT_LENGTHS, TrajectoryEvaluation,
 };
@@ -176,7 +176,7 @@ fn place_recognition_closes_the_loop_without_the_search_by_position() {
         seen.ate,
         report.place_candidates,
         report.place_loops_closed,
-        report.loops_beyond_drift,
+        report.loop_rejections.get(LoopRejection::BeyondDrift),
         seen.loop_errors
     );
     assert!(

@@ -1,0 +1,137 @@
+//! What the engine keeps of each scan: keyframes (graph nodes with their clouds) and every
+//! accepted scan's pose riding on one; the trajectories and the map read from them.
+
+use nalgebra::Vector6;
+
+use super::engine::GraphSlam;
+use crate::cloud::PointCloud;
+use crate::error::CloudError;
+use crate::geometry::Pose3;
+use crate::io::StampedPose;
+use crate::traits::optimizer::Optimizer;
+use crate::traits::registrator::MapRegistrator;
+
+/// A keyframe: a node of the graph with what the engine keeps of its scan.
+pub(super) struct Keyframe<S, C> {
+    pub(super) stamp: f64,
+    /// The odometry at the keyframe, `None` for a LiDAR-only scan.
+    pub(super) odom_t_lidar: Option<Pose3>,
+    /// Prepared for the odometry/refinement registrator.
+    pub(super) source: S,
+    /// Prepared for the coarse loop registrator.
+    pub(super) coarse: C,
+    /// Voxel-filtered scan (LiDAR frame) for the map.
+    pub(super) cloud: PointCloud,
+    /// Distance walked from the first keyframe to this one along the estimate when it was
+    /// made (metres): the drift a loop may correct grows with it.
+    pub(super) walked: f64,
+}
+
+/// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the
+/// keyframe's optimised pose.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ScanPose {
+    pub(super) stamp: f64,
+    /// Index of the keyframe.
+    pub(super) keyframe: usize,
+    /// The scan's LiDAR pose in the keyframe's LiDAR frame.
+    pub(super) keyframe_t_lidar: Pose3,
+    /// How the scan was deskewed, when it was.
+    pub(super) sweep: Option<Sweep>,
+}
+
+/// The motion a scan was deskewed with.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Sweep {
+    /// The middle of the sweep (seconds after the stamp).
+    pub(super) middle: f64,
+    /// The velocity (LiDAR-frame twist per second).
+    pub(super) velocity: Vector6<f64>,
+}
+
+impl Sweep {
+    /// The sweep of `cloud` (its time channel) deskewed with `velocity`; `None` without times.
+    pub(super) fn of(cloud: &PointCloud, velocity: Vector6<f64>) -> Option<Self> {
+        let times = cloud.time()?;
+        let (lo, hi) = times
+            .iter()
+            .filter(|t| t.is_finite())
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        (lo <= hi).then(|| Self {
+            middle: 0.5 * f64::from(lo + hi),
+            velocity,
+        })
+    }
+}
+
+impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, O> {
+    /// Number of keyframes.
+    #[must_use]
+    pub fn keyframe_count(&self) -> usize {
+        self.keyframes.len()
+    }
+
+    /// Keyframe `i`'s optimised LiDAR pose (`map_T_lidar`).
+    pub(super) fn keyframe_pose(&self, i: usize) -> Pose3 {
+        self.graph.nodes()[i].pose
+    }
+
+    /// The latest LiDAR pose in the map frame (`map_T_lidar`), `None` before the first scan.
+    #[must_use]
+    pub fn current_lidar_pose(&self) -> Option<Pose3> {
+        let s = self.scan_poses.last()?;
+        Some(self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar)
+    }
+
+    /// Optimised keyframe trajectory: stamp and `map_T_lidar` per keyframe.
+    #[must_use]
+    pub fn keyframe_trajectory(&self) -> Vec<StampedPose> {
+        self.keyframes
+            .iter()
+            .enumerate()
+            .map(|(i, k)| StampedPose {
+                stamp: k.stamp,
+                pose: self.keyframe_pose(i),
+            })
+            .collect()
+    }
+
+    /// Trajectory of every accepted scan, stamp and `map_T_lidar`: each scan rides on its
+    /// keyframe, so loop closures correct it too.
+    #[must_use]
+    pub fn scan_trajectory(&self) -> Vec<StampedPose> {
+        self.scan_poses
+            .iter()
+            .map(|s| StampedPose {
+                stamp: s.stamp,
+                pose: self.keyframe_pose(s.keyframe) * s.keyframe_t_lidar,
+            })
+            .collect()
+    }
+
+    /// Every keyframe's scan (voxel-filtered, in the LiDAR frame) with its optimised
+    /// `map_T_lidar`: the rays an occupancy grid's free space comes from.
+    pub fn keyframe_scans(&self) -> impl Iterator<Item = (Pose3, &PointCloud)> + '_ {
+        self.keyframes
+            .iter()
+            .enumerate()
+            .map(|(i, k)| (self.keyframe_pose(i), &k.cloud))
+    }
+
+    /// The map: every keyframe cloud at its optimised pose, voxel-filtered at `voxel_size`.
+    ///
+    /// # Errors
+    /// [`CloudError::InvalidVoxelSize`] for a bad voxel size.
+    pub fn map(&self, voxel_size: f32) -> Result<PointCloud, CloudError> {
+        let mut all = PointCloud::new();
+        for (i, k) in self.keyframes.iter().enumerate() {
+            let mut c = k.cloud.transformed(&self.keyframe_pose(i));
+            // Channels may differ between sensors' scans; the map keeps positions only.
+            c = PointCloud::from_points(c.into_parts().0);
+            all.extend_from(&c)?;
+        }
+        all.voxel_downsample(voxel_size)
+    }
+}

@@ -1,0 +1,120 @@
+//! A prepared scan registered against the local map by the tracker, then (LiDAR-only, swept)
+//! registered again together with its sweep's own motion and deskewed anew with it.
+
+use nalgebra::{Matrix6, Vector6};
+
+use super::engine::{GraphSlam, ScanInput};
+use super::scan_preparation::Prepared;
+use crate::geometry::{Pose3, pose3_is_finite};
+use crate::traits::optimizer::Optimizer;
+use crate::traits::registrator::MapRegistrator;
+
+/// A scan after tracking.
+pub(super) struct TrackedScan<S> {
+    /// The scan, deskewed anew when its sweep's motion was found.
+    pub(super) prepared: Prepared<S>,
+    /// Its LiDAR pose in the map frame: registered, or the prediction on a fallback.
+    pub(super) pose: Pose3,
+    /// The registration's information; `None` on a fallback.
+    pub(super) information: Option<Matrix6<f64>>,
+}
+
+impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, O> {
+    /// `prepared` registered from `guesses`; with `refine_sweep` (a swept scan without
+    /// odometry, whose velocity between two scans says little about the 0.1 s of one sweep: at
+    /// 2 Hz a hand's shake is faster than the scans) registered again with its sweep's own
+    /// motion and deskewed anew with `velocity` corrected by it.
+    pub(super) fn track(
+        &mut self,
+        scan: &ScanInput<'_>,
+        prepared: Prepared<R::Source>,
+        guesses: &[Pose3],
+        velocity: Option<Vector6<f64>>,
+        refine_sweep: bool,
+    ) -> TrackedScan<R::Source> {
+        let (pose, information) = self.register(&prepared, guesses);
+        let mut tracked = TrackedScan {
+            prepared,
+            pose,
+            information,
+        };
+        if refine_sweep
+            && self.config.sweep_motion
+            && tracked.information.is_some()
+            && let Some((at, information, correction)) =
+                self.sweep_motion(&tracked.prepared, &tracked.pose)
+        {
+            // The second scan has no velocity yet: its sweep's own motion is all there is.
+            let v = velocity.unwrap_or_else(Vector6::zeros);
+            tracked.prepared = self.redeskew(scan, tracked.prepared, v + correction);
+            tracked.pose = at;
+            tracked.information = Some(information);
+        }
+        tracked
+    }
+
+    /// The pose of a scan and its registration's information: registered against the local
+    /// map from `guesses` (the prediction first) by the tracker; the prediction, counted as a
+    /// fallback, when it cannot be (no map, or the registration is not taken). An alternative
+    /// guess that wins counts as an odometry fault.
+    fn register(
+        &mut self,
+        prepared: &Prepared<R::Source>,
+        guesses: &[Pose3],
+    ) -> (Pose3, Option<Matrix6<f64>>) {
+        let has_map = self.ensure_local_map();
+        let target = self
+            .local_map
+            .as_ref()
+            .filter(|_| has_map)
+            .map(|m| &m.target);
+        let outcome = self.tracker.track(
+            &self.odometry,
+            &prepared.source,
+            target,
+            guesses,
+            prepared.extent,
+        );
+        self.report.tracking = *self.tracker.health();
+        if outcome.tracked() && outcome.guess > 0 {
+            self.report.odometry_faults += 1;
+        }
+        // Scan poses are chained on each other without odometry: keep their quaternions unit,
+        // or rounding compounds scan after scan.
+        let mut pose = outcome.pose;
+        pose.rotation.renormalize();
+        self.last_fit = outcome.alignment.as_ref().map(|a| a.rmse);
+        (pose, outcome.alignment.map(|a| a.information))
+    }
+
+    /// The scan registered again from `pose` (its registration) together with its sweep's own
+    /// motion ([`Registrator::align_sweep`](crate::Registrator::align_sweep)): the pose at the
+    /// sweep's start, its information, and the correction to the velocity it was deskewed with.
+    /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
+    /// pose, too small a gain over the scan's registration:
+    /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain)).
+    fn sweep_motion(
+        &self,
+        prepared: &Prepared<R::Source>,
+        pose: &Pose3,
+    ) -> Option<(Pose3, Matrix6<f64>, Vector6<f64>)> {
+        let map = &self.local_map.as_ref()?.target;
+        let sweep = self
+            .odometry
+            .align_sweep(
+                prepared.coarse.as_ref().unwrap_or(&prepared.cloud),
+                map,
+                pose,
+            )?
+            .ok()?;
+        let a = sweep.alignment;
+        let gain = self.config.sweep_min_gain;
+        let better = self
+            .last_fit
+            .is_none_or(|rmse| a.rmse <= rmse * (1.0 - gain));
+        (pose3_is_finite(&a.pose)
+            && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
+            && better)
+            .then_some((a.pose, a.information, sweep.velocity_correction))
+    }
+}
