@@ -266,6 +266,42 @@ pub(crate) mod sealed {
         ) -> Result<GncReport, OptimizeError>;
     }
 
+    /// What the two pose types share: composition, and the loops run with `$slot`, the type's
+    /// cache slot.
+    macro_rules! shared {
+        ($slot:ident) => {
+            fn compose(&self, other: &Self) -> Self {
+                self * other
+            }
+            fn inverse_pose(&self) -> Self {
+                self.inverse()
+            }
+            fn optimize_cached(
+                graph: &mut PoseGraph<Self>,
+                caches: &mut Caches,
+                config: &SolverConfig,
+                levenberg: bool,
+                initial_lambda: f64,
+            ) -> Result<OptimizationReport, OptimizeError> {
+                optimize(
+                    graph,
+                    &mut caches.$slot,
+                    config,
+                    levenberg,
+                    initial_lambda,
+                    None,
+                )
+            }
+            fn graduate(
+                graph: &mut PoseGraph<Self>,
+                caches: &mut Caches,
+                config: &GncConfig,
+            ) -> Result<GncReport, OptimizeError> {
+                graduate(graph, &mut caches.$slot, config)
+            }
+        };
+    }
+
     impl Sealed for Pose3 {
         fn position(&self) -> nalgebra::Vector3<f64> {
             self.translation.vector
@@ -273,36 +309,7 @@ pub(crate) mod sealed {
         fn identity_pose() -> Self {
             Pose3::identity()
         }
-        fn compose(&self, other: &Self) -> Self {
-            self * other
-        }
-        fn inverse_pose(&self) -> Self {
-            self.inverse()
-        }
-        fn optimize_cached(
-            graph: &mut PoseGraph<Self>,
-            caches: &mut Caches,
-            config: &SolverConfig,
-            levenberg: bool,
-            initial_lambda: f64,
-        ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(
-                graph,
-                &mut caches.se3,
-                config,
-                levenberg,
-                initial_lambda,
-                None,
-            )
-        }
-
-        fn graduate(
-            graph: &mut PoseGraph<Self>,
-            caches: &mut Caches,
-            config: &GncConfig,
-        ) -> Result<GncReport, OptimizeError> {
-            graduate(graph, &mut caches.se3, config)
-        }
+        shared!(se3);
     }
 
     impl Sealed for Pose2 {
@@ -313,36 +320,7 @@ pub(crate) mod sealed {
         fn identity_pose() -> Self {
             Pose2::identity()
         }
-        fn compose(&self, other: &Self) -> Self {
-            self * other
-        }
-        fn inverse_pose(&self) -> Self {
-            self.inverse()
-        }
-        fn optimize_cached(
-            graph: &mut PoseGraph<Self>,
-            caches: &mut Caches,
-            config: &SolverConfig,
-            levenberg: bool,
-            initial_lambda: f64,
-        ) -> Result<OptimizationReport, OptimizeError> {
-            optimize(
-                graph,
-                &mut caches.se2,
-                config,
-                levenberg,
-                initial_lambda,
-                None,
-            )
-        }
-
-        fn graduate(
-            graph: &mut PoseGraph<Self>,
-            caches: &mut Caches,
-            config: &GncConfig,
-        ) -> Result<GncReport, OptimizeError> {
-            graduate(graph, &mut caches.se2, config)
-        }
+        shared!(se2);
     }
 }
 

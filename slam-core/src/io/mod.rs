@@ -23,6 +23,7 @@ mod cloud_file;
 mod kitti;
 mod pcd;
 mod ply;
+mod point_record;
 mod scalar;
 mod tum;
 

@@ -5,6 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::point_record::{ascii_record, binary_record};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -579,38 +580,16 @@ pub fn write_pcd_to(
         PcdEncoding::Binary => {
             writeln!(w, "DATA binary")?;
             let mut rec = Vec::with_capacity(22);
-            for (i, p) in cloud.points().iter().enumerate() {
+            for i in 0..cloud.len() {
                 rec.clear();
-                for v in [p.x, p.y, p.z] {
-                    rec.extend_from_slice(&v.to_le_bytes());
-                }
-                if let Some(c) = cloud.intensity() {
-                    rec.extend_from_slice(&c[i].to_le_bytes());
-                }
-                if let Some(c) = cloud.ring() {
-                    rec.extend_from_slice(&c[i].to_le_bytes());
-                }
-                if let Some(c) = cloud.time() {
-                    rec.extend_from_slice(&c[i].to_le_bytes());
-                }
+                binary_record(cloud, i, &mut rec);
                 w.write_all(&rec)?;
             }
         }
         PcdEncoding::Ascii => {
             writeln!(w, "DATA ascii")?;
-            for (i, p) in cloud.points().iter().enumerate() {
-                // `{}` prints the shortest text that reads back to the same f32.
-                write!(w, "{} {} {}", p.x, p.y, p.z)?;
-                if let Some(c) = cloud.intensity() {
-                    write!(w, " {}", c[i])?;
-                }
-                if let Some(c) = cloud.ring() {
-                    write!(w, " {}", c[i])?;
-                }
-                if let Some(c) = cloud.time() {
-                    write!(w, " {}", c[i])?;
-                }
-                writeln!(w)?;
+            for i in 0..cloud.len() {
+                ascii_record(cloud, i, &mut w)?;
             }
         }
     }

@@ -5,6 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::point_record::{ascii_record, binary_record};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -428,35 +429,15 @@ pub fn write_ply_to(
         writeln!(w, "property float time")?;
     }
     writeln!(w, "end_header")?;
-    for (i, p) in cloud.points().iter().enumerate() {
+    let mut rec = Vec::with_capacity(22);
+    for i in 0..cloud.len() {
         match encoding {
             PlyEncoding::BinaryLittleEndian => {
-                for v in [p.x, p.y, p.z] {
-                    w.write_all(&v.to_le_bytes())?;
-                }
-                if let Some(c) = cloud.intensity() {
-                    w.write_all(&c[i].to_le_bytes())?;
-                }
-                if let Some(c) = cloud.ring() {
-                    w.write_all(&c[i].to_le_bytes())?;
-                }
-                if let Some(c) = cloud.time() {
-                    w.write_all(&c[i].to_le_bytes())?;
-                }
+                rec.clear();
+                binary_record(cloud, i, &mut rec);
+                w.write_all(&rec)?;
             }
-            PlyEncoding::Ascii => {
-                write!(w, "{} {} {}", p.x, p.y, p.z)?;
-                if let Some(c) = cloud.intensity() {
-                    write!(w, " {}", c[i])?;
-                }
-                if let Some(c) = cloud.ring() {
-                    write!(w, " {}", c[i])?;
-                }
-                if let Some(c) = cloud.time() {
-                    write!(w, " {}", c[i])?;
-                }
-                writeln!(w)?;
-            }
+            PlyEncoding::Ascii => ascii_record(cloud, i, &mut w)?,
         }
     }
     w.flush()?;
