@@ -6,7 +6,7 @@ use crate::best_first::best_first;
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::cost::octile;
-use crate::open_list::BucketRing;
+use crate::open_list::CellRing;
 use crate::search_space::SearchSpace;
 
 /// A* with the octile-distance heuristic (admissible and consistent for this movement model, so
@@ -14,7 +14,7 @@ use crate::search_space::SearchSpace;
 pub struct AStar<'g> {
     grid: &'g BitGrid,
     components: Components,
-    space: SearchSpace<BucketRing>,
+    space: SearchSpace<CellRing>,
     closed: ClosedSet,
 }
 

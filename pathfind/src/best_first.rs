@@ -7,7 +7,7 @@ use crate::closed_set::ClosedSet;
 use crate::components::Components;
 use crate::cost::{Cost, STEP};
 use crate::movement::DIRECTIONS;
-use crate::open_list::BucketRing;
+use crate::open_list::CellRing;
 use crate::search_space::SearchSpace;
 
 /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
@@ -15,7 +15,7 @@ use crate::search_space::SearchSpace;
 pub(crate) fn best_first(
     grid: &BitGrid,
     components: &Components,
-    space: &mut SearchSpace<BucketRing>,
+    space: &mut SearchSpace<CellRing>,
     closed: &mut ClosedSet,
     start: Cell,
     goal: Cell,

@@ -4,7 +4,7 @@
 //! (the priority, then the tie-break) when it becomes the current bucket, so pops come out in
 //! exact key order: the buckets only spare a heap's logarithmic sifting.
 
-use std::cmp::Reverse;
+use crate::bucket_ring::{BucketRing, Keyed};
 
 /// Words of the ring's occupancy bits.
 const RING_WORDS: usize = 8;
@@ -22,7 +22,8 @@ pub(crate) struct Entry {
     pub(crate) index: u32,
 }
 
-impl Entry {
+impl Keyed for Entry {
+    type Key = (u64, u32);
     #[inline]
     fn key(&self) -> (u64, u32) {
         (self.f, self.tie)
@@ -33,17 +34,9 @@ impl Entry {
 /// `f_min` is the priority last popped (or the first pushed after a clear) and `window` the width
 /// given to [`CostRing::new`].
 pub(crate) struct CostRing {
-    buckets: Vec<Vec<Entry>>,
-    /// Bit `s % 64` of word `s / 64` set when ring slot `s` holds entries.
-    occupied: [u64; RING_WORDS],
+    ring: BucketRing<Entry, RING_WORDS>,
     /// A bucket holds the priorities with the same `f >> shift`.
     shift: u32,
-    /// Absolute number of the current bucket.
-    base: u64,
-    /// Whether the current bucket is sorted (descending: its minimum pops off the end).
-    sorted: bool,
-    /// Whether nothing was pushed since the last clear (the next push sets `base`).
-    fresh: bool,
 }
 
 impl CostRing {
@@ -55,103 +48,33 @@ impl CostRing {
             shift += 1;
         }
         Self {
-            buckets: (0..RING).map(|_| Vec::new()).collect(),
-            occupied: [0; RING_WORDS],
+            ring: BucketRing::default(),
             shift,
-            base: 0,
-            sorted: false,
-            fresh: true,
         }
-    }
-
-    #[inline]
-    fn slot(bucket: u64) -> usize {
-        (bucket % RING as u64) as usize
     }
 
     /// Drop every entry.
     pub(crate) fn clear(&mut self) {
-        for (w, word) in self.occupied.iter_mut().enumerate() {
-            while *word != 0 {
-                let s = w * 64 + word.trailing_zeros() as usize;
-                *word &= *word - 1;
-                self.buckets[s].clear();
-            }
-        }
-        self.sorted = false;
-        self.fresh = true;
+        self.ring.clear();
     }
 
     /// Queue `index` with priority `f` and tie-break `tie`.
     #[inline]
     pub(crate) fn push(&mut self, f: u64, tie: u32, index: u32) {
-        let bucket = f >> self.shift;
-        if self.fresh {
-            self.fresh = false;
-            self.base = bucket;
-        }
-        debug_assert!(
-            bucket >= self.base && bucket - self.base < RING as u64,
-            "priority outside the ring's window"
-        );
-        let s = Self::slot(bucket);
-        let entry = Entry { f, tie, index };
-        let list = &mut self.buckets[s];
-        if self.sorted && bucket == self.base {
-            let at = list.partition_point(|q| q.key() > entry.key());
-            list.insert(at, entry);
-        } else {
-            list.push(entry);
-        }
-        self.occupied[s / 64] |= 1 << (s % 64);
-    }
-
-    /// Buckets from the current one to the next occupied one; `None` when the ring is empty.
-    #[inline]
-    fn distance_to_next(&self) -> Option<u64> {
-        let b = Self::slot(self.base);
-        let (w, bit) = (b / 64, b % 64);
-        let here = self.occupied[w] >> bit;
-        if here != 0 {
-            return Some(u64::from(here.trailing_zeros()));
-        }
-        for k in 1..=RING_WORDS {
-            let word = self.occupied[(w + k) % RING_WORDS];
-            if word != 0 {
-                let slot = ((w + k) % RING_WORDS) * 64 + word.trailing_zeros() as usize;
-                return Some(((slot + RING - b) % RING) as u64);
-            }
-        }
-        None
+        self.ring.push(f >> self.shift, Entry { f, tie, index });
     }
 
     /// The entry with the smallest `(f, tie)`.
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<Entry> {
-        let step = self.distance_to_next()?;
-        if step != 0 {
-            self.base += step;
-            self.sorted = false;
-        }
-        let s = Self::slot(self.base);
-        let list = &mut self.buckets[s];
-        if !self.sorted {
-            if list.len() > 1 {
-                list.sort_unstable_by_key(|q| Reverse(q.key()));
-            }
-            self.sorted = true;
-        }
-        let q = list.pop()?;
-        if list.is_empty() {
-            self.occupied[s / 64] &= !(1 << (s % 64));
-            self.sorted = false;
-        }
-        Some(q)
+        self.ring.pop().map(|(_, e)| e)
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use std::cmp::Reverse;
+
     use super::*;
 
     /// Pops in key order against a sorted list, with pushes within the window of the last pop.

@@ -5,7 +5,7 @@ use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 use crate::best_first::best_first;
 use crate::closed_set::ClosedSet;
 use crate::components::Components;
-use crate::open_list::BucketRing;
+use crate::open_list::CellRing;
 use crate::search_space::SearchSpace;
 
 /// Dijkstra's algorithm on the grid (uniform-cost search, no heuristic). Exact and simple; use
@@ -13,7 +13,7 @@ use crate::search_space::SearchSpace;
 pub struct Dijkstra<'g> {
     grid: &'g BitGrid,
     components: Components,
-    space: SearchSpace<BucketRing>,
+    space: SearchSpace<CellRing>,
     closed: ClosedSet,
 }
 

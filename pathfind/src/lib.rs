@@ -48,6 +48,7 @@
 mod astar;
 mod best_first;
 mod block_scan;
+mod bucket_ring;
 mod cell_cost_astar;
 mod closed_set;
 mod components;
