@@ -67,7 +67,7 @@ fn scratch_file(extension: &str) -> PathBuf {
         std::process::id(),
         std::thread::current().id()
     ))
-    .to_path_buf()
+    .clone()
 }
 
 /// A bag (`extension` `bag` or `mcap`): when it opens, every sample it then gives has a finite
@@ -126,11 +126,13 @@ fn check_bag(path: &std::path::Path) -> bool {
 }
 
 /// A ROS 1 bag (format 2.0) through [`Bag::open`] and [`Bag::samples`].
+#[must_use]
 pub fn ros1_bag(data: &[u8]) -> bool {
     bag(data, "bag")
 }
 
 /// An MCAP file (ROS 2 bag) through [`Bag::open`] and [`Bag::samples`].
+#[must_use]
 pub fn mcap_bag(data: &[u8]) -> bool {
     bag(data, "mcap")
 }
@@ -157,6 +159,7 @@ fn assert_decoded(msg: &PointCloud2<'_>, decoded: &DecodedCloud) {
 /// 0 decides the time unit from the cloud, 1 to 4 gives one), then the payload. When it decodes,
 /// every point is accounted for and finite, per-point times lie within the scan period of the
 /// stamp, and decoding it again with the unit decided gives the same cloud.
+#[must_use]
 pub fn point_cloud2(data: &[u8]) -> bool {
     let Some((&selector, payload)) = data.split_first() else {
         return false;
@@ -205,6 +208,7 @@ pub fn point_cloud2(data: &[u8]) -> bool {
 /// `nav_msgs/Odometry`, `tf2_msgs/TFMessage` or `sensor_msgs/Imu`. Input: one selector byte
 /// (bit 0 the wire, bits 1 and 2: 0 odometry, 1 tf, 2 IMU, 3 odometry), then the payload. When
 /// it decodes, stamps are finite and every pose finite with a unit rotation.
+#[must_use]
 pub fn ros_message(data: &[u8]) -> bool {
     let Some((&selector, payload)) = data.split_first() else {
         return false;

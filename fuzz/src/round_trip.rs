@@ -19,8 +19,9 @@ use spot_adapter::record::parse_index;
 use spot_adapter::record::{calibration_text, parse_calibration};
 use std::path::Path;
 
-/// PCD (ascii, binary and binary_compressed data: one reader): a file that parses is written in
+/// PCD (ascii, binary and `binary_compressed` data: one reader): a file that parses is written in
 /// both of our encodings and must read back to the same cloud.
+#[must_use]
 pub fn pcd(data: &[u8]) -> bool {
     let Ok(cloud) = parse_pcd(data) else {
         return false;
@@ -36,6 +37,7 @@ pub fn pcd(data: &[u8]) -> bool {
 
 /// PLY (ascii, binary little and big endian: one reader): a file that parses is written in
 /// both of our encodings and must read back to the same cloud.
+#[must_use]
 pub fn ply(data: &[u8]) -> bool {
     let Ok(cloud) = parse_ply(data) else {
         return false;
@@ -50,6 +52,7 @@ pub fn ply(data: &[u8]) -> bool {
 }
 
 /// KITTI velodyne scans (`x y z reflectance` as f32): written back bit for bit.
+#[must_use]
 pub fn kitti_bin(data: &[u8]) -> bool {
     let Ok(cloud) = parse_kitti_bin(data) else {
         return false;
@@ -63,6 +66,7 @@ pub fn kitti_bin(data: &[u8]) -> bool {
 
 /// KITTI pose files (3x4 matrices): the poses written back read the same (the reader
 /// re-orthonormalises rotations, so to rounding).
+#[must_use]
 pub fn kitti_poses(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -82,6 +86,7 @@ pub fn kitti_poses(data: &[u8]) -> bool {
 }
 
 /// TUM trajectories (`stamp tx ty tz qx qy qz qw`): stamps exact, poses to rounding.
+#[must_use]
 pub fn tum(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -114,6 +119,7 @@ fn same_structure<P: GraphPose>(a: &PoseGraph<P>, b: &PoseGraph<P>) {
 }
 
 /// g2o graphs (SE(2) and SE(3)): ids, fixed flags, information exact; poses to rounding.
+#[must_use]
 pub fn g2o(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -151,6 +157,7 @@ pub fn g2o(data: &[u8]) -> bool {
 }
 
 /// TORO 2D graphs: ids and information exact (ids as integers), poses to rounding.
+#[must_use]
 pub fn toro(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -170,6 +177,7 @@ pub fn toro(data: &[u8]) -> bool {
 }
 
 /// Moving AI `.map` grids: the same blocked cells and terrain letters after writing.
+#[must_use]
 pub fn movingai_map(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -185,6 +193,7 @@ pub fn movingai_map(data: &[u8]) -> bool {
 
 /// Moving AI `.scen` scenarios: every field the same after writing (the tolerance follows the
 /// version written, so it is not compared).
+#[must_use]
 pub fn movingai_scen(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -207,6 +216,7 @@ pub fn movingai_scen(data: &[u8]) -> bool {
 /// ROS `map_server` maps: the input is the YAML text, a NUL byte, then the image file's bytes
 /// (PGM or PNG). The YAML keys read back from their text; the grid, written as `map_saver`
 /// would (PGM and YAML), reads back cell for cell.
+#[must_use]
 pub fn ros_map(data: &[u8]) -> bool {
     let split = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let (yaml, image) = (&data[..split], data.get(split + 1..).unwrap_or_default());
@@ -234,6 +244,7 @@ pub fn ros_map(data: &[u8]) -> bool {
 }
 
 /// spot-nav recording indexes (`index stamp cloud` lines): the same entries after writing.
+#[must_use]
 pub fn recording_index(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
@@ -249,6 +260,7 @@ pub fn recording_index(data: &[u8]) -> bool {
 
 /// spot-nav recording calibrations (`body_T_lidar tx ty tz qx qy qz qw`): the same mounting
 /// after writing (to rounding of the quaternion).
+#[must_use]
 pub fn recording_calibration(data: &[u8]) -> bool {
     let Ok(text) = std::str::from_utf8(data) else {
         return false;
