@@ -52,6 +52,6 @@ pub use odometry::{OdometryDriftConfig, OdometryModel};
 pub use ray_cast::{HitTarget, RayHit};
 pub use rng::SimRng;
 pub use route::Route;
-pub use route_planning::RouteConfig;
+pub use route_planning::{RouteConfig, shortest_length};
 pub use simulated_spot::{SimulatedSpot, SimulationConfig};
 pub use solid_box::{BoxId, BoxKind, SolidBox};

@@ -92,6 +92,44 @@ impl Route {
     }
 }
 
+/// The length (metres) of the shortest way from `start` to `goal` (plan-view metres) over the
+/// building's ground-truth floor plan at `resolution`, with every cell whose centre lies within
+/// `inflation` of a wall's cell blocked, as a navigator's planning grid blocks them: A*'s path
+/// through the cell centres with every turn a straight line of sight can skip skipped
+/// (`pathfind::filter_path`), joined to `start` and `goal`. `None` when an endpoint lies in a
+/// blocked cell or outside the building, or the two are not connected. The figure a walk to
+/// `goal` is measured against: [`Route::between`] keeps a wider berth and can go round.
+///
+/// # Errors
+/// [`AdapterError::NavigationGrid`] for an `inflation` that is negative or not finite,
+/// [`AdapterError::Grid`] for an unusable resolution, [`AdapterError::Planner`] when the planner
+/// fails.
+pub fn shortest_length(
+    building: &Building,
+    start: Vector2<f64>,
+    goal: Vector2<f64>,
+    inflation: f64,
+    resolution: f64,
+) -> Result<Option<f64>, AdapterError> {
+    let grid = inflate(&building.occupancy_grid(resolution)?, inflation)
+        .map_err(AdapterError::NavigationGrid)?;
+    let free = |p: Vector2<f64>| grid.cell_at(p).filter(|&c| !grid.is_blocked(c));
+    let (Some(s), Some(g)) = (free(start), free(goal)) else {
+        return Ok(None);
+    };
+    let Some(path) = AStar::new(&grid)
+        .plan(s, g)
+        .map_err(AdapterError::Planner)?
+    else {
+        return Ok(None);
+    };
+    let filtered = filter_path(&grid, &path);
+    let mut points = vec![start];
+    points.extend(filtered.waypoints.iter().map(|&c| grid.cell_center(c)));
+    points.push(goal);
+    Ok(Some(points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()))
+}
+
 impl Route {
     /// A collision-free route visiting `waypoints` in order (plan-view metres), each leg planned
     /// as in [`Route::between`]; with `closed`, a last leg returns to the first waypoint. For

@@ -9,6 +9,7 @@ use nalgebra::{Point3, Vector2, Vector3};
 use slam_core::io::StampedPose;
 use spot_adapter::sim::{
     BoxKind, Building, BuildingConfig, HitTarget, Route, RouteConfig, SimRng, SolidBox,
+    shortest_length,
 };
 
 fn building(seed: u64) -> Building {
@@ -173,6 +174,43 @@ fn routes_stay_clear_of_obstacles() {
         Route::between(&b, wall, rooms[0].entry_point(), &config),
         Err(spot_adapter::AdapterError::BlockedEndpoint { which: "start", .. })
     ));
+}
+
+#[test]
+fn the_shortest_way_is_straight_where_it_can_be_and_never_longer_than_a_route() {
+    let b = building(4);
+    let res = 0.1;
+    // Along one side of the corridor loop there is a line of sight: the way is the straight
+    // line (up to the half cells at each end).
+    let corners = b.corridor_loop();
+    let (s, g) = (corners[0], corners[1]);
+    let straight = shortest_length(&b, s, g, 0.3, res).unwrap().unwrap();
+    assert!(
+        straight >= (g - s).norm() - 1e-9 && straight <= (g - s).norm() + 2.0 * res,
+        "{straight} m for a straight {} m",
+        (g - s).norm()
+    );
+    // Between rooms: never shorter than the straight line, and never longer than the
+    // simulator's route, which keeps a wider berth (0.45 m) through the same building.
+    let rooms = b.rooms();
+    for (i, j) in [(0, rooms.len() - 1), (3, rooms.len() / 2), (1, 2)] {
+        let (s, g) = (rooms[i].entry_point(), rooms[j].entry_point());
+        let shortest = shortest_length(&b, s, g, 0.3, res).unwrap().unwrap();
+        let route = Route::between(&b, s, g, &RouteConfig::default()).unwrap();
+        assert!(shortest >= (g - s).norm() - 1e-9, "{i}->{j}: {shortest} m");
+        assert!(
+            shortest <= route.length() + 2.0 * res,
+            "{i}->{j}: {shortest} m, the route {} m",
+            route.length()
+        );
+    }
+    // An endpoint in a wall has no way.
+    let wall = Vector2::new(0.05, 3.0);
+    assert_eq!(
+        shortest_length(&b, wall, rooms[0].entry_point(), 0.3, res).unwrap(),
+        None
+    );
+    assert!(shortest_length(&b, s, g, f64::NAN, res).is_err());
 }
 
 /// Every room of `b` has a route from the corridor loop's start to its entry point.
