@@ -1,6 +1,6 @@
 //! Settings of the ICP backends.
 
-use slam_core::RegistrationError;
+use slam_core::{InvalidSetting, RegistrationError};
 
 use crate::kernel::IcpKernel;
 
@@ -148,17 +148,17 @@ impl IcpConfig {
     /// Preparation and alignment call it, so a bad setting is an error, not a silent change.
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), RegistrationError> {
+    /// [`InvalidSetting`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         let c = self;
         for (setting, v) in [
             ("IcpConfig::source_voxel", c.source_voxel),
             ("IcpConfig::target_voxel", c.target_voxel),
         ] {
-            check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
+            InvalidSetting::check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
         let reach = c.max_correspondence_distance;
-        check(
+        InvalidSetting::check(
             reach.is_finite() && reach > 0.0,
             "IcpConfig::max_correspondence_distance",
             reach,
@@ -169,17 +169,17 @@ impl IcpConfig {
             ("IcpConfig::rotation_tolerance", c.rotation_tolerance),
             ("IcpConfig::degeneracy_threshold", c.degeneracy_threshold),
         ] {
-            check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
+            InvalidSetting::check(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }
         if let IcpKernel::Huber { k } | IcpKernel::Tukey { k } = c.kernel {
-            check(
+            InvalidSetting::check(
                 k.is_finite() && k > 0.0,
                 "IcpConfig::kernel",
                 k,
                 "a finite and positive threshold",
             )?;
         }
-        check(
+        InvalidSetting::check(
             (0.0..=1.0).contains(&c.min_planarity),
             "IcpConfig::min_planarity",
             c.min_planarity,
@@ -217,9 +217,9 @@ impl IcpConfig {
                 "at least 1 (1 skips the coarse stage)",
             ),
         ] {
-            check(v >= least, setting, v as f64, expected)?;
+            InvalidSetting::check(v >= least, setting, v as f64, expected)?;
         }
-        check(
+        InvalidSetting::check(
             c.pair_target_points <= 16,
             "IcpConfig::pair_target_points",
             c.pair_target_points as f64,
@@ -250,29 +250,15 @@ pub(crate) fn check(
     value: f64,
     expected: &'static str,
 ) -> Result<(), RegistrationError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(RegistrationError::InvalidConfig {
-            setting,
-            value,
-            expected,
-        })
-    }
+    Ok(InvalidSetting::check(ok, setting, value, expected)?)
 }
 
-/// [`check`] for an `f32` setting, whose value the error gives as written (`-0.1`, not the
-/// `-0.10000000149011612` of its exact `f64` conversion).
+/// [`check`] for an `f32` setting, whose value the error gives as written.
 pub(crate) fn check_f32(
     ok: bool,
     setting: &'static str,
     value: f32,
     expected: &'static str,
 ) -> Result<(), RegistrationError> {
-    if ok {
-        return Ok(());
-    }
-    // The shortest decimal that reads back as the f32 ("NaN" and "inf" included).
-    let value = value.to_string().parse().unwrap_or(f64::from(value));
-    check(false, setting, value, expected)
+    Ok(InvalidSetting::check_f32(ok, setting, value, expected)?)
 }

@@ -4,8 +4,8 @@
 
 use nalgebra::{Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError,
-    Registrator, pose3_is_finite, se3_exp,
+    Alignment, Degeneracy, InvalidSetting, MapRegistrator, PointCloud, Pose3, Reach,
+    RegistrationError, Registrator, pose3_is_finite, se3_exp,
 };
 
 use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
@@ -449,11 +449,12 @@ impl Registrator for LoamRegistrator {
         reach: &Reach,
     ) -> Result<Alignment, RegistrationError> {
         if !reach.is_valid() {
-            return Err(RegistrationError::InvalidConfig {
+            return Err(InvalidSetting {
                 setting: "Reach::distance",
                 value: reach.distance.min(reach.kernel),
                 expected: "finite and positive, with a finite and positive kernel",
-            });
+            }
+            .into());
         }
         let config = LoamConfig {
             max_neighbour_distance: self.config.max_neighbour_distance.max(reach.distance),

@@ -2,7 +2,7 @@
 //! retrieval of places that look like a query scan, with the heading between them.
 
 use kiddo::{MutableKdTree, SquaredEuclidean};
-use slam_core::{PlaceMatch, PlaceRecognizer, PointCloud, RegistrationError};
+use slam_core::{InvalidSetting, PlaceMatch, PlaceRecognizer, PointCloud, RegistrationError};
 
 use crate::scan_context::{SCAN_CONTEXT_RINGS, ScanContext, ScanContextConfig, ScanContextMatch};
 
@@ -35,18 +35,20 @@ impl ScanContextIndexConfig {
     /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
     pub fn validate(&self) -> Result<(), RegistrationError> {
         if self.ring_key_candidates == 0 {
-            return Err(RegistrationError::InvalidConfig {
+            return Err(InvalidSetting {
                 setting: "ScanContextIndexConfig::ring_key_candidates",
                 value: 0.0,
                 expected: "at least 1",
-            });
+            }
+            .into());
         }
         if !(self.max_distance > 0.0 && self.max_distance <= 1.0) {
-            return Err(RegistrationError::InvalidConfig {
+            return Err(InvalidSetting {
                 setting: "ScanContextIndexConfig::max_distance",
                 value: self.max_distance,
                 expected: "in (0, 1]",
-            });
+            }
+            .into());
         }
         Ok(())
     }
@@ -214,11 +216,12 @@ impl ScanContextRecognizer {
     ) -> Result<Self, RegistrationError> {
         descriptor.validate()?;
         if !(query_offset.is_finite() && query_offset >= 0.0) {
-            return Err(RegistrationError::InvalidConfig {
+            return Err(InvalidSetting {
                 setting: "ScanContextRecognizer::new query_offset",
                 value: query_offset,
                 expected: "finite and not negative",
-            });
+            }
+            .into());
         }
         Ok(Self {
             descriptor,

@@ -4,7 +4,7 @@
 //! the sectors, so comparing two scans means finding the column shift that makes them agree,
 //! and that shift is the heading between them.
 
-use slam_core::{PointCloud, RegistrationError};
+use slam_core::{InvalidSetting, PointCloud, RegistrationError};
 
 /// Rings of a [`ScanContext`] (range bins): fixed, because the ring key indexes a k-d tree of
 /// this dimension. 20 as in the paper.
@@ -46,10 +46,12 @@ impl ScanContextConfig {
     /// # Errors
     /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
     pub fn validate(&self) -> Result<(), RegistrationError> {
-        let invalid = |setting, value, expected| RegistrationError::InvalidConfig {
-            setting,
-            value,
-            expected,
+        let invalid = |setting, value, expected| {
+            RegistrationError::from(InvalidSetting {
+                setting,
+                value,
+                expected,
+            })
         };
         if !(4..=3600).contains(&self.sectors) {
             return Err(invalid(
@@ -469,7 +471,7 @@ mod tests {
         ] {
             assert!(matches!(
                 ScanContext::from_cloud(&scan, &config),
-                Err(RegistrationError::InvalidConfig { .. })
+                Err(RegistrationError::InvalidConfig(_))
             ));
         }
         let far = PointCloud::from_points(vec![Point3::new(100.0, 0.0, 0.0)]);

@@ -14,8 +14,8 @@
 use nalgebra::{Point3, SMatrix, SVector, Vector6};
 use rayon::prelude::*;
 use slam_core::{
-    Alignment, Degeneracy, PointCloud, Pose3, RegistrationError, SweepAlignment, pose3_is_finite,
-    se3_adjoint, se3_exp,
+    Alignment, Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment,
+    pose3_is_finite, se3_adjoint, se3_exp,
 };
 
 use crate::config::IcpConfig;
@@ -36,11 +36,11 @@ fn sweep_points(
 ) -> Result<(Vec<Point3<f64>>, Vec<f64>), RegistrationError> {
     let thinned = if config.source_voxel > 0.0 {
         sweep.voxel_downsample(config.source_voxel).map_err(|_| {
-            RegistrationError::InvalidConfig {
+            RegistrationError::from(InvalidSetting {
                 setting: "IcpConfig::source_voxel",
                 value: f64::from(config.source_voxel),
                 expected: "finite and positive",
-            }
+            })
         })?
     } else {
         sweep.clone()

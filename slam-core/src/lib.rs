@@ -47,7 +47,7 @@ mod voxel;
 pub use cloud::{Aabb, PointCloud};
 pub use error::{
     CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
-    InvalidSlamConfig, OptimizeError, PlanError, RegistrationError, RigidFitError,
+    InvalidSetting, OptimizeError, PlanError, RegistrationError, RigidFitError,
 };
 pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};

@@ -7,10 +7,7 @@ use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
     ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
 };
-use slam_core::{
-    GraphSlam, GraphSlamConfig, InvalidSlamConfig, MapRegistrator, PlaceRecognizer,
-    RegistrationError,
-};
+use slam_core::{GraphSlam, GraphSlamConfig, InvalidSetting, MapRegistrator, PlaceRecognizer};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
 pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, GraduatedNonConvexity>;
@@ -38,7 +35,7 @@ fn assemble<R: MapRegistrator>(
     config: GraphSlamConfig,
     odometry: R,
     refine: R,
-) -> Result<GraphSlam<R, PointToPointIcp, GraduatedNonConvexity>, InvalidSlamConfig> {
+) -> Result<GraphSlam<R, PointToPointIcp, GraduatedNonConvexity>, InvalidSetting> {
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
@@ -122,8 +119,8 @@ pub fn point_to_plane_localiser() -> PointToPlaneIcp {
 /// [`slam_config`]).
 ///
 /// # Errors
-/// [`InvalidSlamConfig`] naming the first bad setting of `config`.
-pub fn point_to_plane_slam(config: GraphSlamConfig) -> Result<PointToPlaneSlam, InvalidSlamConfig> {
+/// [`InvalidSetting`] naming the first bad setting of `config`.
+pub fn point_to_plane_slam(config: GraphSlamConfig) -> Result<PointToPlaneSlam, InvalidSetting> {
     point_to_plane_slam_with(config, point_to_plane_tracker())
 }
 
@@ -131,24 +128,13 @@ pub fn point_to_plane_slam(config: GraphSlamConfig) -> Result<PointToPlaneSlam, 
 /// tracking settings on a recording, say).
 ///
 /// # Errors
-/// [`InvalidSlamConfig`] naming the first bad setting of `config` or of `odometry`'s
+/// [`InvalidSetting`] naming the first bad setting of `config` or of `odometry`'s
 /// (`IcpConfig::...`).
 pub fn point_to_plane_slam_with(
     config: GraphSlamConfig,
     odometry: PointToPlaneIcp,
-) -> Result<PointToPlaneSlam, InvalidSlamConfig> {
-    if let Err(RegistrationError::InvalidConfig {
-        setting,
-        value,
-        expected,
-    }) = odometry.config.validate()
-    {
-        return Err(InvalidSlamConfig {
-            setting,
-            value,
-            expected,
-        });
-    }
+) -> Result<PointToPlaneSlam, InvalidSetting> {
+    odometry.config.validate()?;
     let refine = PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.10 },
@@ -164,8 +150,8 @@ pub fn point_to_plane_slam_with(
 /// [`slam_config`]).
 ///
 /// # Errors
-/// [`InvalidSlamConfig`] naming the first bad setting of `config`.
-pub fn loam_slam(config: GraphSlamConfig) -> Result<LoamSlam, InvalidSlamConfig> {
+/// [`InvalidSetting`] naming the first bad setting of `config`.
+pub fn loam_slam(config: GraphSlamConfig) -> Result<LoamSlam, InvalidSetting> {
     let odometry = LoamRegistrator {
         config: LoamConfig::local_map_odometry(),
     };

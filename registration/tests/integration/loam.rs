@@ -6,7 +6,9 @@
 use crate::common::{error, garage_frames, here, os1_128, random_halves, reference, target_scan};
 use registration::{LidarLayout, LoamConfig, LoamFeatures, LoamRegistrator};
 use slam_core::io::read_ply;
-use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
+use slam_core::{
+    InvalidSetting, PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy,
+};
 
 fn hdl32e() -> LoamRegistrator {
     let mut config = LoamConfig::default();
@@ -132,10 +134,10 @@ fn degenerate_input_is_an_error_or_flagged() {
     bad.config.tukey_threshold = -1.0;
     assert!(matches!(
         bad.prepare_target(&target_scan()),
-        Err(RegistrationError::InvalidConfig {
+        Err(RegistrationError::InvalidConfig(InvalidSetting {
             setting: "LoamConfig::tukey_threshold",
             ..
-        })
+        }))
     ));
     let source = loam.prepare_source(&target_scan()).unwrap();
     let target = loam.prepare_target(&target_scan()).unwrap();

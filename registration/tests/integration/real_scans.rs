@@ -6,7 +6,9 @@ use crate::common::{error, here, random_halves, random_halves_with, reference, t
 use nalgebra::Point3;
 use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
 use slam_core::io::read_ply;
-use slam_core::{PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy};
+use slam_core::{
+    InvalidSetting, PointCloud, Pose3, RegistrationError, Registrator, pose3_from_xyz_rpy,
+};
 
 fn run<R: Registrator>(r: &R, source: &PointCloud, target: &PointCloud, initial: &Pose3) -> Pose3 {
     let a = r
@@ -244,7 +246,9 @@ fn invalid_settings_are_errors() {
     );
     for (setting, config) in bad_settings(good) {
         let invalid = |r: Result<(), RegistrationError>| match r {
-            Err(RegistrationError::InvalidConfig { setting: s, .. }) => s == setting,
+            Err(RegistrationError::InvalidConfig(InvalidSetting { setting: s, .. })) => {
+                s == setting
+            }
             _ => false,
         };
         let (plane, point) = (PointToPlaneIcp { config }, PointToPointIcp { config });

@@ -1,7 +1,6 @@
 //! Settings of the Graph-SLAM engine, with the thesis' values as defaults.
 
-use crate::error::InvalidSlamConfig;
-use crate::error::check_slam as check;
+use crate::error::InvalidSetting;
 use crate::robust_kernel::RobustKernel;
 use crate::tracking::TrackerConfig;
 
@@ -157,7 +156,7 @@ impl Default for GraphSlamConfig {
 impl EdgeInformation {
     /// Checks the sigmas (finite, positive, and with a finite `1 / sigma^2`) or the scale
     /// (finite and positive); `field` names the configuration field it sits in.
-    fn validate(&self, field: Fields) -> Result<(), InvalidSlamConfig> {
+    fn validate(&self, field: Fields) -> Result<(), InvalidSetting> {
         match *self {
             Self::Fixed {
                 translation_sigma,
@@ -167,7 +166,7 @@ impl EdgeInformation {
                     (field.translation_sigma, translation_sigma),
                     (field.rotation_sigma, rotation_sigma),
                 ] {
-                    check(
+                    InvalidSetting::check(
                         sigma.is_finite() && sigma > 0.0 && (1.0 / (sigma * sigma)).is_finite(),
                         setting,
                         sigma,
@@ -176,7 +175,7 @@ impl EdgeInformation {
                 }
                 Ok(())
             }
-            Self::FromRegistration { scale } => check(
+            Self::FromRegistration { scale } => InvalidSetting::check(
                 scale.is_finite() && scale > 0.0,
                 field.scale,
                 scale,
@@ -213,9 +212,9 @@ impl GraphSlamConfig {
     /// [`GraphSlam::try_new`](super::GraphSlam::try_new) calls it.
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting.
+    /// [`InvalidSetting`] naming the first bad setting.
     #[allow(clippy::cast_precision_loss)]
-    pub fn validate(&self) -> Result<(), InvalidSlamConfig> {
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         for (setting, v) in [
             ("GraphSlamConfig::keyframe_distance", self.keyframe_distance),
             ("GraphSlamConfig::keyframe_rotation", self.keyframe_rotation),
@@ -236,27 +235,27 @@ impl GraphSlamConfig {
                 self.loop_max_drift_rate,
             ),
         ] {
-            check(
+            InvalidSetting::check(
                 v.is_finite() && v >= 0.0,
                 setting,
                 v,
                 "finite and not negative",
             )?;
         }
-        check(
+        InvalidSetting::check(
             (0.0..1.0).contains(&self.sweep_min_gain),
             "GraphSlamConfig::sweep_min_gain",
             self.sweep_min_gain,
             "in [0, 1)",
         )?;
         let voxel = f64::from(self.map_voxel_size);
-        check(
+        InvalidSetting::check(
             voxel.is_finite() && voxel > 0.0,
             "GraphSlamConfig::map_voxel_size",
             voxel,
             "finite and positive",
         )?;
-        check(
+        InvalidSetting::check(
             self.local_map_keyframes >= 1,
             "GraphSlamConfig::local_map_keyframes",
             self.local_map_keyframes as f64,
@@ -267,7 +266,7 @@ impl GraphSlamConfig {
                 RobustKernel::Huber { delta } => delta,
                 RobustKernel::Cauchy { c } | RobustKernel::GemanMcClure { c } => c,
             };
-            check(
+            InvalidSetting::check(
                 kernel.is_valid(),
                 "GraphSlamConfig::loop_kernel",
                 parameter,

@@ -16,7 +16,7 @@ use super::prediction::Prediction;
 use super::report::{ScanOutcome, SkipReason, SlamReport};
 use super::scan_preparation::Prepared;
 use crate::cloud::PointCloud;
-use crate::error::{InvalidSlamConfig, OptimizeError};
+use crate::error::{InvalidSetting, OptimizeError};
 use crate::geometry::{Pose3, pose3_is_finite};
 use crate::io::StampedPose;
 use crate::pose_graph::{GraphPose, PoseGraph};
@@ -88,7 +88,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// backend as odometry with a looser outlier threshold, thesis: 0.10 m).
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting of `config`
+    /// [`InvalidSetting`] naming the first bad setting of `config`
     /// ([`GraphSlamConfig::validate`]).
     pub fn try_new(
         config: GraphSlamConfig,
@@ -96,7 +96,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         loop_coarse: C,
         loop_refine: R,
         optimizer: O,
-    ) -> Result<Self, InvalidSlamConfig> {
+    ) -> Result<Self, InvalidSetting> {
         config.validate()?;
         Ok(Self {
             tracker: Tracker::new(config.tracker)?,

@@ -3,8 +3,7 @@
 
 use std::collections::VecDeque;
 
-use crate::error::InvalidSlamConfig;
-use crate::error::check_slam as check;
+use crate::error::InvalidSetting;
 use crate::geometry::Pose3;
 
 /// Settings of [`AdaptiveReach`]. Lengths in metres.
@@ -40,30 +39,30 @@ impl ReachConfig {
     /// a window of at least one scan.
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting.
+    /// [`InvalidSetting`] naming the first bad setting.
     #[allow(clippy::cast_precision_loss)]
-    pub fn validate(&self) -> Result<(), InvalidSlamConfig> {
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         for (setting, v) in [
             ("ReachConfig::initial", self.initial),
             ("ReachConfig::min", self.min),
             ("ReachConfig::max", self.max),
             ("ReachConfig::sigmas", self.sigmas),
         ] {
-            check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
+            InvalidSetting::check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
         }
-        check(
+        InvalidSetting::check(
             self.min <= self.max,
             "ReachConfig::max",
             self.max,
             "at least ReachConfig::min",
         )?;
-        check(
+        InvalidSetting::check(
             (self.min..=self.max).contains(&self.initial),
             "ReachConfig::initial",
             self.initial,
             "from ReachConfig::min to ReachConfig::max",
         )?;
-        check(
+        InvalidSetting::check(
             self.window >= 1,
             "ReachConfig::window",
             self.window as f64,
@@ -93,7 +92,7 @@ pub fn point_displacement(correction: &Pose3, extent: f64) -> f64 {
 /// assert_eq!(reach.current(), 0.5); // 3 x 5 cm, held at the minimum
 /// reach.record(3.0); // a sudden turn
 /// assert!(reach.current() > 1.5);
-/// # Ok::<(), slam_core::InvalidSlamConfig>(())
+/// # Ok::<(), slam_core::InvalidSetting>(())
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdaptiveReach {
@@ -110,8 +109,8 @@ impl AdaptiveReach {
     /// A reach at `config.initial` until predictions are checked.
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting ([`ReachConfig::validate`]).
-    pub fn new(config: ReachConfig) -> Result<Self, InvalidSlamConfig> {
+    /// [`InvalidSetting`] naming the first bad setting ([`ReachConfig::validate`]).
+    pub fn new(config: ReachConfig) -> Result<Self, InvalidSetting> {
         config.validate()?;
         Ok(Self {
             errors: VecDeque::with_capacity(config.window),

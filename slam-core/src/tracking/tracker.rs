@@ -5,8 +5,7 @@ use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
 use super::health::{FallbackReason, TrackingHealth};
 use super::reach::{AdaptiveReach, ReachConfig, point_displacement};
-use crate::error::check_slam as check;
-use crate::error::{InvalidSlamConfig, RegistrationError};
+use crate::error::{InvalidSetting, RegistrationError};
 use crate::geometry::{Pose3, pose3_is_finite};
 use crate::traits::registrator::{Alignment, Reach, Registrator};
 
@@ -73,16 +72,16 @@ impl TrackerConfig {
     /// step finite and positive; `lost_after` at least 1.
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting.
+    /// [`InvalidSetting`] naming the first bad setting.
     #[allow(clippy::cast_precision_loss)]
-    pub fn validate(&self) -> Result<(), InvalidSlamConfig> {
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         self.reach.validate()?;
         for (setting, v) in [
             ("TrackerConfig::coarse_kernel", self.coarse_kernel),
             ("TrackerConfig::min_inlier_ratio", self.min_inlier_ratio),
             ("TrackerConfig::suspect_ratio", self.suspect_ratio),
         ] {
-            check(v > 0.0 && v <= 1.0, setting, v, "within (0, 1]")?;
+            InvalidSetting::check(v > 0.0 && v <= 1.0, setting, v, "within (0, 1]")?;
         }
         for (setting, v) in [
             (
@@ -99,9 +98,9 @@ impl TrackerConfig {
             ),
             ("TrackerConfig::retry_turn_step", self.retry_turn_step),
         ] {
-            check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
+            InvalidSetting::check(v.is_finite() && v > 0.0, setting, v, "finite and positive")?;
         }
-        check(
+        InvalidSetting::check(
             self.lost_after >= 1,
             "TrackerConfig::lost_after",
             self.lost_after as f64,
@@ -177,7 +176,7 @@ type Attempt = Result<Alignment, (FallbackReason, Option<Box<Alignment>>)>;
 /// assert!(outcome.tracked());
 /// assert_eq!(outcome.pose, answer);
 /// assert_eq!(tracker.health().tracked, 1);
-/// # Ok::<(), slam_core::InvalidSlamConfig>(())
+/// # Ok::<(), slam_core::InvalidSetting>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct Tracker {
@@ -221,8 +220,8 @@ impl Tracker {
     /// A tracker with `config`.
     ///
     /// # Errors
-    /// [`InvalidSlamConfig`] naming the first bad setting ([`TrackerConfig::validate`]).
-    pub fn new(config: TrackerConfig) -> Result<Self, InvalidSlamConfig> {
+    /// [`InvalidSetting`] naming the first bad setting ([`TrackerConfig::validate`]).
+    pub fn new(config: TrackerConfig) -> Result<Self, InvalidSetting> {
         config.validate()?;
         Ok(Self {
             reach: AdaptiveReach::new(config.reach)?,

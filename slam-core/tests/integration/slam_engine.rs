@@ -632,7 +632,7 @@ fn local_map_slid_in_place_equals_rebuilt() {
 /// The engine with the test backends.
 fn brute_engine(
     config: GraphSlamConfig,
-) -> Result<GraphSlam<BruteIcp, BruteIcp, DenseGaussNewton>, slam_core::InvalidSlamConfig> {
+) -> Result<GraphSlam<BruteIcp, BruteIcp, DenseGaussNewton>, slam_core::InvalidSetting> {
     GraphSlam::try_new(
         config,
         BruteIcp { max_distance: 0.5 },
