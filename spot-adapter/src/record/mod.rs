@@ -71,6 +71,7 @@ mod read_ahead;
 mod recording;
 mod ros_messages;
 mod source;
+mod time_unit;
 mod wire;
 
 pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
