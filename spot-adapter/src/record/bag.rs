@@ -23,17 +23,15 @@ use nalgebra::UnitQuaternion;
 use slam_core::Pose3;
 
 use crate::error::{AdapterError, MessageError};
-use crate::record::bag_file::{BagFormat, BagMessages, RawMessage, TopicInfo};
+use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
+use crate::record::bag_file::{BagFormat, BagMessages, TopicInfo};
 use crate::record::bag_frames::BagFrames;
 use crate::record::bag_imu::{ImuChoice, ImuSource, ImuSummary};
 use crate::record::bag_samples::BagSamples;
 use crate::record::frame_tree::FrameTree;
 use crate::record::imu::GyroIntegrator;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
-use crate::record::ros_messages::{
-    Header, ImuReading, Odometry, PointCloud2, RosMessageType, decode_tf_message,
-};
-use crate::record::wire::WireReader;
+use crate::record::ros_messages::RosMessageType;
 
 /// Where the odometry of a bag comes from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -202,21 +200,6 @@ pub struct Bag {
     pub(super) decoder: PointCloud2Decoder,
 }
 
-/// The error for message `index` of `topic`.
-pub(super) fn message_error(
-    path: &Path,
-    topic: &str,
-    index: usize,
-    source: MessageError,
-) -> AdapterError {
-    AdapterError::Message {
-        path: path.to_path_buf(),
-        topic: topic.to_owned(),
-        index,
-        source: Box::new(source),
-    }
-}
-
 fn bad(path: &Path, message: String) -> AdapterError {
     AdapterError::Recording {
         path: path.to_path_buf(),
@@ -267,46 +250,6 @@ pub(super) fn check_topic_type(
         ));
     }
     Ok(())
-}
-
-/// Whether `topic` is a tf topic, and whether the static one.
-pub(super) fn tf_kind(topic: &str) -> Option<bool> {
-    match topic.trim_start_matches('/') {
-        "tf" => Some(false),
-        "tf_static" => Some(true),
-        _ => None,
-    }
-}
-
-/// A decoded message the samples need.
-pub(super) enum Decoded<'a> {
-    Cloud(PointCloud2<'a>),
-    Odometry(Odometry),
-    Tf(Vec<crate::record::ros_messages::TransformStamped>, bool),
-    Imu(ImuReading),
-}
-
-/// Decode `msg` as what its topic carries; `None` for topics not used.
-pub(super) fn decode(msg: &RawMessage) -> Result<Option<Decoded<'_>>, MessageError> {
-    let Some(kind) = msg.topic.message_type else {
-        return Ok(None);
-    };
-    let mut r = WireReader::new(&msg.data, msg.topic.wire)?;
-    Ok(Some(match kind {
-        RosMessageType::PointCloud2 => Decoded::Cloud(PointCloud2::decode(&mut r)?),
-        RosMessageType::Odometry => Decoded::Odometry(Odometry::decode(&mut r)?),
-        RosMessageType::TfMessage => match tf_kind(&msg.topic.name) {
-            Some(is_static) => Decoded::Tf(decode_tf_message(&mut r)?, is_static),
-            None => return Ok(None),
-        },
-        RosMessageType::Imu => Decoded::Imu(ImuReading::decode(&mut r)?),
-    }))
-}
-
-/// The header of a cloud payload only.
-pub(super) fn cloud_header(msg: &RawMessage) -> Result<Header, MessageError> {
-    let mut r = WireReader::new(&msg.data, msg.topic.wire)?;
-    Header::decode(&mut r)
 }
 
 /// What the first pass gathers.

@@ -9,9 +9,8 @@ use std::collections::{HashMap, VecDeque};
 use slam_core::{PointCloud, Pose3};
 
 use crate::error::{AdapterError, MessageError};
-use crate::record::bag::{
-    Bag, Decoded, ResolvedOdometry, cloud_header, decode, message_error, tf_kind,
-};
+use crate::record::bag::{Bag, ResolvedOdometry};
+use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
 use crate::record::bag_file::{BagMessages, RawMessage};
 use crate::record::frame_tree::{FrameTree, PoseSeries};
 use crate::record::imu::GyroIntegrator;

@@ -55,6 +55,7 @@
 //! Uses `robot` (the sample type) and `slam-core`'s file formats only.
 
 mod bag;
+mod bag_decoding;
 mod bag_file;
 mod bag_frames;
 mod bag_imu;
