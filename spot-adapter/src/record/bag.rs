@@ -16,24 +16,23 @@
 //! message at a time: memory holds the few clouds that wait for the odometry after them.
 
 use std::collections::BTreeMap;
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use nalgebra::UnitQuaternion;
 use slam_core::Pose3;
 
 use crate::error::{AdapterError, MessageError};
-use crate::record::bag_file::{BagFormat, BagMessages, RawMessage, TopicInfo};
+use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
+use crate::record::bag_file::{BagFormat, BagMessages};
 use crate::record::bag_frames::BagFrames;
-use crate::record::bag_imu::{ImuChoice, ImuSource, ImuSummary};
+use crate::record::bag_imu::{ImuChoice, ImuSource};
 use crate::record::bag_samples::BagSamples;
+use crate::record::bag_summary::{BagSummary, ResolvedOdometry};
+use crate::record::bag_topics::{TopicSummary, check_topic_type, listing};
 use crate::record::frame_tree::FrameTree;
 use crate::record::imu::GyroIntegrator;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
-use crate::record::ros_messages::{
-    Header, ImuReading, Odometry, PointCloud2, RosMessageType, decode_tf_message,
-};
-use crate::record::wire::WireReader;
+use crate::record::ros_messages::RosMessageType;
 
 /// Where the odometry of a bag comes from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -74,147 +73,16 @@ pub struct BagConfig {
     pub cloud: PointCloud2Config,
 }
 
-/// The odometry a bag's samples get, as decided.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ResolvedOdometry {
-    /// A `nav_msgs/Odometry` topic.
-    Topic(String),
-    /// The `/tf` transform from `odom_frame` to the body frame.
-    Tf {
-        /// The odometry frame.
-        odom_frame: String,
-    },
-    /// None: identity.
-    None,
-}
-
-/// One topic's count and log-time span.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TopicSummary {
-    /// The topic.
-    pub info: TopicInfo,
-    /// Messages.
-    pub count: usize,
-    /// First log time (seconds).
-    pub first: f64,
-    /// Last log time (seconds).
-    pub last: f64,
-}
-
-/// What [`Bag::open`] found.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BagSummary {
-    /// The file.
-    pub path: PathBuf,
-    /// Its format.
-    pub format: BagFormat,
-    /// Every topic, by name.
-    pub topics: Vec<TopicSummary>,
-    /// Seconds from the first message to the last.
-    pub duration: f64,
-    /// The cloud topic used.
-    pub cloud_topic: String,
-    /// The first cloud's layout.
-    pub layout: CloudLayout,
-    /// Where the odometry comes from.
-    pub odometry: ResolvedOdometry,
-    /// The body frame.
-    pub base_frame: String,
-    /// The LiDAR frame.
-    pub lidar_frame: String,
-    /// The LiDAR mounting.
-    pub body_t_lidar: Pose3,
-    /// Clouds that will be delivered (stamped within the odometry's span).
-    pub clouds: usize,
-    /// Clouds stamped before the first or after the last odometry (left out).
-    pub clouds_outside_odometry: usize,
-    /// The IMU whose gyro gives the samples' orientation, when one does.
-    pub imu: Option<ImuSummary>,
-    /// What the bag has that is not used, and why, one line each (an odometry or IMU topic whose
-    /// frame is not joined to the clouds' or the body's).
-    pub notes: Vec<String>,
-}
-
-impl fmt::Display for BagSummary {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(
-            f,
-            "bag         {} ({:?}, {:.1} s)",
-            self.path.display(),
-            self.format,
-            self.duration
-        )?;
-        for t in &self.topics {
-            writeln!(
-                f,
-                "topic       {:<28} {:<30} {:>7} messages",
-                t.info.name, t.info.type_name, t.count
-            )?;
-        }
-        writeln!(f, "clouds      {} ({})", self.cloud_topic, self.layout)?;
-        let odometry = match &self.odometry {
-            ResolvedOdometry::Topic(t) => format!("topic {t}"),
-            ResolvedOdometry::Tf { odom_frame } => {
-                format!("/tf {odom_frame} -> {}", self.base_frame)
-            }
-            ResolvedOdometry::None => "none (LiDAR-only)".into(),
-        };
-        writeln!(f, "odometry    {odometry}")?;
-        match &self.imu {
-            Some(imu) => writeln!(f, "imu         {imu}")?,
-            None if self
-                .topics
-                .iter()
-                .any(|t| t.info.message_type == Some(RosMessageType::Imu)) =>
-            {
-                writeln!(f, "imu         none")?;
-            }
-            None => {}
-        }
-        for note in &self.notes {
-            writeln!(f, "note        {note}")?;
-        }
-        let t = self.body_t_lidar.translation.vector;
-        write!(
-            f,
-            "frames      body {}, lidar {} at ({:.3}, {:.3}, {:.3}) m, {:.2} deg; {} clouds used, {} outside the odometry",
-            self.base_frame,
-            self.lidar_frame,
-            t.x,
-            t.y,
-            t.z,
-            self.body_t_lidar.rotation.angle().to_degrees(),
-            self.clouds,
-            self.clouds_outside_odometry
-        )
-    }
-}
-
 /// A bag opened and checked.
 #[derive(Clone, Debug)]
 pub struct Bag {
-    pub(super) summary: BagSummary,
+    summary: BagSummary,
     /// The fixed transforms.
-    pub(super) fixed: FrameTree,
+    fixed: FrameTree,
     /// The stamps between which odometry is known.
-    pub(super) span: (f64, f64),
+    span: (f64, f64),
     /// The decoder with the time unit decided on the first cloud.
-    pub(super) decoder: PointCloud2Decoder,
-}
-
-/// The error for message `index` of `topic`.
-pub(super) fn message_error(
-    path: &Path,
-    topic: &str,
-    index: usize,
-    source: MessageError,
-) -> AdapterError {
-    AdapterError::Message {
-        path: path.to_path_buf(),
-        topic: topic.to_owned(),
-        index,
-        source: Box::new(source),
-    }
+    decoder: PointCloud2Decoder,
 }
 
 fn bad(path: &Path, message: String) -> AdapterError {
@@ -231,82 +99,6 @@ fn of_type(s: &Survey, kind: RosMessageType) -> Vec<&str> {
         .filter(|x| x.info.message_type == Some(kind))
         .map(|x| x.info.name.as_str())
         .collect()
-}
-
-/// `name, type, name, type...` of every topic.
-fn listing(topics: &BTreeMap<String, TopicSummary>) -> String {
-    topics
-        .values()
-        .map(|t| format!("{} ({})", t.info.name, t.info.type_name))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// Check that the bag has topic `name` and that it carries `kind`.
-pub(super) fn check_topic_type(
-    path: &Path,
-    topics: &BTreeMap<String, TopicSummary>,
-    name: &str,
-    kind: RosMessageType,
-) -> Result<(), AdapterError> {
-    let Some(topic) = topics.get(name) else {
-        return Err(bad(
-            path,
-            format!("no topic {name}; the bag has {}", listing(topics)),
-        ));
-    };
-    if topic.info.message_type != Some(kind) {
-        return Err(message_error(
-            path,
-            name,
-            0,
-            MessageError::UnknownType {
-                found: topic.info.type_name.clone(),
-                expected: kind.name(),
-            },
-        ));
-    }
-    Ok(())
-}
-
-/// Whether `topic` is a tf topic, and whether the static one.
-pub(super) fn tf_kind(topic: &str) -> Option<bool> {
-    match topic.trim_start_matches('/') {
-        "tf" => Some(false),
-        "tf_static" => Some(true),
-        _ => None,
-    }
-}
-
-/// A decoded message the samples need.
-pub(super) enum Decoded<'a> {
-    Cloud(PointCloud2<'a>),
-    Odometry(Odometry),
-    Tf(Vec<crate::record::ros_messages::TransformStamped>, bool),
-    Imu(ImuReading),
-}
-
-/// Decode `msg` as what its topic carries; `None` for topics not used.
-pub(super) fn decode(msg: &RawMessage) -> Result<Option<Decoded<'_>>, MessageError> {
-    let Some(kind) = msg.topic.message_type else {
-        return Ok(None);
-    };
-    let mut r = WireReader::new(&msg.data, msg.topic.wire)?;
-    Ok(Some(match kind {
-        RosMessageType::PointCloud2 => Decoded::Cloud(PointCloud2::decode(&mut r)?),
-        RosMessageType::Odometry => Decoded::Odometry(Odometry::decode(&mut r)?),
-        RosMessageType::TfMessage => match tf_kind(&msg.topic.name) {
-            Some(is_static) => Decoded::Tf(decode_tf_message(&mut r)?, is_static),
-            None => return Ok(None),
-        },
-        RosMessageType::Imu => Decoded::Imu(ImuReading::decode(&mut r)?),
-    }))
-}
-
-/// The header of a cloud payload only.
-pub(super) fn cloud_header(msg: &RawMessage) -> Result<Header, MessageError> {
-    let mut r = WireReader::new(&msg.data, msg.topic.wire)?;
-    Header::decode(&mut r)
 }
 
 /// What the first pass gathers.
@@ -776,6 +568,12 @@ impl Bag {
     /// As [`Bag::open`], when the file cannot be opened again.
     pub fn samples(&self) -> Result<BagSamples, AdapterError> {
         let messages = BagMessages::open(&self.summary.path, self.summary.format)?;
-        Ok(BagSamples::new(self.clone(), messages))
+        Ok(BagSamples::new(
+            self.summary.clone(),
+            self.fixed.clone(),
+            self.span,
+            self.decoder.clone(),
+            messages,
+        ))
     }
 }

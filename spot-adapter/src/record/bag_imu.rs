@@ -13,8 +13,8 @@ use std::path::Path;
 use nalgebra::UnitQuaternion;
 
 use crate::error::AdapterError;
-use crate::record::bag::{TopicSummary, check_topic_type};
 use crate::record::bag_frames::BagFrames;
+use crate::record::bag_topics::{TopicSummary, check_topic_type};
 use crate::record::frame_tree::FrameTree;
 use crate::record::imu::{GyroCounts, GyroIntegrator, MAX_GYRO_GAP};
 use crate::record::ros_messages::RosMessageType;

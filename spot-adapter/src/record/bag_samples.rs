@@ -9,21 +9,27 @@ use std::collections::{HashMap, VecDeque};
 use slam_core::{PointCloud, Pose3};
 
 use crate::error::{AdapterError, MessageError};
-use crate::record::bag::{
-    Bag, Decoded, ResolvedOdometry, cloud_header, decode, message_error, tf_kind,
-};
+use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
 use crate::record::bag_file::{BagMessages, RawMessage};
+use crate::record::bag_summary::{BagSummary, ResolvedOdometry};
 use crate::record::frame_tree::{FrameTree, PoseSeries};
 use crate::record::imu::GyroIntegrator;
 use crate::record::no_return::DroppedPoints;
+use crate::record::point_cloud2::PointCloud2Decoder;
 use crate::record::ros_messages::{ImuReading, RosMessageType};
 use crate::robot::Sample;
 
-/// A bag's samples, read one message at a time (from [`Bag::samples`]).
+/// A bag's samples, read one message at a time (from [`Bag::samples`](crate::record::Bag::samples)).
 #[derive(Debug)]
 pub struct BagSamples {
     messages: BagMessages,
-    bag: Bag,
+    /// What the bag holds and how it is read.
+    summary: BagSummary,
+    /// The stamps between which odometry is known.
+    span: (f64, f64),
+    /// The decoder with the time unit decided on the first cloud.
+    decoder: PointCloud2Decoder,
+    /// The fixed transforms and the moving ones read so far.
     tree: FrameTree,
     odometry: PoseSeries,
     /// Clouds waiting for the odometry after their stamp.
@@ -47,18 +53,27 @@ enum OdometryAt {
 }
 
 impl BagSamples {
-    pub(super) fn new(bag: Bag, messages: BagMessages) -> Self {
-        let gyro = bag
-            .summary
+    /// The samples of a bag `summary` describes, read from `messages`, with its fixed
+    /// transforms, the `span` of its odometry and its cloud `decoder`.
+    pub(super) fn new(
+        summary: BagSummary,
+        fixed: FrameTree,
+        span: (f64, f64),
+        decoder: PointCloud2Decoder,
+        messages: BagMessages,
+    ) -> Self {
+        let gyro = summary
             .imu
             .as_ref()
             .map(|imu| GyroIntegrator::new(&imu.frame, imu.body_r_imu));
         Self {
             gyro,
             messages,
-            tree: bag.fixed.clone(),
-            left: bag.summary.clouds,
-            bag,
+            tree: fixed,
+            left: summary.clouds,
+            summary,
+            span,
+            decoder,
             odometry: PoseSeries::default(),
             pending: VecDeque::new(),
             counters: HashMap::new(),
@@ -73,7 +88,7 @@ impl BagSamples {
     /// Whether the gyro orientation at `stamp` is known, or will never be: no IMU, a stamp
     /// outside its readings, a reading at or after it read, or the bag read to its end.
     fn gyro_ready(&self, stamp: f64) -> bool {
-        let (Some(gyro), Some(imu)) = (&self.gyro, &self.bag.summary.imu) else {
+        let (Some(gyro), Some(imu)) = (&self.gyro, &self.summary.imu) else {
             return true;
         };
         self.exhausted
@@ -96,7 +111,7 @@ impl BagSamples {
     }
 
     fn odometry_at(&self, stamp: f64) -> Result<OdometryAt, MessageError> {
-        let summary = &self.bag.summary;
+        let summary = &self.summary;
         match &summary.odometry {
             ResolvedOdometry::None => Ok(OdometryAt::Known(Pose3::identity())),
             ResolvedOdometry::Topic(_) => match self.odometry.last_stamp() {
@@ -130,23 +145,23 @@ impl BagSamples {
 
     /// Take in one message.
     fn take(&mut self, msg: &RawMessage) -> Result<(), AdapterError> {
-        let path = self.bag.summary.path.clone();
+        let path = self.summary.path.clone();
         let name = &msg.topic.name;
         let counter = self.counters.entry(name.clone()).or_default();
         let index = *counter;
         *counter += 1;
         let at = |e| message_error(&path, name, index, e);
-        let summary = &self.bag.summary;
+        let summary = &self.summary;
         if *name == summary.cloud_topic {
             let stamp = cloud_header(msg).map_err(at)?.stamp;
-            let (from, until) = self.bag.span;
+            let (from, until) = self.span;
             if stamp < from || stamp > until {
                 return Ok(());
             }
             let Some(Decoded::Cloud(cloud)) = decode(msg).map_err(at)? else {
                 return Ok(());
             };
-            let decoded = self.bag.decoder.decode(&cloud).map_err(at)?;
+            let decoded = self.decoder.decode(&cloud).map_err(at)?;
             self.dropped.add(decoded.dropped);
             self.pending.push_back((index, stamp, decoded.cloud));
             return Ok(());
@@ -197,7 +212,7 @@ impl BagSamples {
         Some(Sample {
             stamp,
             odom_t_body,
-            body_t_lidar: self.bag.summary.body_t_lidar,
+            body_t_lidar: self.summary.body_t_lidar,
             cloud,
             ground_truth: None,
             gyro_orientation,
@@ -208,19 +223,14 @@ impl BagSamples {
         loop {
             if let Some(&(index, stamp, _)) = self.pending.front() {
                 let known = self.odometry_at(stamp).map_err(|e| {
-                    message_error(
-                        &self.bag.summary.path,
-                        &self.bag.summary.cloud_topic,
-                        index,
-                        e,
-                    )
+                    message_error(&self.summary.path, &self.summary.cloud_topic, index, e)
                 })?;
                 match known {
                     OdometryAt::Known(odom_t_body) if self.gyro_ready(stamp) => {
                         return Ok(self.deliver(odom_t_body));
                     }
                     OdometryAt::NotYet if self.exhausted => {
-                        let summary = &self.bag.summary;
+                        let summary = &self.summary;
                         return Err(message_error(
                             &summary.path,
                             &summary.cloud_topic,

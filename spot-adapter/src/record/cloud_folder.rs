@@ -25,7 +25,7 @@ use slam_core::io::read_tum;
 use crate::error::AdapterError;
 use crate::record::frame_tree::PoseSeries;
 use crate::record::no_return::{DroppedPoints, ReturnFilter};
-use crate::record::point_cloud2::{PointCloud2Config, PointCloud2Decoder};
+use crate::record::time_unit::TimeUnitInference;
 use crate::robot::Sample;
 
 /// Seconds between scans when nothing gives their stamps.
@@ -205,7 +205,7 @@ impl CloudFolder {
             folder: self.clone(),
             next: 0,
             dropped: DroppedPoints::default(),
-            times: PointCloud2Decoder::new(PointCloud2Config::default()),
+            times: TimeUnitInference::default(),
         }
     }
 }
@@ -217,7 +217,7 @@ pub struct CloudFolderSamples {
     next: usize,
     dropped: DroppedPoints,
     /// Decides the per-point time unit (seconds or Ouster's nanoseconds) once.
-    times: PointCloud2Decoder,
+    times: TimeUnitInference,
 }
 
 impl CloudFolderSamples {

@@ -55,10 +55,13 @@
 //! Uses `robot` (the sample type) and `slam-core`'s file formats only.
 
 mod bag;
+mod bag_decoding;
 mod bag_file;
 mod bag_frames;
 mod bag_imu;
 mod bag_samples;
+mod bag_summary;
+mod bag_topics;
 mod bounded_file;
 mod cloud_folder;
 mod frame_tree;
@@ -71,13 +74,16 @@ mod read_ahead;
 mod recording;
 mod ros_messages;
 mod source;
+mod time_unit;
 mod wire;
 
-pub use bag::{Bag, BagConfig, BagSummary, OdometrySource, ResolvedOdometry, TopicSummary};
+pub use bag::{Bag, BagConfig, OdometrySource};
 pub use bag_file::{BagFormat, TopicInfo};
 pub use bag_frames::BagFrames;
 pub use bag_imu::{ImuSource, ImuSummary};
 pub use bag_samples::BagSamples;
+pub use bag_summary::{BagSummary, ResolvedOdometry};
+pub use bag_topics::TopicSummary;
 pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
 pub use frame_tree::{FrameTree, PoseSeries};
