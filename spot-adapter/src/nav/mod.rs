@@ -6,10 +6,13 @@
 //! simulator: the same code drives a simulated Spot and a real one.
 
 mod config;
+mod controller;
+mod detour;
 mod drive;
 mod localiser;
 mod navigation_map;
 mod navigator;
+mod path;
 mod stuck;
 mod unseen;
 
