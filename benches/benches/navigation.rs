@@ -54,6 +54,7 @@ fn navigation(c: &mut Criterion) {
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
     let nav_config = NavigatorConfig::default();
+    let map_config = nav_config.map_config();
     let start = building.corridor_loop()[0];
     // The farthest room's entry: every plan crosses the building.
     let Some(goal) = building
@@ -68,12 +69,12 @@ fn navigation(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("prepare_map", |b| {
         b.iter(|| {
-            let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config);
+            let navigation = NavigationMap::from_scans(&refs, lidar_height, &map_config);
             let target = point_to_plane_localiser().prepare_target(&map);
             black_box((navigation.is_ok(), target.is_ok()))
         });
     });
-    let Ok(navigation) = NavigationMap::from_scans(&refs, lidar_height, &nav_config) else {
+    let Ok(navigation) = NavigationMap::from_scans(&refs, lidar_height, &map_config) else {
         eprintln!("navigation bench: navigation map failed; skipping");
         return;
     };

@@ -24,7 +24,8 @@ use serde::Serialize;
 use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
 use spot_adapter::nav::{
-    Goal, NavigationMap, NavigationStep, Navigator, NavigatorConfig, PlannerKind,
+    Goal, NavigationMap, NavigationMapConfig, NavigationStep, Navigator, NavigatorConfig,
+    PlannerKind,
 };
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places, slam_config,
@@ -170,7 +171,8 @@ fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
     let sim_config = SimulationConfig::default();
     let lidar_height = sim_config.spot.body_height + sim_config.spot.body_t_lidar.translation.z;
-    let navigation = NavigationMap::from_scans(&scans, lidar_height, &NavigatorConfig::default())?;
+    let navigation =
+        NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default())?;
     Ok(Mapped {
         map: slam.map(0.05)?,
         navigation,

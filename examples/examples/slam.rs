@@ -25,7 +25,7 @@ use slam_core::{
     EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
     quaternion_from_xyzw,
 };
-use spot_adapter::nav::{NavigationMap, NavigatorConfig};
+use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
 use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
 use spot_adapter::record::{
     BagConfig, DroppedPoints, ImuSource, OdometrySource, PointCloud2Config, ReadAhead,
@@ -667,7 +667,7 @@ fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
     write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
     let scans: Vec<_> = slam.keyframe_scans().collect();
-    match NavigationMap::from_scans(&scans, lidar_height, &NavigatorConfig::default()) {
+    match NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default()) {
         Ok(navigation) => {
             let grid = navigation.occupancy();
             let planning = grid.to_planning_grid(UnknownCells::Free);

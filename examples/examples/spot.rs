@@ -110,14 +110,15 @@ fn run(args: &Args) -> Result<DriveOutcome> {
         let [x, y, yaw] = args.start;
         let map_t_body = Pose3::new(Vector3::new(x, y, 0.0), Vector3::new(0.0, 0.0, yaw));
         let lidar = map_t_body * geometry.body_t_lidar;
-        let navigation = NavigationMap::from_cloud(&map, &[lidar], lidar_height, &nav_config)?;
+        let navigation =
+            NavigationMap::from_cloud(&map, &[lidar], lidar_height, &nav_config.map_config())?;
         (map, navigation, map_t_body, args.goal)
     } else {
         let odom_t_start = spot.frame_tree()?.a_t_b("odom", "body")?;
         println!("mapping: turning once in place");
         let scans = map_in_place(&mut spot)?;
         let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
-        let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config)?;
+        let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config.map_config())?;
         let points: Vec<Point3<f32>> = scans
             .iter()
             .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())

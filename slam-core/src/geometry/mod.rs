@@ -17,7 +17,7 @@ pub use pose::{
     quaternion_from_xyzw, quaternion_to_wxyz, quaternion_to_xyzw,
 };
 pub use rigid_fit::{WeightedPair, fit_rigid_transform, fit_weighted_rigid_transform};
-pub use se2::{se2_exp, se2_log};
+pub use se2::{se2_exp, se2_log, wrap_angle};
 pub use se3::{se3_adjoint, se3_exp, se3_hat, se3_left_jacobian, se3_log, se3_vee};
 pub use so3::{so3_exp, so3_hat, so3_left_jacobian, so3_left_jacobian_inverse, so3_log, so3_vee};
 

@@ -20,6 +20,25 @@ pub fn se2_exp(xi: &Vector3<f64>) -> Isometry2<f64> {
     Isometry2::new(t, xi.z)
 }
 
+/// `angle` (radians) wrapped to `(-pi, pi]`: a heading error or a turn, the short way round.
+///
+/// ```
+/// use std::f64::consts::PI;
+/// use slam_core::wrap_angle;
+///
+/// assert!((wrap_angle(1.5 * PI) + 0.5 * PI).abs() < 1e-12);
+/// assert_eq!(wrap_angle(-PI), PI);
+/// ```
+#[must_use]
+pub fn wrap_angle(angle: f64) -> f64 {
+    let a = angle.rem_euclid(std::f64::consts::TAU);
+    if a > std::f64::consts::PI {
+        a - std::f64::consts::TAU
+    } else {
+        a
+    }
+}
+
 /// The twist `[x, y, theta]` with `exp(xi) = t`, `theta` in `(-pi, pi]`.
 #[must_use]
 pub fn se2_log(t: &Isometry2<f64>) -> Vector3<f64> {

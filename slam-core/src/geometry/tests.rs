@@ -156,6 +156,25 @@ proptest! {
 }
 
 #[test]
+fn angles_wrap_into_minus_pi_to_pi() {
+    use std::f64::consts::PI;
+    for (a, want) in [
+        (0.0, 0.0),
+        (PI, PI),
+        (-PI, PI),
+        (1.5 * PI, -0.5 * PI),
+        (-1.5 * PI, 0.5 * PI),
+        (7.0, 7.0 - 2.0 * PI),
+    ] {
+        assert!(
+            (wrap_angle(a) - want).abs() < 1e-12,
+            "{a} -> {}",
+            wrap_angle(a)
+        );
+    }
+}
+
+#[test]
 fn quaternion_component_orders() {
     let q = UnitQuaternion::from_euler_angles(0.3, -0.2, 1.0);
     let xyzw = quaternion_to_xyzw(&q);

@@ -289,7 +289,6 @@ impl<R: Registrator> Localiser<R> {
             self.map_t_body *= step;
         }
         let voxel = self.config.walking_scan_voxel;
-        #[allow(clippy::cast_possible_truncation)]
         let thinned = (walking && voxel > 0.0)
             .then(|| sample.cloud.voxel_downsample(voxel as f32).ok())
             .flatten();

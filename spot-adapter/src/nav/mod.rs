@@ -5,15 +5,20 @@
 //! Uses `robot` (samples, commands, limits), `gridmap`, `pathfind` and `slam-core`, never the
 //! simulator: the same code drives a simulated Spot and a real one.
 
+mod config;
+mod controller;
+mod detour;
 mod drive;
 mod localiser;
 mod navigation_map;
 mod navigator;
+mod path;
 mod stuck;
 mod unseen;
 
+pub use config::{NavigationMapConfig, NavigatorConfig, PlannerKind};
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
 pub use navigation_map::NavigationMap;
-pub use navigator::{Goal, NavigationStep, Navigator, NavigatorConfig, PlannerKind};
+pub use navigator::{Goal, NavigationStep, Navigator};
 pub use stuck::StuckConfig;

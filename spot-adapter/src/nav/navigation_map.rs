@@ -6,7 +6,7 @@ use gridmap::{FloorMap, OccupancyGrid, OccupancyGridBuilder, floor_hints_below};
 use slam_core::{PointCloud, Pose3};
 
 use crate::error::AdapterError;
-use crate::nav::navigator::NavigatorConfig;
+use crate::nav::config::NavigationMapConfig;
 
 /// The static layer of navigation: occupancy (obstacles from the floor up, free where beams
 /// passed, unknown elsewhere) and the floor under it.
@@ -23,12 +23,12 @@ impl NavigationMap {
     /// the cells the beams crossed; cells no beam reached are unknown.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid settings, [`AdapterError::NavigationGrid`]
-    /// (with gridmap's error as its source) when the grid cannot be built.
+    /// [`AdapterError::NavigationGrid`] (with gridmap's error as its source) for invalid settings
+    /// or when the grid cannot be built.
     pub fn from_scans(
         scans: &[(Pose3, &PointCloud)],
         lidar_height: f64,
-        config: &NavigatorConfig,
+        config: &NavigationMapConfig,
     ) -> Result<Self, AdapterError> {
         config.validate()?;
         let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
@@ -51,7 +51,7 @@ impl NavigationMap {
         map: &PointCloud,
         sensor_poses: &[Pose3],
         lidar_height: f64,
-        config: &NavigatorConfig,
+        config: &NavigationMapConfig,
     ) -> Result<Self, AdapterError> {
         config.validate()?;
         let hints = floor_hints_below(sensor_poses, lidar_height);

@@ -4,7 +4,9 @@
 
 use nalgebra::Vector2;
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
+use spot_adapter::nav::{
+    DriveOutcome, NavigationMap, NavigationMapConfig, Navigator, NavigatorConfig, drive,
+};
 use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
@@ -35,7 +37,7 @@ pub fn building_and_map(seed: u64) -> (Building, PointCloud, NavigationMap) {
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
     let navigation =
-        NavigationMap::from_scans(&refs, lidar_height, &NavigatorConfig::default()).unwrap();
+        NavigationMap::from_scans(&refs, lidar_height, &NavigationMapConfig::default()).unwrap();
     (building, map, navigation)
 }
 

@@ -1,0 +1,280 @@
+//! From the planning grid to the waypoints the robot steers at: the planner's path with every
+//! cell, then the turning points a straight segment with room to spare cannot skip.
+
+use gridmap::PlanningGrid;
+use nalgebra::Vector2;
+use pathfind::{AStar, CellCostAStar, JumpPointSearch, filter_path};
+use slam_core::{BitGrid, Cell, GridPath, Planner};
+
+use crate::error::AdapterError;
+use crate::nav::config::PlannerKind;
+
+/// A path to the goal and the waypoints along it, kept together from the plan to the goal: the
+/// path's cells are what the blocked-path test and the detour policy read, the waypoints what
+/// the controller steers at.
+#[derive(Clone, Debug)]
+pub(crate) struct Plan {
+    /// Every cell from the start to the goal, and the length in cells (straight 1, diagonal
+    /// sqrt(2)).
+    path: GridPath,
+    /// Waypoints (metres) after the start, ending at the goal ...
+    waypoints: Vec<Vector2<f64>>,
+    /// ... of which this many are behind the robot.
+    passed: usize,
+}
+
+impl Default for Plan {
+    fn default() -> Self {
+        Self {
+            path: GridPath {
+                cells: Vec::new(),
+                length: 0.0,
+                expanded: 0,
+            },
+            waypoints: Vec::new(),
+            passed: 0,
+        }
+    }
+}
+
+impl Plan {
+    /// A plan on `planning` by `planner` from `position` to `goal`, its straight segments
+    /// keeping `shortcut_clearance` (metres) where they can, or `None` when no path joins them
+    /// (either end off the map, the goal blocked, or no path). A start inside the inflated
+    /// obstacles (the robot brushed a wall) plans from the nearest free cell.
+    pub(crate) fn search(
+        planning: &PlanningGrid,
+        planner: PlannerKind,
+        shortcut_clearance: f64,
+        position: Vector2<f64>,
+        goal: Vector2<f64>,
+    ) -> Result<Option<Self>, AdapterError> {
+        let Some(path) = dense_path(planning, planner, position, goal)? else {
+            return Ok(None);
+        };
+        let waypoints = waypoints_along(planning, shortcut_clearance, &path, goal);
+        Ok(Some(Self {
+            path,
+            waypoints,
+            passed: 0,
+        }))
+    }
+
+    /// The path, every cell from the start to the goal (empty when there is none).
+    pub(crate) fn path(&self) -> &GridPath {
+        &self.path
+    }
+
+    /// Whether there is a path to follow.
+    pub(crate) fn has_path(&self) -> bool {
+        !self.path.cells.is_empty()
+    }
+
+    /// The waypoints (metres) still ahead, ending at the goal.
+    pub(crate) fn waypoints(&self) -> &[Vector2<f64>] {
+        &self.waypoints[self.passed..]
+    }
+
+    /// Pass the waypoints within `near` (metres) of `position`, all but the last.
+    pub(crate) fn pass(&mut self, position: Vector2<f64>, near: f64) {
+        while self.waypoints().len() > 1 && (self.waypoints()[0] - position).norm() <= near {
+            self.passed += 1;
+        }
+    }
+
+    /// Drop the path and its waypoints.
+    pub(crate) fn clear(&mut self) {
+        self.clear_path();
+        self.clear_waypoints();
+    }
+
+    /// Drop the path (the next cycle plans again); the waypoints stay until it does.
+    pub(crate) fn clear_path(&mut self) {
+        self.path.cells.clear();
+        self.path.length = 0.0;
+    }
+
+    /// Drop the waypoints (the robot stops following them); the path stays.
+    pub(crate) fn clear_waypoints(&mut self) {
+        self.waypoints.clear();
+        self.passed = 0;
+    }
+
+    /// The path from its cell nearest `position` on, its waypoints made afresh: the route kept,
+    /// as a replan from here along it would give.
+    pub(crate) fn follow_on(
+        &mut self,
+        planning: &PlanningGrid,
+        shortcut_clearance: f64,
+        position: Vector2<f64>,
+        goal: Vector2<f64>,
+    ) {
+        let grid = planning.blocked();
+        let nearest = self
+            .path
+            .cells
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                let d = |c: &Cell| (grid.cell_center(*c) - position).norm_squared();
+                d(a.1).total_cmp(&d(b.1))
+            })
+            .map_or(0, |(k, _)| k);
+        self.path.cells.drain(..nearest);
+        self.path.length = cells_length(&self.path.cells);
+        self.waypoints = waypoints_along(planning, shortcut_clearance, &self.path, goal);
+        self.passed = 0;
+    }
+}
+
+/// The path on `planning` from `position` to `goal` by `planner` with every cell, its length
+/// that of those cells, or `None` when none joins them (see [`Plan::search`]).
+pub(crate) fn dense_path(
+    planning: &PlanningGrid,
+    planner: PlannerKind,
+    position: Vector2<f64>,
+    goal: Vector2<f64>,
+) -> Result<Option<GridPath>, AdapterError> {
+    let grid = planning.blocked();
+    let Some(goal_cell) = grid.cell_at(goal).filter(|&c| !grid.is_blocked(c)) else {
+        return Ok(None);
+    };
+    let Some(start) = grid.cell_at(position).and_then(|c| nearest_free(grid, c)) else {
+        return Ok(None);
+    };
+    let path: Option<GridPath> = match planner {
+        PlannerKind::CellCostAStar => CellCostAStar::new(grid, planning.step_costs())
+            .map_err(|_| AdapterError::invalid("planning costs", f64::NAN, "valid"))?
+            .plan(start, goal_cell),
+        PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
+        PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
+    }
+    .map_err(AdapterError::Planner)?;
+    // The length of the cells walked, not the planner's cost (which counts the clearance cost).
+    Ok(path.map(|p| {
+        let cells = p.expand();
+        GridPath {
+            length: cells_length(&cells),
+            expanded: p.expanded,
+            cells,
+        }
+    }))
+}
+
+/// Waypoints (metres) along the dense `path` to `goal`, after its first cell: the turning
+/// points a straight segment keeping `shortcut_clearance` cannot skip, then the goal.
+fn waypoints_along(
+    planning: &PlanningGrid,
+    shortcut_clearance: f64,
+    path: &GridPath,
+    goal: Vector2<f64>,
+) -> Vec<Vector2<f64>> {
+    let grid = planning.blocked();
+    // Shortcuts only where they keep room to spare; in narrow places the path's cells.
+    let roomy = roomy_grid(planning, shortcut_clearance);
+    let filtered = filter_path(&roomy, path);
+    let mut waypoints: Vec<Vector2<f64>> = filtered
+        .waypoints
+        .iter()
+        .skip(1)
+        .map(|&c| grid.cell_center(c))
+        .collect();
+    // The goal itself, not its cell's centre, ends the path.
+    if let Some(last) = waypoints.last_mut() {
+        *last = goal;
+    } else {
+        waypoints.push(goal);
+    }
+    waypoints
+}
+
+/// The planning grid with every cell closer than `shortcut_clearance` (metres) to an obstacle
+/// blocked too: the grid straight segments between waypoints must keep to.
+fn roomy_grid(planning: &PlanningGrid, shortcut_clearance: f64) -> BitGrid {
+    let grid = planning.blocked();
+    let limit = shortcut_clearance as f32;
+    let clearance = planning.clearance();
+    let mut roomy = grid.clone();
+    let w = grid.width() as usize;
+    for (k, &d) in clearance.iter().enumerate() {
+        if d < limit {
+            let c = Cell::new((k % w) as u32, (k / w) as u32);
+            // The cell exists: k indexes the grid's cells.
+            let _ = roomy.set(c, true);
+        }
+    }
+    roomy
+}
+
+/// Length of a chain of 8-connected cells, in cells.
+fn cells_length(cells: &[Cell]) -> f64 {
+    cells
+        .windows(2)
+        .map(|w| {
+            let diagonal = w[0].x != w[1].x && w[0].y != w[1].y;
+            if diagonal {
+                std::f64::consts::SQRT_2
+            } else {
+                1.0
+            }
+        })
+        .sum()
+}
+
+/// `cell` when free, else the nearest free cell within 1 m at 0.10 m cells (rings of growing
+/// Chebyshev radius, nearest centre first within a ring).
+fn nearest_free(grid: &BitGrid, cell: Cell) -> Option<Cell> {
+    if !grid.is_blocked(cell) {
+        return Some(cell);
+    }
+    let (cx, cy) = (i64::from(cell.x), i64::from(cell.y));
+    for r in 1..=10i64 {
+        let ring = (-r..=r)
+            .flat_map(|dx| (-r..=r).map(move |dy| (dx, dy)))
+            .filter(|&(dx, dy)| dx.abs() == r || dy.abs() == r);
+        let best = ring
+            .filter(|&(dx, dy)| grid.is_free_signed(cx + dx, cy + dy))
+            .min_by_key(|&(dx, dy)| dx * dx + dy * dy);
+        if let Some((dx, dy)) = best {
+            return Some(Cell::new((cx + dx) as u32, (cy + dy) as u32));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_blocked_start_moves_to_the_closest_free_cell_of_the_first_ring_that_has_one() {
+        // A 3-cell-thick wall across the middle; free everywhere else.
+        let grid = BitGrid::from_fn(20, 20, |_, y| (9..12).contains(&y)).unwrap();
+        assert_eq!(nearest_free(&grid, Cell::new(5, 3)), Some(Cell::new(5, 3)));
+        // From the wall's middle row, the nearest free cells are 2 rows away, straight up or down.
+        let found = nearest_free(&grid, Cell::new(5, 10)).unwrap();
+        assert_eq!(found.x, 5);
+        assert!(found.y == 8 || found.y == 12, "{found:?}");
+        // Nothing free within 10 cells: no start.
+        let solid = BitGrid::from_fn(30, 30, |_, _| true).unwrap();
+        assert_eq!(nearest_free(&solid, Cell::new(15, 15)), None);
+    }
+
+    #[test]
+    fn passing_waypoints_keeps_the_last_one() {
+        let mut plan = Plan {
+            waypoints: vec![
+                Vector2::new(0.0, 0.0),
+                Vector2::new(0.01, 0.0),
+                Vector2::new(1.0, 0.0),
+            ],
+            ..Plan::default()
+        };
+        plan.pass(Vector2::zeros(), 0.02);
+        assert_eq!(plan.waypoints(), &[Vector2::new(1.0, 0.0)]);
+        plan.pass(Vector2::new(1.0, 0.0), 0.02);
+        assert_eq!(plan.waypoints(), &[Vector2::new(1.0, 0.0)]);
+        plan.clear_waypoints();
+        assert!(plan.waypoints().is_empty());
+    }
+}
