@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use slam_core::InvalidSetting;
 use thiserror::Error;
 
 /// Errors building, transforming or storing occupancy grids.
@@ -45,15 +46,8 @@ pub enum GridMapError {
         stamp: f64,
     },
     /// A setting or argument is out of its valid range.
-    #[error("{setting} = {value}: must be {expected}")]
-    InvalidConfig {
-        /// The setting, as `Type::field` (or the argument's name).
-        setting: &'static str,
-        /// Its value (integers converted).
-        value: f64,
-        /// The valid range, in words.
-        expected: &'static str,
-    },
+    #[error(transparent)]
+    InvalidConfig(#[from] InvalidSetting),
     /// A local grid's cell list does not match its size.
     #[error("local grid has {cells} cells for {width}x{height}")]
     LocalGridCells {
@@ -124,13 +118,5 @@ pub(crate) fn check(
     value: f64,
     expected: &'static str,
 ) -> Result<(), GridMapError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(GridMapError::InvalidConfig {
-            setting,
-            value,
-            expected,
-        })
-    }
+    Ok(InvalidSetting::check(ok, setting, value, expected)?)
 }

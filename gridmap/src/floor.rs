@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use nalgebra::{Point3, Vector2};
-use slam_core::{PointCloud, Pose3};
+use slam_core::{InvalidSetting, PointCloud, Pose3};
 
 use crate::error::{GridMapError, check};
 
@@ -185,17 +185,17 @@ impl FloorMap {
         if hints.is_empty() {
             return Err(GridMapError::NoFloorHint);
         }
-        if let Some(h) = hints.iter().find(|h| !h.iter().all(|v| v.is_finite())) {
-            let value = h
-                .iter()
-                .copied()
-                .find(|v| !v.is_finite())
-                .unwrap_or(f64::NAN);
-            return Err(GridMapError::InvalidConfig {
+        if let Some(value) = hints
+            .iter()
+            .flat_map(|h| h.iter().copied())
+            .find(|v| !v.is_finite())
+        {
+            let bad = InvalidSetting {
                 setting: "FloorMap::estimate hints",
                 value,
                 expected: "finite",
-            });
+            };
+            return Err(bad.into());
         }
         let (mut lo, mut hi) = (
             Vector2::repeat(f64::INFINITY),

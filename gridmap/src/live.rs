@@ -7,7 +7,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use nalgebra::{Point3, Vector2};
-use slam_core::{BitGrid, Cell, PointCloud, Pose2, Pose3};
+use slam_core::{BitGrid, Cell, InvalidSetting, PointCloud, Pose2, Pose3};
 
 use crate::band::{Height, ObstacleBandConfig, band_at, classify};
 use crate::error::{GridMapError, check};
@@ -439,11 +439,12 @@ impl LiveLayer {
         let t = map_t_sensor.translation.vector;
         let q = map_t_sensor.rotation.coords;
         if let Some(v) = t.iter().chain(q.iter()).copied().find(|v| !v.is_finite()) {
-            return Err(GridMapError::InvalidConfig {
+            return Err(InvalidSetting {
                 setting: "LiveLayer map_t_sensor",
                 value: v,
                 expected: "finite",
-            });
+            }
+            .into());
         }
         let bad = scan
             .points()

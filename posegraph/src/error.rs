@@ -72,33 +72,3 @@ impl std::fmt::Display for UnknownTag {
         write!(f, "{} (line {})", self.tag, self.line)
     }
 }
-
-/// A setting of an optimiser's configuration is out of its range.
-#[derive(Clone, Copy, Debug, PartialEq, Error)]
-#[error("{setting} = {value}: must be {expected}")]
-pub struct InvalidConfig {
-    /// The setting, as its field is named (`GncConfig::mu_step`).
-    pub setting: &'static str,
-    /// The value given (counts as numbers).
-    pub value: f64,
-    /// What it must be.
-    pub expected: &'static str,
-}
-
-/// [`InvalidConfig`] for `setting` unless `ok`.
-pub(crate) fn check(
-    ok: bool,
-    setting: &'static str,
-    value: f64,
-    expected: &'static str,
-) -> Result<(), InvalidConfig> {
-    if ok {
-        Ok(())
-    } else {
-        Err(InvalidConfig {
-            setting,
-            value,
-            expected,
-        })
-    }
-}

@@ -11,12 +11,12 @@
 
 use slam_core::{OptimizationReport, OptimizeError, Optimizer, PoseGraph, StopReason};
 
-use crate::error::{InvalidConfig, check};
 use crate::gnc_loss::{GncLoss, chi2_quantile};
 use crate::linearize::Linearize;
 use crate::loop_support::supported;
 use crate::solver::sealed::Caches;
 use crate::solver::{Cache, SolverConfig, SolverPose, check_finite, chi2, optimize};
+use slam_core::InvalidSetting;
 
 /// Which edges graduated non-convexity takes as inliers without testing them (weight 1 always):
 /// odometry, whose errors are small and which keeps the graph connected.
@@ -110,16 +110,16 @@ impl GncConfig {
     /// Checks every setting (see each field's range).
     ///
     /// # Errors
-    /// [`InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), InvalidConfig> {
+    /// [`InvalidSetting`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         let p = self.inlier_probability;
-        check(
+        InvalidSetting::check(
             p > 0.0 && p < 1.0,
             "GncConfig::inlier_probability",
             p,
             "in (0, 1)",
         )?;
-        check(
+        InvalidSetting::check(
             self.mu_step.is_finite() && self.mu_step > 1.0,
             "GncConfig::mu_step",
             self.mu_step,
@@ -129,10 +129,10 @@ impl GncConfig {
             ("GncConfig::max_outer_iterations", self.max_outer_iterations),
             ("GncConfig::inner_iterations", self.inner_iterations),
         ] {
-            check(v >= 1, setting, v as f64, "at least 1")?;
+            InvalidSetting::check(v >= 1, setting, v as f64, "at least 1")?;
         }
         let t = self.weight_tolerance;
-        check(
+        InvalidSetting::check(
             t > 0.0 && t < 0.5,
             "GncConfig::weight_tolerance",
             t,
@@ -200,8 +200,8 @@ impl GraduatedNonConvexity {
     /// Graduated non-convexity with `config`.
     ///
     /// # Errors
-    /// [`InvalidConfig`] naming the first bad setting of `config`.
-    pub fn try_new(config: GncConfig) -> Result<Self, InvalidConfig> {
+    /// [`InvalidSetting`] naming the first bad setting of `config`.
+    pub fn try_new(config: GncConfig) -> Result<Self, InvalidSetting> {
         config.validate()?;
         Ok(Self {
             config,

@@ -61,7 +61,7 @@ pub mod toro;
 pub mod wrong_loops;
 
 pub use chordal::{ChordalInitialization, initialize_chordal};
-pub use error::{GraphFileError, InvalidConfig, UnknownTag};
+pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use gnc::{GncConfig, GncReport, GraduatedNonConvexity, KnownInliers};
 pub use gnc_loss::GncLoss;

@@ -7,9 +7,9 @@ use slam_core::{
     PoseGraph, RobustKernel, StopReason,
 };
 
-use crate::error::{InvalidConfig, check};
 use crate::linearize::{ErrorModel, Linearize};
 use crate::normal_equations::NormalEquations;
+use slam_core::InvalidSetting;
 
 /// Stopping and damping settings shared by both optimisers.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,9 +40,9 @@ impl SolverConfig {
     /// Checks every setting: at least one iteration, tolerances finite and not negative.
     ///
     /// # Errors
-    /// [`InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), InvalidConfig> {
-        check(
+    /// [`InvalidSetting`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
+        InvalidSetting::check(
             self.max_iterations >= 1,
             "SolverConfig::max_iterations",
             self.max_iterations as f64,
@@ -55,7 +55,7 @@ impl SolverConfig {
             ),
             ("SolverConfig::step_tolerance", self.step_tolerance),
         ] {
-            check(
+            InvalidSetting::check(
                 v.is_finite() && v >= 0.0,
                 setting,
                 v,

@@ -9,7 +9,7 @@ use gridmap::{
     write_ros_map,
 };
 use nalgebra::{Point3, Vector2};
-use slam_core::{PointCloud, Pose3};
+use slam_core::{InvalidSetting, PointCloud, Pose3};
 
 /// The map frame starts at the first LiDAR pose: the floor is 0.80 m below it.
 const FLOOR: f64 = -0.80;
@@ -193,7 +193,9 @@ fn bad_floor_settings_and_input_are_errors() {
     let cloud = PointCloud::from_points(vec![Point3::new(0.0, 0.0, -0.8)]);
     let hint = [Point3::new(0.0, 0.0, -0.8)];
     let invalid = |r: Result<FloorMap, GridMapError>, name: &str| match r {
-        Err(GridMapError::InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+        Err(GridMapError::InvalidConfig(InvalidSetting { setting, .. })) => {
+            assert_eq!(setting, name);
+        }
         other => panic!("{name}: {other:?}"),
     };
     for v in [f64::NAN, 0.0, -1.0, f64::INFINITY] {
@@ -312,7 +314,9 @@ fn bad_band_settings_and_input_are_errors() {
         ),
     ] {
         match builder().build_floor_band(&cloud, &floor, &band) {
-            Err(GridMapError::InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+            Err(GridMapError::InvalidConfig(InvalidSetting { setting, .. })) => {
+                assert_eq!(setting, name);
+            }
             other => panic!("{name}: {other:?}"),
         }
     }

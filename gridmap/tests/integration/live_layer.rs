@@ -9,7 +9,7 @@ use gridmap::{
     PlanningGridConfig,
 };
 use nalgebra::{Point3, Vector2};
-use slam_core::{Cell, PointCloud, Pose3};
+use slam_core::{Cell, InvalidSetting, PointCloud, Pose3};
 
 const FLOOR: f64 = -0.80;
 
@@ -283,7 +283,9 @@ fn bad_settings_are_errors() {
     ];
     for (cfg, name) in cases {
         match LiveLayer::new(map.clone(), cfg) {
-            Err(GridMapError::InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+            Err(GridMapError::InvalidConfig(InvalidSetting { setting, .. })) => {
+                assert_eq!(setting, name);
+            }
             other => panic!("{name}: {:?}", other.err()),
         }
     }
@@ -294,10 +296,10 @@ fn bad_settings_are_errors() {
     };
     assert!(matches!(
         LiveLayer::new(map.clone(), wide).err(),
-        Some(GridMapError::InvalidConfig {
+        Some(GridMapError::InvalidConfig(InvalidSetting {
             setting: "LiveLayerConfig::window",
             ..
-        })
+        }))
     ));
 }
 
@@ -316,10 +318,10 @@ fn bad_input_is_an_error() {
     let pose = Pose3::translation(2.0, 2.0, 0.8);
     assert!(matches!(
         layer.update(&scan, &pose, &floor, f64::NAN),
-        Err(GridMapError::InvalidConfig {
+        Err(GridMapError::InvalidConfig(InvalidSetting {
             setting: "LiveLayer stamp",
             ..
-        })
+        }))
     ));
     layer.update(&scan, &pose, &floor, 1.0).unwrap();
     assert!(matches!(
@@ -329,10 +331,10 @@ fn bad_input_is_an_error() {
     let nan_pose = Pose3::translation(f64::NAN, 2.0, 0.8);
     assert!(matches!(
         layer.update(&scan, &nan_pose, &floor, 2.0),
-        Err(GridMapError::InvalidConfig {
+        Err(GridMapError::InvalidConfig(InvalidSetting {
             setting: "LiveLayer map_t_sensor",
             ..
-        })
+        }))
     ));
     let nan = PointCloud::from_points(vec![Point3::new(f32::NAN, 0.0, 0.3)]);
     assert!(matches!(

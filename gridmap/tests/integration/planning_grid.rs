@@ -10,7 +10,7 @@ use gridmap::{
 };
 use nalgebra::{Point3, Vector2};
 use proptest::prelude::*;
-use slam_core::{Cell, GridGeometry};
+use slam_core::{Cell, GridGeometry, InvalidSetting};
 
 fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
     let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.1).unwrap();
@@ -200,7 +200,9 @@ fn bad_settings_are_errors() {
     ];
     for (cfg, name) in cases {
         match PlanningGrid::new(&occupancy, cfg) {
-            Err(GridMapError::InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+            Err(GridMapError::InvalidConfig(InvalidSetting { setting, .. })) => {
+                assert_eq!(setting, name);
+            }
             other => panic!("{name}: {other:?}"),
         }
     }

@@ -15,12 +15,12 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 use posegraph::g2o::{G2oGraph, read_g2o};
 use posegraph::wrong_loops::{RobustScore, add_wrong_loops, score};
 use posegraph::{
-    GncConfig, GncLoss, GraduatedNonConvexity, InvalidConfig, KnownInliers, LevenbergMarquardt,
-    SolverConfig, SolverPose,
+    GncConfig, GncLoss, GraduatedNonConvexity, KnownInliers, LevenbergMarquardt, SolverConfig,
+    SolverPose,
 };
 use rand_pcg::Pcg64Mcg;
 use rand_pcg::rand_core::{Rng, SeedableRng};
-use slam_core::{Optimizer, Pose2, PoseGraph, RobustKernel, StopReason, se2_exp};
+use slam_core::{InvalidSetting, Optimizer, Pose2, PoseGraph, RobustKernel, StopReason, se2_exp};
 
 fn bundled(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -287,7 +287,7 @@ fn settings_are_validated() {
     ];
     for (config, name) in bad.into_iter().zip(names) {
         match GraduatedNonConvexity::try_new(config) {
-            Err(InvalidConfig { setting, .. }) => assert_eq!(setting, name),
+            Err(InvalidSetting { setting, .. }) => assert_eq!(setting, name),
             Ok(_) => panic!("{name} accepted"),
         }
     }
