@@ -88,7 +88,6 @@ impl LidarLayout {
             (self.highest_elevation_deg - self.lowest_elevation_deg) / f64::from(self.rings - 1);
         let k = ((elevation - self.lowest_elevation_deg) / spacing).round();
         // In range by the check above, so the cast is exact.
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         (k >= 0.0 && k < f64::from(self.rings)).then_some(k as u16)
     }
 }
@@ -108,7 +107,6 @@ mod tests {
     fn rings_from_elevation() {
         let at = |deg: f64| {
             let (s, c) = deg.to_radians().sin_cos();
-            #[allow(clippy::cast_possible_truncation)]
             Point3::new((10.0 * c) as f32, 0.0, (10.0 * s) as f32)
         };
         let l = LidarLayout::VLP16;

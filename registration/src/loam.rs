@@ -136,7 +136,6 @@ impl LoamTarget {
 
 /// Mean and eigen-decomposition of a patch's covariance (eigenvalues ascending).
 fn patch_pca(patch: &[Point3<f64>]) -> (Vector3<f64>, Eigen3) {
-    #[allow(clippy::cast_precision_loss)]
     let n = patch.len() as f64;
     let mean = patch.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n;
     let cov = patch.iter().fold(Matrix3::zeros(), |m, p| {
@@ -535,7 +534,6 @@ fn align_loam(
     if inliers < config.min_correspondences {
         return Err(too_few(inliers));
     }
-    #[allow(clippy::cast_precision_loss)]
     Ok(Alignment {
         pose,
         converged,

@@ -149,7 +149,6 @@ pub(crate) fn voxel_thin(points: Vec<Point3<f64>>, voxel: f32) -> Vec<Point3<f64
         .filter(|p| {
             // 21 bits per axis: voxel indices wrap beyond ±10^6 voxels (±50 km at 5 cm), far
             // outside any local map. Saturating casts keep absurd coordinates finite.
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
             let axis = |v: f64| u64::from(((v * inv).floor() as i32 as u32) & 0x1F_FFFF);
             seen.insert(axis(p.x) | (axis(p.y) << 21) | (axis(p.z) << 42))
         })
@@ -306,7 +305,6 @@ fn roughness(points: &[Point3<f64>], gaps: &[f64], n: usize) -> (Vec<f64>, Vec<f
     if m < 2 * n + 1 {
         return (rough, sharp);
     }
-    #[allow(clippy::cast_precision_loss)]
     let (two_n, half) = ((2 * n) as f64, (n + 1) as f64 / 2.0);
     // Running sums over the window: O(1) per point.
     let mut window: Vector3<f64> = points[..=2 * n].iter().map(|p| p.coords).sum();
@@ -414,9 +412,7 @@ fn extract_ring(points: &[Point3<f64>], config: &LoamFeatureConfig, out: &mut Lo
     // Sector members keyed by roughness (as f32 bits, which order like the non-negative
     // values) above their index: one integer sort per sector.
     let mut order: Vec<u64> = Vec::new();
-    #[allow(clippy::cast_possible_truncation)]
     let key = |i: usize| (u64::from((rough[i] as f32).to_bits()) << 32) | i as u64;
-    #[allow(clippy::cast_possible_truncation)]
     let index = |k: u64| (k & 0xFFFF_FFFF) as usize;
     for s in 0..sectors {
         let lo = first + (end - first) * s / sectors;

@@ -85,7 +85,6 @@ impl Matcher {
                         let sum = nearest.iter().fold(Vector3::zeros(), |m, c| {
                             m + target.points[c.id as usize].coords
                         });
-                        #[allow(clippy::cast_precision_loss)]
                         Point3::from(sum / nearest.len() as f64)
                     };
                     chunk.pairs.push(Pair {

@@ -91,7 +91,6 @@ impl NeighbourCache {
     /// The `k` points of `target` nearest `p` within reach for point `slot`, into `out`
     /// (cleared; in no particular order), and whether they changed since this slot's previous
     /// answer.
-    #[allow(clippy::cast_possible_truncation)]
     pub(crate) fn nearest<T: NearestSearch + ?Sized>(
         &mut self,
         slot: usize,

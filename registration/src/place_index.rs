@@ -305,7 +305,6 @@ impl ScanContextRecognizer {
         };
         keep(self.index.query(here));
         for &(dx, dy) in offsets {
-            #[allow(clippy::cast_possible_truncation)]
             let there = ScanContext::seen_from(scan, &self.descriptor, dx as f32, dy as f32)?;
             keep(self.index.query(&there));
         }

@@ -149,7 +149,6 @@ impl ScanContext {
         let sectors = config.sectors;
         let mut bins = vec![0.0f32; SCAN_CONTEXT_RINGS * sectors];
         // f32 throughout: the points are f32, and bins are metres and degrees wide.
-        #[allow(clippy::cast_possible_truncation)]
         let (min_range, max_range, offset) = (
             config.min_range as f32,
             config.max_range as f32,
@@ -165,10 +164,8 @@ impl ScanContext {
             if !(range2.is_finite() && p.z.is_finite()) || range2 < min2 || range2 >= max2 {
                 continue;
             }
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
             let ring = ((range2.sqrt() * rings_per_metre) as usize).min(SCAN_CONTEXT_RINGS - 1);
             let azimuth = fast_azimuth(px, py);
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
             let sector = ((azimuth * sectors_per_radian) as usize).min(sectors - 1);
             // A point below the offset floor still marks its bin as seen.
             let height = (p.z + offset).max(1e-3);
@@ -356,7 +353,6 @@ mod tests {
             let a = std::f64::consts::TAU * t;
             pts.push(Point3::new(4.0 + 0.3 * a.cos(), 3.0 + 0.3 * a.sin(), 0.8));
         }
-        #[allow(clippy::cast_possible_truncation)]
         let pts = pts
             .into_iter()
             .map(|p| Point3::new(p.x as f32, p.y as f32, p.z as f32))
@@ -505,7 +501,6 @@ mod tests {
                         pairs += 1;
                     }
                 }
-                #[allow(clippy::cast_precision_loss)]
                 (pairs > 0).then(|| sum / pairs as f64)
             })
             .collect()
@@ -519,9 +514,8 @@ mod tests {
             state = state
                 .wrapping_mul(6_364_136_223_846_793_005)
                 .wrapping_add(1_442_695_040_888_963_407);
-            #[allow(clippy::cast_precision_loss)]
-            let u = (state >> 40) as f32 / (1u64 << 24) as f32;
-            u
+
+            (state >> 40) as f32 / (1u64 << 24) as f32
         };
         // Random clutter, some of it in a few sectors only (so that some sectors are empty),
         // and the room, turned and moved.
@@ -561,7 +555,6 @@ mod tests {
                 );
                 // The shift it names is one whose distance is the best, to float precision.
                 let width = std::f64::consts::TAU / a.sectors() as f64;
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
                 let shift = (got.yaw.rem_euclid(std::f64::consts::TAU) / width).round() as usize
                     % a.sectors();
                 let there = by_shift[shift].unwrap();

@@ -170,7 +170,6 @@ fn align_sweep_indexed(
     let (h, _) = normal_equations(config, &pairs, times, &pose, &correction, &mut weights);
     let information = h.fixed_view::<6, 6>(0, 0).into_owned();
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, residual);
-    #[allow(clippy::cast_precision_loss)]
     Ok(SweepAlignment {
         alignment: Alignment {
             pose,

@@ -222,11 +222,6 @@ const SPREAD_SHARE: f64 = 0.9;
 /// the 90 % of them nearest their coordinate-wise median whose standard deviation exceeds both
 /// 1e-6 of the largest one and what f32 storage can resolve at their distance from the origin
 /// (plus 1e-6 m).
-#[allow(
-    clippy::cast_precision_loss,
-    clippy::cast_possible_truncation,
-    clippy::cast_sign_loss
-)]
 fn spread_dimensions(points: &[Point3<f64>]) -> usize {
     if points.is_empty() {
         return 0;
@@ -283,7 +278,6 @@ impl TargetIndex {
                 cause: Degeneracy::DegenerateTarget { dimensions },
             });
         }
-        #[allow(clippy::cast_possible_truncation)]
         let coords: Vec<[f32; 3]> = points
             .iter()
             .map(|p| [p.x as f32, p.y as f32, p.z as f32])
@@ -347,7 +341,6 @@ impl TargetIndex {
 /// The normal of `points[i]` from the PCA of its `k` nearest points in `tree`, unless their
 /// middle eigenvalue is below `min_planarity` times the largest (points along a line, whose
 /// normal could be any direction across it).
-#[allow(clippy::cast_precision_loss)]
 fn pca_normal(
     points: &[Point3<f64>],
     tree: &ImmutableKdTree<f32, 3>,
@@ -356,7 +349,6 @@ fn pca_normal(
     min_planarity: f64,
 ) -> Option<Vector3<f64>> {
     let p = points[i];
-    #[allow(clippy::cast_possible_truncation)]
     let nn = tree
         .query(&[p.x as f32, p.y as f32, p.z as f32])
         .nearest_n::<SquaredEuclidean<f32>>(k)
@@ -379,7 +371,6 @@ fn pca_normal(
 
 impl TargetIndex {
     /// The index of the target point nearest to `q` within `max_distance`.
-    #[allow(clippy::cast_possible_truncation)]
     pub(crate) fn nearest_one(&self, q: &Point3<f64>, max_distance: f64) -> Option<usize> {
         let nn = self
             .tree
@@ -391,7 +382,6 @@ impl TargetIndex {
 }
 
 impl NearestSearch for TargetIndex {
-    #[allow(clippy::cast_possible_truncation)]
     fn nearest_into(&self, q: &Point3<f64>, n: usize, max_distance: f64, out: &mut Vec<Candidate>) {
         out.clear();
         let Some(n) = std::num::NonZero::new(n) else {

@@ -86,7 +86,6 @@ impl std::fmt::Debug for VoxelHashMap {
 
 /// 21 bits per axis: cell indices wrap beyond ±10^6 cells (±250 km at 25 cm). A wrapped key only
 /// shares a cell with far points, which the distance test then rejects.
-#[allow(clippy::cast_sign_loss)]
 fn pack(c: [i32; 3]) -> u64 {
     let axis = |v: i32| u64::from(v as u32 & 0x1F_FFFF);
     axis(c[0]) | (axis(c[1]) << 21) | (axis(c[2]) << 42)
@@ -94,7 +93,6 @@ fn pack(c: [i32; 3]) -> u64 {
 
 /// Integer cell of `v` at `inv` cells per metre; saturating at the ends of `i32`, so absurd
 /// coordinates stay finite (and fall in the end cells, which the distance test sorts out).
-#[allow(clippy::cast_possible_truncation)]
 fn cell_of(v: f64, inv: f64) -> i32 {
     // Truncate, then step down for negatives: `f64::floor` is a library call on baseline x86-64.
     let x = v * inv;
@@ -236,7 +234,6 @@ impl VoxelHashMap {
     /// cells (or thinning voxels) an `i32` numbers (2^31 cells from the origin: 859,000 km at
     /// 0.4 m), are skipped; returns whether `p` was kept (searchable or as a stand-in).
     pub fn insert(&mut self, owner: u32, p: &Point3<f64>) -> bool {
-        #[allow(clippy::cast_possible_truncation)]
         let q = [p.x as f32, p.y as f32, p.z as f32];
         if !self.numbered(q) {
             return false;
@@ -336,7 +333,6 @@ impl VoxelHashMap {
     /// The `k` points nearest `q` within `max_distance`, nearest first, as (squared distance,
     /// point) in `out` (cleared first; fewer than `k` when fewer lie within reach). A query
     /// beyond the numbered cells (see [`VoxelHashMap::insert`]) reads every point.
-    #[allow(clippy::cast_possible_truncation)]
     pub fn nearest_k(
         &self,
         q: &Point3<f64>,
@@ -376,7 +372,6 @@ impl VoxelHashMap {
     }
 
     /// The search behind [`VoxelHashMap::nearest_k`], into a caller's buffer.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss)]
     pub(crate) fn search(
         &self,
         q: &Point3<f64>,

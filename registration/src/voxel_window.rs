@@ -48,7 +48,6 @@ impl VoxelWindow {
         let inv = self.inv;
         // `as` saturates: a point 2^63 voxels out shares the edge voxel, where f32 k-d tree
         // coordinates could not tell it apart anyway.
-        #[allow(clippy::cast_possible_truncation)]
         let voxel = |v: f64| (v * inv).floor() as i64;
         let mut part = Vec::with_capacity(points.len());
         for p in points {

@@ -103,9 +103,8 @@ impl PointCloud {
                         count: 0,
                         ring: ring.map_or(0, |r| r[i]),
                     });
-                    #[allow(clippy::cast_possible_truncation)] // clouds hold fewer than 2^32 points
-                    let slot = (acc.len() - 1) as u32;
-                    slot
+                    // Clouds hold fewer than 2^32 points.
+                    (acc.len() - 1) as u32
                 }),
             };
             last = Some((key, slot));

@@ -18,7 +18,6 @@ fn se2_graph(n: u64, loops: &[(u64, u64)], seed: u64) -> PoseGraph<Pose2> {
     let mut r = crate::common::rng(seed);
     let truth: Vec<Pose2> = (0..n)
         .map(|i| {
-            #[allow(clippy::cast_precision_loss)]
             let x = i as f64;
             Pose2::new([x, 0.5 * (x * 0.7).sin()].into(), 0.3 * x)
         })
@@ -49,7 +48,6 @@ fn se3_graph(n: u64, loops: &[(u64, u64)], seed: u64) -> PoseGraph<Pose3> {
     let mut r = crate::common::rng(seed);
     let truth: Vec<Pose3> = (0..n)
         .map(|i| {
-            #[allow(clippy::cast_precision_loss)]
             let x = i as f64;
             pose3_from_xyz_rpy(x.cos() * 3.0, x.sin() * 3.0, 0.2 * x, 0.05 * x, 0.0, x)
         })

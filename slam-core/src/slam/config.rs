@@ -213,7 +213,6 @@ impl GraphSlamConfig {
     ///
     /// # Errors
     /// [`InvalidSetting`] naming the first bad setting.
-    #[allow(clippy::cast_precision_loss)]
     pub fn validate(&self) -> Result<(), InvalidSetting> {
         for (setting, v) in [
             ("GraphSlamConfig::keyframe_distance", self.keyframe_distance),

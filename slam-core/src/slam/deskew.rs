@@ -48,7 +48,6 @@ pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
                         pose
                     }
                 };
-                #[allow(clippy::cast_possible_truncation)]
                 let q: Point3<f32> = (pose * p.cast::<f64>()).cast::<f32>();
                 *p = q;
             }
@@ -75,7 +74,6 @@ mod tests {
             let world = Point3::new(6.0 * a.cos(), 4.0 * a.sin(), 0.3 * (3.0 * a).sin());
             // The sensor at time t sees the world point in its own frame.
             let pose = se3_exp(&(twist * t));
-            #[allow(clippy::cast_possible_truncation)]
             {
                 seen.push((pose.inverse() * world).cast::<f32>());
                 times.push(t as f32);

@@ -30,7 +30,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if let (Some(mut target), true) = (self.odometry.empty_map(), keyed) {
             for i in first..n {
                 let pose = self.keyframe_pose(i);
-                #[allow(clippy::cast_possible_truncation)]
                 self.odometry
                     .add_to_map(&mut target, i as u32, &self.keyframes[i].source, &pose);
             }
@@ -71,7 +70,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 self.odometry
                     .add_to_map(target, key, &self.keyframes[index].source, &pose);
                 if let Some(old) = index.checked_sub(window) {
-                    #[allow(clippy::cast_possible_truncation)]
                     self.odometry.remove_from_map(target, old as u32);
                 }
             }

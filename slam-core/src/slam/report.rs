@@ -277,11 +277,6 @@ impl SlamReport {
     pub fn scan_ms_quantile(&self, q: f64) -> f64 {
         let mut sorted = self.scan_ms.clone();
         sorted.sort_by(f64::total_cmp);
-        #[allow(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            clippy::cast_precision_loss
-        )]
         let rank = (q.clamp(0.0, 1.0) * sorted.len() as f64) as usize;
         sorted
             .get(rank.min(sorted.len().saturating_sub(1)))
@@ -299,12 +294,10 @@ mod tests {
         let mut times = Vec::new();
         let n = 3 * SlamReport::TIMES_KEPT + 17;
         for i in 0..n {
-            #[allow(clippy::cast_precision_loss)]
             SlamReport::record(&mut times, i as f64);
             assert!(times.len() <= SlamReport::TIMES_KEPT);
         }
         // The kept ones are the latest, in order.
-        #[allow(clippy::cast_precision_loss)]
         let expected: Vec<f64> = (n - times.len()..n).map(|i| i as f64).collect();
         assert_eq!(times, expected);
         assert!(times.len() >= SlamReport::TIMES_KEPT / 2);

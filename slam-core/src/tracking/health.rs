@@ -157,9 +157,7 @@ impl TrackingHealth {
         if all == 0 {
             0.0
         } else {
-            #[allow(clippy::cast_precision_loss)]
-            let ratio = fell as f64 / all as f64;
-            ratio
+            fell as f64 / all as f64
         }
     }
 }

@@ -40,7 +40,6 @@ impl ReachConfig {
     ///
     /// # Errors
     /// [`InvalidSetting`] naming the first bad setting.
-    #[allow(clippy::cast_precision_loss)]
     pub fn validate(&self) -> Result<(), InvalidSetting> {
         for (setting, v) in [
             ("ReachConfig::initial", self.initial),
@@ -132,7 +131,6 @@ impl AdaptiveReach {
         if self.errors.is_empty() {
             return self.config.initial;
         }
-        #[allow(clippy::cast_precision_loss)]
         let rms = (self.sum_of_squares.max(0.0) / self.errors.len() as f64).sqrt();
         (self.config.sigmas * rms).clamp(self.config.min, self.config.max)
     }

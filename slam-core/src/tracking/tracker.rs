@@ -73,7 +73,6 @@ impl TrackerConfig {
     ///
     /// # Errors
     /// [`InvalidSetting`] naming the first bad setting.
-    #[allow(clippy::cast_precision_loss)]
     pub fn validate(&self) -> Result<(), InvalidSetting> {
         self.reach.validate()?;
         for (setting, v) in [
@@ -426,7 +425,6 @@ impl Tracker {
         let step = self.config.retry_turn_step;
         let mut best: Option<Alignment> = None;
         for k in 0..=self.config.retry_turns {
-            #[allow(clippy::cast_precision_loss)]
             let a = k as f64 * step;
             let tries: &[(f64, f64)] = if k == 0 {
                 &[(0.0, widest), (0.0, narrow)]

@@ -10,7 +10,6 @@ pub fn rng(seed: u64) -> impl FnMut() -> f64 {
         s ^= s << 13;
         s ^= s >> 7;
         s ^= s << 17;
-        #[allow(clippy::cast_precision_loss)]
         let v = (s >> 11) as f64 / (1u64 << 53) as f64;
         v - 0.5
     }
