@@ -6,17 +6,16 @@
 //! For example, on the bundled garage scan (sensor frame, so the LiDAR is at height 0):
 //! `cargo run --release --example gridmap -- slam-core/tests/data/hdl32e_garage_1503604882.703390000.pcd --lidar-height 0 --resolution 0.05 --out /tmp/garage`
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Parser;
 use gridmap::{
     OccupancyGridBuilder, OccupancyGridConfig, UnknownCells, inflate, write_png, write_ros_map,
 };
-use slam_core::PointCloud;
-use slam_core::io::{read_kitti_bin, read_pcd, read_ply};
+use slam_core::io::read_cloud;
 use spot_nav_examples::out;
 
 /// Turn a map cloud into an occupancy grid (ROS map and PNG picture).
@@ -58,24 +57,10 @@ fn main() -> ExitCode {
     spot_nav_examples::run(|| grid(&Args::parse()))
 }
 
-fn read_any(path: &Path) -> Result<PointCloud> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    Ok(match ext.as_str() {
-        "pcd" => read_pcd(path)?,
-        "ply" => read_ply(path)?,
-        "bin" => read_kitti_bin(path)?,
-        other => bail!("unknown cloud extension {other:?} (pcd, ply or bin)"),
-    })
-}
-
 fn grid(args: &Args) -> Result<()> {
     let (out, resolution, radius) = (&args.out, args.resolution, args.inflate);
     let mut cloud =
-        read_any(&args.cloud).with_context(|| format!("reading {}", args.cloud.display()))?;
+        read_cloud(&args.cloud).with_context(|| format!("reading {}", args.cloud.display()))?;
     let dropped = cloud.remove_non_finite();
     let t = Instant::now();
     let builder = OccupancyGridBuilder::new(OccupancyGridConfig {
