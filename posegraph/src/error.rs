@@ -67,6 +67,31 @@ pub struct UnknownTag {
     pub tag: String,
 }
 
+/// The tags a graph file uses that its reader does not implement, each once at its first line.
+#[derive(Default)]
+pub(crate) struct UnknownTags(Vec<UnknownTag>);
+
+impl UnknownTags {
+    /// Notes `tag` at `line` unless it was noted before.
+    pub(crate) fn note(&mut self, line: usize, tag: &str) {
+        if !self.0.iter().any(|u| u.tag == tag) {
+            self.0.push(UnknownTag {
+                line,
+                tag: tag.to_string(),
+            });
+        }
+    }
+
+    /// [`GraphFileError::UnknownTags`] when any tag was noted.
+    pub(crate) fn check(self) -> Result<(), GraphFileError> {
+        if self.0.is_empty() {
+            Ok(())
+        } else {
+            Err(GraphFileError::UnknownTags { tags: self.0 })
+        }
+    }
+}
+
 impl std::fmt::Display for UnknownTag {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{} (line {})", self.tag, self.line)

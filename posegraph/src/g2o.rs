@@ -9,7 +9,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Matrix6, Translation3, Vector2};
 use slam_core::{GraphPose, Pose2, Pose3, PoseGraph, quaternion_from_xyzw, quaternion_to_xyzw};
 
-use crate::error::{GraphFileError, UnknownTag};
+use crate::error::{GraphFileError, UnknownTags};
 use crate::information_repair::{InformationRepair, RepairedEdge};
 use crate::se2_text::{Se2Format, se2_text};
 
@@ -83,7 +83,7 @@ pub fn parse_g2o_with(
     let mut g2: Option<PoseGraph<Pose2>> = None;
     let mut g3: Option<PoseGraph<Pose3>> = None;
     let mut fixes: Vec<(usize, u64)> = Vec::new();
-    let mut unknown: Vec<UnknownTag> = Vec::new();
+    let mut unknown = UnknownTags::default();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words: Vec<&str> = raw.split_whitespace().collect();
@@ -175,19 +175,10 @@ pub fn parse_g2o_with(
                     fixes.push((line, id(w, line)?));
                 }
             }
-            other => {
-                if !unknown.iter().any(|u| u.tag == other) {
-                    unknown.push(UnknownTag {
-                        line,
-                        tag: other.to_string(),
-                    });
-                }
-            }
+            other => unknown.note(line, other),
         }
     }
-    if !unknown.is_empty() {
-        return Err(GraphFileError::UnknownTags { tags: unknown });
-    }
+    unknown.check()?;
     let mut out = match (g2, g3) {
         (Some(g), None) => G2oGraph::Se2(g),
         (None, Some(g)) => G2oGraph::Se3(g),

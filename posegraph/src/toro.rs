@@ -6,7 +6,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector2};
 use slam_core::{Pose2, PoseGraph};
 
-use crate::error::{GraphFileError, UnknownTag};
+use crate::error::{GraphFileError, UnknownTags};
 use crate::se2_text::{Se2Format, se2_text};
 
 fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
@@ -22,7 +22,7 @@ fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
 /// [`GraphFileError::Line`], [`GraphFileError::Graph`] or [`GraphFileError::UnknownTags`].
 pub fn parse_toro(text: &str) -> Result<PoseGraph<Pose2>, GraphFileError> {
     let mut g = PoseGraph::new();
-    let mut unknown: Vec<UnknownTag> = Vec::new();
+    let mut unknown = UnknownTags::default();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words: Vec<&str> = raw.split_whitespace().collect();
@@ -71,19 +71,10 @@ pub fn parse_toro(text: &str) -> Result<PoseGraph<Pose2>, GraphFileError> {
                 let info = Matrix3::new(xx, xy, xt, xy, yy, yt, xt, yt, tt);
                 g.add_edge(id[0], id[1], z, info, None).map_err(graph_err)?;
             }
-            other => {
-                if !unknown.iter().any(|u| u.tag == other) {
-                    unknown.push(UnknownTag {
-                        line,
-                        tag: other.to_string(),
-                    });
-                }
-            }
+            other => unknown.note(line, other),
         }
     }
-    if !unknown.is_empty() {
-        return Err(GraphFileError::UnknownTags { tags: unknown });
-    }
+    unknown.check()?;
     Ok(g)
 }
 
