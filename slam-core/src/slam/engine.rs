@@ -45,6 +45,13 @@ pub struct ScanInput<'a> {
     pub gyro_orientation: Option<UnitQuaternion<f64>>,
 }
 
+/// A scan's gyro orientation (`start_R_body`) with the scan's stamp.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct GyroReading {
+    pub(super) stamp: f64,
+    pub(super) orientation: UnitQuaternion<f64>,
+}
+
 /// Graph-SLAM over any [`MapRegistrator`] (odometry and loop refinement), a second one for coarse
 /// loop checks (the thesis uses point-to-point ICP), and any [`Optimizer`].
 ///
@@ -70,8 +77,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Every accepted scan.
     pub(super) scan_poses: Vec<ScanPose>,
     pub(super) last_stamp: f64,
-    /// The gyro orientation of the last scan taken (its stamp and `start_R_body`).
-    pub(super) last_gyro: Option<(f64, UnitQuaternion<f64>)>,
+    /// The gyro orientation of the last scan taken.
+    pub(super) last_gyro: Option<GyroReading>,
     /// The RMS error of the last scan's registration by the tracker (its sweep's own must beat
     /// it, [`GraphSlamConfig::sweep_min_gain`]).
     pub(super) last_fit: Option<f64>,
@@ -191,7 +198,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             self.last_gyro = scan
                 .gyro_orientation
                 .filter(|q| q.coords.iter().all(|v| v.is_finite()))
-                .map(|q| (scan.stamp, q));
+                .map(|orientation| GyroReading {
+                    stamp: scan.stamp,
+                    orientation,
+                });
         }
         outcome
     }

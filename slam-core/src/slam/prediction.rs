@@ -4,7 +4,7 @@
 
 use nalgebra::Vector6;
 
-use super::engine::{GraphSlam, ScanInput};
+use super::engine::{GraphSlam, GyroReading, ScanInput};
 use super::keyframes::ScanPose;
 use super::report::SkipReason;
 use crate::geometry::{Pose3, se3_exp, se3_log};
@@ -147,11 +147,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         predicted: Pose3,
         velocity: Option<Vector6<f64>>,
     ) -> (Pose3, Option<Vector6<f64>>) {
-        let (Some((then, g0)), Some(g1), Some(last)) = (
+        let (
+            Some(GyroReading {
+                stamp: then,
+                orientation: g0,
+            }),
+            Some(g1),
+            Some(last),
+        ) = (
             self.last_gyro,
             scan.gyro_orientation,
             self.scan_poses.last(),
-        ) else {
+        )
+        else {
             return (predicted, velocity);
         };
         let dt = scan.stamp - then;
