@@ -7,7 +7,7 @@ use std::fmt;
 
 use slam_core::io::Scalar;
 
-use crate::error::MessageError;
+use crate::record::MessageError;
 use crate::record::ros_messages::{PointCloud2, PointField};
 
 /// Names a per-point time goes by, tried in this order.
