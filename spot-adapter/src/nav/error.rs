@@ -27,6 +27,10 @@ pub enum NavError {
     /// A planner refused its arguments (a start or goal off the grid or blocked).
     #[error("the planner refused its arguments")]
     Planner(#[source] slam_core::PlanError),
+    /// The cost-aware planner refused the planning grid's per-cell step costs (a count that is
+    /// not one per cell, a multiplier below 1 or not finite, or costs too large).
+    #[error("the planner refused the planning grid's step costs")]
+    PlanningCosts(#[source] pathfind::PathfindError),
 }
 
 /// Why [`drive`](super::drive) stopped early; the robot was sent a stop first.

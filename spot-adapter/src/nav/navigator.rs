@@ -148,7 +148,8 @@ impl<R: Registrator> Navigator<R> {
     /// # Errors
     /// [`NavError::NonFiniteGoal`] for a goal that is not a finite point or heading
     /// (checked before anything else); [`NavError::Planner`] when the planner refuses its
-    /// arguments and [`NavError::NavigationGrid`] when the live layer refuses the scan
+    /// arguments, [`NavError::PlanningCosts`] when the cost-aware planner refuses the grid's
+    /// step costs, and [`NavError::NavigationGrid`] when the live layer refuses the scan
     /// (out-of-order stamps), which the navigator's own checks rule out in normal use.
     pub fn step(
         &mut self,

@@ -144,7 +144,7 @@ pub(crate) fn dense_path(
     };
     let path: Option<GridPath> = match planner {
         PlannerKind::CellCostAStar => CellCostAStar::new(grid, planning.step_costs())
-            .map_err(|_| NavError::invalid("planning costs", f64::NAN, "valid"))?
+            .map_err(NavError::PlanningCosts)?
             .plan(start, goal_cell),
         PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
         PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
