@@ -32,7 +32,7 @@ use crate::record::frame_tree::FrameTree;
 use crate::record::imu::GyroIntegrator;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
 use crate::record::ros_messages::RosMessageType;
-use crate::record::{MessageError, RecordError};
+use crate::record::{BodyFrameSource, MessageError, RecordError};
 
 /// Where the odometry of a bag comes from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -266,14 +266,14 @@ impl Bag {
                 RecordError::UnlinkedLidar {
                     path: path.to_path_buf(),
                     body_from: match (&config.base_frame, &odometry) {
-                        (Some(_), _) => "the base frame given".into(),
+                        (Some(_), _) => BodyFrameSource::Given,
                         (None, ResolvedOdometry::Topic(t)) => {
-                            format!("the child frame of odometry topic {t}")
+                            BodyFrameSource::OdometryTopic(t.clone())
                         }
                         (None, ResolvedOdometry::Tf { odom_frame }) => {
-                            format!("the moving child of {odom_frame:?} in /tf")
+                            BodyFrameSource::TfChild(odom_frame.clone())
                         }
-                        (None, ResolvedOdometry::None) => "the LiDAR frame".into(),
+                        (None, ResolvedOdometry::None) => BodyFrameSource::Lidar,
                     },
                     body_frame: base_frame.clone(),
                     lidar_frame: lidar_frame.clone(),

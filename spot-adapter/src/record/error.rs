@@ -386,9 +386,8 @@ pub enum RecordError {
         path: PathBuf,
         /// The body frame.
         body_frame: String,
-        /// Where the body frame came from ("the child frame of odometry topic /odom", "the base
-        /// frame given").
-        body_from: String,
+        /// Where the body frame came from.
+        body_from: BodyFrameSource,
         /// The LiDAR frame.
         lidar_frame: String,
         /// The frames the bag has (boxed: the error enum stays small).
@@ -431,6 +430,31 @@ fn topic_listing(topics: &[(String, String)]) -> String {
         .map(|(name, kind)| format!("{name} ({kind})"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Where a bag's body frame came from, as [`RecordError::UnlinkedLidar`] says.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BodyFrameSource {
+    /// The base frame given (`BagConfig::base_frame`).
+    Given,
+    /// The child frame of this odometry topic.
+    OdometryTopic(String),
+    /// The moving child of this odometry frame in `/tf`.
+    TfChild(String),
+    /// The LiDAR frame (no odometry).
+    Lidar,
+}
+
+impl std::fmt::Display for BodyFrameSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Given => write!(f, "the base frame given"),
+            Self::OdometryTopic(t) => write!(f, "the child frame of odometry topic {t}"),
+            Self::TfChild(frame) => write!(f, "the moving child of {frame:?} in /tf"),
+            Self::Lidar => write!(f, "the LiDAR frame"),
+        }
+    }
 }
 
 /// What is wrong with a line of a recording's `index.txt` (`index stamp cloud-path`).

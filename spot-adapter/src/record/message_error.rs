@@ -39,12 +39,12 @@ pub enum MessageError {
         expected: &'static str,
     },
     /// A point cloud lacks a coordinate field.
-    #[error("the cloud has no {axis:?} field (fields: {fields})")]
+    #[error("the cloud has no {axis:?} field (fields: {})", .fields.join(","))]
     MissingCoordinate {
         /// `x`, `y` or `z`.
         axis: &'static str,
-        /// The fields it has, comma-separated.
-        fields: String,
+        /// The fields it has.
+        fields: Vec<String>,
     },
     /// A point field has a datatype code outside `sensor_msgs/PointField`'s, or one unfit for
     /// its role (a coordinate that is not a float).

@@ -88,7 +88,7 @@ pub use bag_summary::{BagSummary, ResolvedOdometry};
 pub use bag_topics::TopicSummary;
 pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
-pub use error::{CalibrationProblem, IndexLineProblem, RecordError};
+pub use error::{BodyFrameSource, CalibrationProblem, IndexLineProblem, RecordError};
 pub use frame_tree::{FrameTree, PoseSeries};
 pub use imu::{GyroCounts, GyroIntegrator, GyroStep, MAX_GYRO_GAP};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
