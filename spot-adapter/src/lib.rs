@@ -58,4 +58,6 @@ pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 
-pub use error::{AdapterError, DriveError, MessageError};
+pub use error::AdapterError;
+pub use nav::DriveError;
+pub use record::MessageError;

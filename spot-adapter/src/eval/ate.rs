@@ -6,7 +6,7 @@ use nalgebra::Point3;
 use slam_core::io::StampedPose;
 use slam_core::{Pose3, RigidFitError, fit_rigid_transform};
 
-use crate::error::AdapterError;
+use crate::eval::EvalError;
 
 /// Largest stamp difference (seconds) for two poses to be associated, 0.01 s (evo's default).
 pub const DEFAULT_MAX_STAMP_DIFFERENCE: f64 = 0.01;
@@ -62,13 +62,13 @@ pub fn associate(
 /// alignment (translation errors; stamps associated within `max_dt` seconds).
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] when fewer than 3 poses can be associated,
-/// [`AdapterError::Alignment`] when a pose is not finite.
+/// [`EvalError::TooFewPoses`] when fewer than 3 poses can be associated,
+/// [`EvalError::Alignment`] when a pose is not finite.
 pub fn absolute_trajectory_error(
     estimate: &[StampedPose],
     reference: &[StampedPose],
     max_dt: f64,
-) -> Result<AteReport, AdapterError> {
+) -> Result<AteReport, EvalError> {
     let pairs = associate(estimate, reference, max_dt);
     let est: Vec<Point3<f64>> = pairs
         .iter()
@@ -79,11 +79,11 @@ pub fn absolute_trajectory_error(
         .map(|&(_, j)| Point3::from(reference[j].pose.translation.vector))
         .collect();
     let alignment = fit_rigid_transform(&est, &refs).map_err(|e| match e {
-        RigidFitError::TooFewPairs { pairs, required } => AdapterError::TooFewPoses {
+        RigidFitError::TooFewPairs { pairs, required } => EvalError::TooFewPoses {
             found: pairs,
             required,
         },
-        other => AdapterError::Alignment(other),
+        other => EvalError::Alignment(other),
     })?;
     let mut errors: Vec<f64> = est
         .iter()

@@ -5,7 +5,7 @@
 
 use slam_core::Pose3;
 
-use crate::error::AdapterError;
+use crate::eval::EvalError;
 
 /// KITTI's segment lengths (metres), for outdoor runs of kilometres.
 pub const KITTI_SEGMENT_LENGTHS: [f64; 8] =
@@ -24,9 +24,9 @@ pub fn path_length(poses: &[Pose3]) -> f64 {
 }
 
 /// Associated lists must be of equal length, at least 2.
-pub(crate) fn check_lengths(estimate: &[Pose3], reference: &[Pose3]) -> Result<(), AdapterError> {
+pub(crate) fn check_lengths(estimate: &[Pose3], reference: &[Pose3]) -> Result<(), EvalError> {
     if estimate.len() != reference.len() || estimate.len() < 2 {
-        return Err(AdapterError::TooFewPoses {
+        return Err(EvalError::TooFewPoses {
             found: estimate.len().min(reference.len()),
             required: 2,
         });
@@ -51,11 +51,11 @@ pub struct EndPointDrift {
 /// pose, and their last positions compared.
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2.
+/// [`EvalError::TooFewPoses`] for lists of different lengths or shorter than 2.
 pub fn end_point_drift(
     estimate: &[Pose3],
     reference: &[Pose3],
-) -> Result<EndPointDrift, AdapterError> {
+) -> Result<EndPointDrift, EvalError> {
     check_lengths(estimate, reference)?;
     let n = estimate.len() - 1;
     let e = estimate[0].inverse() * estimate[n];
@@ -103,14 +103,14 @@ pub struct SegmentDrift {
 /// no segment reaches are left out. [`kitti_segment_drift`] is the KITTI devkit's exact rule.
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2, or when no
+/// [`EvalError::TooFewPoses`] for lists of different lengths or shorter than 2, or when no
 /// segment of any length fits.
 pub fn segment_drift(
     estimate: &[Pose3],
     reference: &[Pose3],
     lengths: &[f64],
     step: usize,
-) -> Result<SegmentDrift, AdapterError> {
+) -> Result<SegmentDrift, EvalError> {
     segments(estimate, reference, lengths, step, |d, end| d >= end)
 }
 
@@ -126,7 +126,7 @@ pub fn kitti_segment_drift(
     estimate: &[Pose3],
     reference: &[Pose3],
     lengths: &[f64],
-) -> Result<SegmentDrift, AdapterError> {
+) -> Result<SegmentDrift, EvalError> {
     segments(estimate, reference, lengths, KITTI_STEP, |d, end| d > end)
 }
 
@@ -140,7 +140,7 @@ fn segments(
     lengths: &[f64],
     step: usize,
     ends: impl Fn(f64, f64) -> bool,
-) -> Result<SegmentDrift, AdapterError> {
+) -> Result<SegmentDrift, EvalError> {
     check_lengths(estimate, reference)?;
     let mut dist = vec![0.0];
     for w in reference.windows(2) {
@@ -171,7 +171,7 @@ fn segments(
         }
     }
     if count == 0 {
-        return Err(AdapterError::TooFewPoses {
+        return Err(EvalError::TooFewPoses {
             found: reference.len(),
             required: 2,
         });
@@ -192,8 +192,8 @@ fn segments(
 /// needs a reference whose z is up (REP-103).
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2.
-pub fn height_drift(estimate: &[Pose3], reference: &[Pose3]) -> Result<f64, AdapterError> {
+/// [`EvalError::TooFewPoses`] for lists of different lengths or shorter than 2.
+pub fn height_drift(estimate: &[Pose3], reference: &[Pose3]) -> Result<f64, EvalError> {
     check_lengths(estimate, reference)?;
     let n = estimate.len() - 1;
     let end = reference[0] * estimate[0].inverse() * estimate[n];

@@ -5,7 +5,7 @@
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::error::AdapterError;
+use crate::eval::EvalError;
 use crate::eval::ate::{
     AteReport, DEFAULT_MAX_STAMP_DIFFERENCE, absolute_trajectory_error, associate,
 };
@@ -63,13 +63,13 @@ impl TrajectoryEvaluation {
     /// their world frames, the drifts compare motion relative to each one's first pose.
     ///
     /// # Errors
-    /// [`AdapterError::TooFewPoses`] when fewer than 3 poses can be associated.
+    /// [`EvalError::TooFewPoses`] when fewer than 3 poses can be associated.
     pub fn compute(
         estimate: &[StampedPose],
         reference: &[StampedPose],
         max_dt: f64,
         segment_lengths: &[f64],
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, EvalError> {
         let ate = absolute_trajectory_error(estimate, reference, max_dt)?;
         let pairs = associate(estimate, reference, max_dt);
         let est: Vec<Pose3> = pairs.iter().map(|&(i, _)| estimate[i].pose).collect();
@@ -120,7 +120,7 @@ impl TrajectoryEvaluation {
         lidar_trajectory: Vec<StampedPose>,
         body_t_lidar: &Pose3,
         truth: &[StampedPose],
-    ) -> Result<(Self, Vec<StampedPose>), AdapterError> {
+    ) -> Result<(Self, Vec<StampedPose>), EvalError> {
         let estimate = body_trajectory(lidar_trajectory, body_t_lidar);
         let e = Self::compute(
             &estimate,

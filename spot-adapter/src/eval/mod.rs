@@ -9,6 +9,7 @@
 
 mod ate;
 mod drift;
+mod error;
 mod evaluation;
 mod relative;
 
@@ -18,5 +19,6 @@ pub use drift::{
     end_point_drift, height_drift, kitti_segment_drift, loop_end_point_error, path_length,
     segment_drift,
 };
+pub use error::EvalError;
 pub use evaluation::{TrajectoryEvaluation, body_trajectory};
 pub use relative::{KittiRpe, kitti_rpe, step_rotation_errors};

@@ -4,7 +4,7 @@
 
 use slam_core::Pose3;
 
-use crate::error::AdapterError;
+use crate::eval::EvalError;
 use crate::eval::drift::{KITTI_SEGMENT_LENGTHS, check_lengths, kitti_segment_drift, path_length};
 
 /// KITTI's relative pose error: the devkit's mean translation error over segment length.
@@ -69,11 +69,11 @@ pub fn kitti_rpe(estimate: &[Pose3], reference: &[Pose3]) -> Option<KittiRpe> {
 /// tracker turned the wrong way: where it was lost.
 ///
 /// # Errors
-/// [`AdapterError::TooFewPoses`] for lists of different lengths or shorter than 2.
+/// [`EvalError::TooFewPoses`] for lists of different lengths or shorter than 2.
 pub fn step_rotation_errors(
     estimate: &[Pose3],
     reference: &[Pose3],
-) -> Result<Vec<f64>, AdapterError> {
+) -> Result<Vec<f64>, EvalError> {
     check_lengths(estimate, reference)?;
     Ok(estimate
         .windows(2)

@@ -4,7 +4,7 @@ use gridmap::{
     FloorConfig, LiveLayerConfig, ObstacleBandConfig, OccupancyGridConfig, PlanningGridConfig,
 };
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::nav::localiser::LocaliserConfig;
 use crate::nav::stuck::StuckConfig;
 
@@ -105,9 +105,9 @@ impl NavigatorConfig {
     /// and the stuck monitor's settings valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting, or
-    /// [`AdapterError::NavigationGrid`] with gridmap's error for a bad grid setting.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    /// [`NavError::InvalidConfig`] naming the first bad setting, or
+    /// [`NavError::NavigationGrid`] with gridmap's error for a bad grid setting.
+    pub fn validate(&self) -> Result<(), NavError> {
         for (setting, value) in [
             ("goal_tolerance", self.goal_tolerance),
             ("heading_tolerance", self.heading_tolerance),
@@ -122,17 +122,15 @@ impl NavigatorConfig {
             ("detour_extra", self.detour_extra),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(AdapterError::invalid(setting, value, "finite and positive"));
+                return Err(NavError::invalid(setting, value, "finite and positive"));
             }
         }
         if self.replan_every == 0 {
-            return Err(AdapterError::invalid("replan_every", 0.0, "at least 1"));
+            return Err(NavError::invalid("replan_every", 0.0, "at least 1"));
         }
         validate_floor_band(&self.floor, &self.band)?;
-        self.planning
-            .validate()
-            .map_err(AdapterError::NavigationGrid)?;
-        self.live.validate().map_err(AdapterError::NavigationGrid)?;
+        self.planning.validate().map_err(NavError::NavigationGrid)?;
+        self.live.validate().map_err(NavError::NavigationGrid)?;
         self.localiser.validate()?;
         self.stuck.validate()
     }
@@ -182,13 +180,13 @@ impl NavigationMapConfig {
     /// The floor's and the band's settings valid (the grid's are checked when it is built).
     ///
     /// # Errors
-    /// [`AdapterError::NavigationGrid`] with gridmap's error for a bad setting.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    /// [`NavError::NavigationGrid`] with gridmap's error for a bad setting.
+    pub fn validate(&self) -> Result<(), NavError> {
         validate_floor_band(&self.floor, &self.band)
     }
 }
 
-fn validate_floor_band(floor: &FloorConfig, band: &ObstacleBandConfig) -> Result<(), AdapterError> {
-    floor.validate().map_err(AdapterError::NavigationGrid)?;
-    band.validate().map_err(AdapterError::NavigationGrid)
+fn validate_floor_band(floor: &FloorConfig, band: &ObstacleBandConfig) -> Result<(), NavError> {
+    floor.validate().map_err(NavError::NavigationGrid)?;
+    band.validate().map_err(NavError::NavigationGrid)
 }

@@ -6,7 +6,7 @@ use gridmap::PlanningGrid;
 use nalgebra::Vector2;
 use slam_core::{BitGrid, Cell};
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::nav::config::{NavigatorConfig, PlannerKind};
 use crate::nav::path::{Plan, dense_path};
 
@@ -125,7 +125,7 @@ impl DetourPolicy {
         position: Vector2<f64>,
         target: Vector2<f64>,
         plan: Option<&Plan>,
-    ) -> Result<Option<Wait>, AdapterError> {
+    ) -> Result<Option<Wait>, NavError> {
         if self.waited_out_for == Some(target) && plan.is_some() {
             return Ok(None);
         }
@@ -146,7 +146,7 @@ impl DetourPolicy {
         position: Vector2<f64>,
         goal: Vector2<f64>,
         live_length: Option<f64>,
-    ) -> Result<Option<Wait>, AdapterError> {
+    ) -> Result<Option<Wait>, NavError> {
         let resolution = live.blocked().geometry().resolution;
         let extra = self.extra;
         // No path can be shorter than the straight line: most plans need no second search.

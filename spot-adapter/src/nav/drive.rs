@@ -4,7 +4,7 @@
 
 use slam_core::{Pose3, Registrator};
 
-use crate::error::DriveError;
+use crate::nav::DriveError;
 use crate::nav::navigator::{Goal, NavigationStep, Navigator};
 use crate::robot::{MobilityCommand, Robot, Sample};
 

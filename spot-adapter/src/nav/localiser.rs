@@ -8,7 +8,7 @@ use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use slam_core::tracking::{ReachConfig, Tracker, TrackerConfig, scan_extent};
 use slam_core::{Pose3, Registrator};
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::robot::Sample;
 
 /// Settings of the localiser. Lengths in metres, angles in radians.
@@ -111,8 +111,8 @@ impl LocaliserConfig {
     /// walking voxel 0 (off) or 1 cm to 10 m, the full-scan distance finite and not negative.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    /// [`NavError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), NavError> {
         for (setting, value) in [
             ("max_correction", self.max_correction),
             ("max_correction_angle", self.max_correction_angle),
@@ -124,19 +124,19 @@ impl LocaliserConfig {
             ("search_angle_step", self.search_angle_step),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(AdapterError::invalid(setting, value, "finite and positive"));
+                return Err(NavError::invalid(setting, value, "finite and positive"));
             }
         }
         let voxel = self.walking_scan_voxel;
         if !(voxel == 0.0 || (0.01..=10.0).contains(&voxel)) {
-            return Err(AdapterError::invalid(
+            return Err(NavError::invalid(
                 "walking_scan_voxel",
                 voxel,
                 "0 (off) or from 0.01 to 10",
             ));
         }
         if !(self.full_scan_within.is_finite() && self.full_scan_within >= 0.0) {
-            return Err(AdapterError::invalid(
+            return Err(NavError::invalid(
                 "full_scan_within",
                 self.full_scan_within,
                 "finite and not negative",
@@ -144,29 +144,27 @@ impl LocaliserConfig {
         }
         let ratio = self.relocalise_min_inlier_ratio;
         if !(ratio > 0.0 && ratio <= 1.0) {
-            return Err(AdapterError::invalid(
+            return Err(NavError::invalid(
                 "relocalise_min_inlier_ratio",
                 ratio,
                 "within (0, 1]",
             ));
         }
-        if let Err(e) = self.tracker.validate() {
-            return Err(AdapterError::invalid(e.setting, e.value, e.expected));
-        }
+        self.tracker.validate()?;
         for (setting, value) in [
             ("confirm_after", self.confirm_after),
             ("lost_after", self.lost_after),
             ("max_searches", self.max_searches),
         ] {
             if value == 0 {
-                return Err(AdapterError::invalid(setting, 0.0, "at least 1"));
+                return Err(NavError::invalid(setting, 0.0, "at least 1"));
             }
         }
         // The search's seed count grows with the square of radius / step: keep it bounded.
         let per_axis = (2.0 * self.search_radius / self.search_step).floor() + 1.0;
         let headings = (2.0 * self.search_angle / self.search_angle_step).floor() + 1.0;
         if per_axis * per_axis * headings > 2000.0 {
-            return Err(AdapterError::invalid(
+            return Err(NavError::invalid(
                 "search_step",
                 self.search_step,
                 "large enough for at most 2000 seeds",
@@ -249,15 +247,14 @@ pub(crate) struct Localiser<R: Registrator> {
 
 impl<R: Registrator> Localiser<R> {
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for bad tracker settings.
+    /// [`NavError::InvalidConfig`] for bad tracker settings.
     pub(crate) fn new(
         registrator: R,
         map: R::Target,
         map_t_body: Pose3,
         config: LocaliserConfig,
-    ) -> Result<Self, AdapterError> {
-        let tracker = Tracker::new(config.tracker)
-            .map_err(|e| AdapterError::invalid(e.setting, e.value, e.expected))?;
+    ) -> Result<Self, NavError> {
+        let tracker = Tracker::new(config.tracker)?;
         Ok(Self {
             config,
             registrator,

@@ -9,6 +9,7 @@ mod config;
 mod controller;
 mod detour;
 mod drive;
+mod error;
 mod localiser;
 mod navigation_map;
 mod navigator;
@@ -18,6 +19,7 @@ mod unseen;
 
 pub use config::{NavigationMapConfig, NavigatorConfig, PlannerKind};
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
+pub use error::{DriveError, NavError};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
 pub use navigation_map::NavigationMap;
 pub use navigator::{Goal, NavigationStep, Navigator};

@@ -5,7 +5,7 @@
 use gridmap::{FloorMap, OccupancyGrid, OccupancyGridBuilder, floor_hints_below};
 use slam_core::{PointCloud, Pose3};
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::nav::config::NavigationMapConfig;
 
 /// The static layer of navigation: occupancy (obstacles from the floor up, free where beams
@@ -23,21 +23,21 @@ impl NavigationMap {
     /// the cells the beams crossed; cells no beam reached are unknown.
     ///
     /// # Errors
-    /// [`AdapterError::NavigationGrid`] (with gridmap's error as its source) for invalid settings
+    /// [`NavError::NavigationGrid`] (with gridmap's error as its source) for invalid settings
     /// or when the grid cannot be built.
     pub fn from_scans(
         scans: &[(Pose3, &PointCloud)],
         lidar_height: f64,
         config: &NavigationMapConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, NavError> {
         config.validate()?;
         let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
         let hints = floor_hints_below(&poses, lidar_height);
         let floor = FloorMap::estimate_from_scans(scans, &hints, &config.floor)
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         let occupancy = OccupancyGridBuilder::new(config.grid.clone())
             .and_then(|b| b.build_floor_band_from_scans(scans, &floor, &config.band))
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         Ok(Self { occupancy, floor })
     }
 
@@ -52,14 +52,14 @@ impl NavigationMap {
         sensor_poses: &[Pose3],
         lidar_height: f64,
         config: &NavigationMapConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, NavError> {
         config.validate()?;
         let hints = floor_hints_below(sensor_poses, lidar_height);
         let floor =
-            FloorMap::estimate(map, &hints, &config.floor).map_err(AdapterError::NavigationGrid)?;
+            FloorMap::estimate(map, &hints, &config.floor).map_err(NavError::NavigationGrid)?;
         let occupancy = OccupancyGridBuilder::new(config.grid.clone())
             .and_then(|b| b.build_floor_band(map, &floor, &config.band))
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         Ok(Self { occupancy, floor })
     }
 

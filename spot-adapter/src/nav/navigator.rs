@@ -6,7 +6,7 @@ use gridmap::{CellRect, CellState, LiveLayer, PlanningGrid};
 use nalgebra::Vector2;
 use slam_core::{BitGrid, Cell, PointCloud, Pose3, Registrator, wrap_angle};
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::nav::config::NavigatorConfig;
 use crate::nav::controller::Controller;
 use crate::nav::detour::{DetourPolicy, Wait};
@@ -102,9 +102,9 @@ impl<R: Registrator> Navigator<R> {
     /// commands keep to the robot's motion limits.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid settings or limits,
-    /// [`AdapterError::NavigationGrid`] for grid settings gridmap refuses,
-    /// [`AdapterError::LocalisationMap`] (with the registrator's error as its source) for a
+    /// [`NavError::InvalidConfig`] for invalid settings or limits,
+    /// [`NavError::NavigationGrid`] for grid settings gridmap refuses,
+    /// [`NavError::LocalisationMap`] (with the registrator's error as its source) for a
     /// map the registrator refuses.
     pub fn new(
         registrator: R,
@@ -113,16 +113,16 @@ impl<R: Registrator> Navigator<R> {
         map_t_body: Pose3,
         robot: &RobotDescription,
         config: NavigatorConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, NavError> {
         config.validate()?;
         robot.limits.validate()?;
         let target = registrator
             .prepare_target(map)
-            .map_err(AdapterError::LocalisationMap)?;
+            .map_err(NavError::LocalisationMap)?;
         let live = LiveLayer::new(navigation.occupancy().clone(), config.live.clone())
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         let planning = PlanningGrid::new(live.combined(), config.planning.clone())
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         let static_planning = planning.clone();
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone())?,
@@ -146,22 +146,23 @@ impl<R: Registrator> Navigator<R> {
     /// or a [`Goal`] with a final heading).
     ///
     /// # Errors
-    /// [`AdapterError::NonFiniteGoal`] for a goal that is not a finite point or heading
-    /// (checked before anything else); [`AdapterError::Planner`] when the planner refuses its
-    /// arguments and [`AdapterError::NavigationGrid`] when the live layer refuses the scan
+    /// [`NavError::NonFiniteGoal`] for a goal that is not a finite point or heading
+    /// (checked before anything else); [`NavError::Planner`] when the planner refuses its
+    /// arguments, [`NavError::PlanningCosts`] when the cost-aware planner refuses the grid's
+    /// step costs, and [`NavError::NavigationGrid`] when the live layer refuses the scan
     /// (out-of-order stamps), which the navigator's own checks rule out in normal use.
     pub fn step(
         &mut self,
         sample: &Sample,
         goal: impl Into<Goal>,
-    ) -> Result<NavigationStep, AdapterError> {
+    ) -> Result<NavigationStep, NavError> {
         let goal = goal.into();
         let target = goal.position;
         if !(target.x.is_finite()
             && target.y.is_finite()
             && goal.heading.is_none_or(f64::is_finite))
         {
-            return Err(AdapterError::NonFiniteGoal {
+            return Err(NavError::NonFiniteGoal {
                 x: target.x,
                 y: target.y,
             });
@@ -260,7 +261,7 @@ impl<R: Registrator> Navigator<R> {
         position: Vector2<f64>,
         target: Vector2<f64>,
         fused_at: Option<f64>,
-    ) -> Result<Option<NavigationStep>, AdapterError> {
+    ) -> Result<Option<NavigationStep>, NavError> {
         self.cycles_since_plan += 1;
         let path = &self.plan.path().cells;
         let blocked = self.plan.has_path() && self.planning.blocks_any(path);
@@ -330,11 +331,7 @@ impl<R: Registrator> Navigator<R> {
     }
 
     /// A plan from `position` to `goal` on the live planning grid (see [`Plan::search`]).
-    fn search(
-        &self,
-        position: Vector2<f64>,
-        goal: Vector2<f64>,
-    ) -> Result<Option<Plan>, AdapterError> {
+    fn search(&self, position: Vector2<f64>, goal: Vector2<f64>) -> Result<Option<Plan>, NavError> {
         let c = &self.config;
         Plan::search(
             &self.planning,
@@ -352,7 +349,7 @@ impl<R: Registrator> Navigator<R> {
         position: Vector2<f64>,
         target: Vector2<f64>,
         plan: Option<&Plan>,
-    ) -> Result<Option<Wait>, AdapterError> {
+    ) -> Result<Option<Wait>, NavError> {
         self.detour.waiting_for(
             &self.planning,
             &self.static_planning,
@@ -365,34 +362,34 @@ impl<R: Registrator> Navigator<R> {
 
     /// Return `cells` to the static map's state in the live layer (at `stamp`, seconds) and
     /// refresh the planning grid there.
-    fn forget(&mut self, cells: &[Cell], stamp: f64) -> Result<(), AdapterError> {
+    fn forget(&mut self, cells: &[Cell], stamp: f64) -> Result<(), NavError> {
         self.mark(cells, stamp, |live, c| live.static_map().state(c))
     }
 
     /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
     /// where it changed.
-    fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), AdapterError> {
+    fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), NavError> {
         let map_t_lidar = pose * sample.body_t_lidar;
         let update = self
             .live
             .update(&sample.cloud, &map_t_lidar, self.map.floor(), sample.stamp)
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         if let Some(changed) = update.changed {
             self.refresh(changed)?;
         }
         Ok(())
     }
 
-    fn refresh(&mut self, changed: CellRect) -> Result<(), AdapterError> {
+    fn refresh(&mut self, changed: CellRect) -> Result<(), NavError> {
         self.planning
             .refresh(self.live.combined(), changed)
-            .map_err(AdapterError::NavigationGrid)?;
+            .map_err(NavError::NavigationGrid)?;
         Ok(())
     }
 
     /// Mark the cells just ahead of the body (0.3-0.6 m ahead, 0.5 m wide) as occupied in the
     /// live layer: what the robot could not walk through.
-    fn mark_ahead(&mut self, pose: &Pose3, stamp: f64) -> Result<(), AdapterError> {
+    fn mark_ahead(&mut self, pose: &Pose3, stamp: f64) -> Result<(), NavError> {
         let yaw = pose.rotation.euler_angles().2;
         let (ahead, left) = (
             Vector2::new(yaw.cos(), yaw.sin()),
@@ -418,7 +415,7 @@ impl<R: Registrator> Navigator<R> {
         cells: &[Cell],
         stamp: f64,
         state: impl Fn(&LiveLayer, Cell) -> CellState,
-    ) -> Result<(), AdapterError> {
+    ) -> Result<(), NavError> {
         let mut changed = CellRect {
             x0: 0,
             y0: 0,
@@ -429,7 +426,7 @@ impl<R: Registrator> Navigator<R> {
             let update = self
                 .live
                 .mark(c, state(&self.live, c), stamp)
-                .map_err(AdapterError::NavigationGrid)?;
+                .map_err(NavError::NavigationGrid)?;
             if let Some(r) = update.changed {
                 changed = changed.union(&r);
             }

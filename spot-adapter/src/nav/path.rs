@@ -6,7 +6,7 @@ use nalgebra::Vector2;
 use pathfind::{AStar, CellCostAStar, JumpPointSearch, filter_path};
 use slam_core::{BitGrid, Cell, GridPath, Planner};
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::nav::config::PlannerKind;
 
 /// A path to the goal and the waypoints along it, kept together from the plan to the goal: the
@@ -48,7 +48,7 @@ impl Plan {
         shortcut_clearance: f64,
         position: Vector2<f64>,
         goal: Vector2<f64>,
-    ) -> Result<Option<Self>, AdapterError> {
+    ) -> Result<Option<Self>, NavError> {
         let Some(path) = dense_path(planning, planner, position, goal)? else {
             return Ok(None);
         };
@@ -134,7 +134,7 @@ pub(crate) fn dense_path(
     planner: PlannerKind,
     position: Vector2<f64>,
     goal: Vector2<f64>,
-) -> Result<Option<GridPath>, AdapterError> {
+) -> Result<Option<GridPath>, NavError> {
     let grid = planning.blocked();
     let Some(goal_cell) = grid.cell_at(goal).filter(|&c| !grid.is_blocked(c)) else {
         return Ok(None);
@@ -144,12 +144,12 @@ pub(crate) fn dense_path(
     };
     let path: Option<GridPath> = match planner {
         PlannerKind::CellCostAStar => CellCostAStar::new(grid, planning.step_costs())
-            .map_err(|_| AdapterError::invalid("planning costs", f64::NAN, "valid"))?
+            .map_err(NavError::PlanningCosts)?
             .plan(start, goal_cell),
         PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
         PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
     }
-    .map_err(AdapterError::Planner)?;
+    .map_err(NavError::Planner)?;
     // The length of the cells walked, not the planner's cost (which counts the clearance cost).
     Ok(path.map(|p| {
         let cells = p.expand();

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 
 use nalgebra::Vector2;
 
-use crate::error::AdapterError;
+use crate::nav::NavError;
 use crate::robot::VelocityCommand;
 
 /// Settings of the stuck monitor. Lengths in metres, speeds in m/s.
@@ -40,14 +40,14 @@ impl StuckConfig {
     /// Positive lengths and speeds, counts of at least 1.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    /// [`NavError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), NavError> {
         for (setting, value) in [
             ("stuck.min_progress", self.min_progress),
             ("stuck.backoff_speed", self.backoff_speed),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(AdapterError::invalid(setting, value, "finite and positive"));
+                return Err(NavError::invalid(setting, value, "finite and positive"));
             }
         }
         for (setting, value) in [
@@ -56,7 +56,7 @@ impl StuckConfig {
             ("stuck.max_attempts", self.max_attempts),
         ] {
             if value == 0 {
-                return Err(AdapterError::invalid(setting, 0.0, "at least 1"));
+                return Err(NavError::invalid(setting, 0.0, "at least 1"));
             }
         }
         Ok(())

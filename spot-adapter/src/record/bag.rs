@@ -21,7 +21,6 @@ use std::path::Path;
 use nalgebra::UnitQuaternion;
 use slam_core::Pose3;
 
-use crate::error::{AdapterError, MessageError};
 use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
 use crate::record::bag_file::{BagFormat, BagMessages};
 use crate::record::bag_frames::BagFrames;
@@ -33,6 +32,7 @@ use crate::record::frame_tree::FrameTree;
 use crate::record::imu::GyroIntegrator;
 use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Decoder, TimeUnit};
 use crate::record::ros_messages::RosMessageType;
+use crate::record::{BodyFrameSource, MessageError, RecordError};
 
 /// Where the odometry of a bag comes from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -83,13 +83,6 @@ pub struct Bag {
     span: (f64, f64),
     /// The decoder with the time unit decided on the first cloud.
     decoder: PointCloud2Decoder,
-}
-
-fn bad(path: &Path, message: String) -> AdapterError {
-    AdapterError::Recording {
-        path: path.to_path_buf(),
-        message,
-    }
 }
 
 /// The topics of type `kind`.
@@ -157,20 +150,25 @@ impl Bag {
     /// Open the bag at `path` (`.mcap` or `.bag`) and check it in one streaming pass.
     ///
     /// # Errors
-    /// [`AdapterError::Io`], [`AdapterError::Mcap`], [`AdapterError::McapLength`],
-    /// [`AdapterError::Ros1Bag`] or [`AdapterError::Recording`] for a file that cannot be read
-    /// (truncated, not a bag); [`AdapterError::Message`] for a message that cannot be decoded, a cloud topic of another
-    /// type, a missing transform; [`AdapterError::Recording`] when the topics asked for are
-    /// absent or the choice is ambiguous.
-    pub fn open(path: impl AsRef<Path>, config: &BagConfig) -> Result<Self, AdapterError> {
+    /// [`RecordError::Io`], [`RecordError::Mcap`], [`RecordError::McapLength`],
+    /// [`RecordError::Ros1Bag`], [`RecordError::NotABag`], [`RecordError::NotRos1Bag`],
+    /// [`RecordError::Ros1Header`], [`RecordError::Unindexed`] or
+    /// [`RecordError::UnknownConnection`] for a file that cannot be read (truncated, not a
+    /// bag); [`RecordError::Message`] for a message that cannot be decoded, a cloud topic of
+    /// another type, a missing transform; [`RecordError::NoTopic`],
+    /// [`RecordError::NoCloudTopic`], [`RecordError::EmptyTopic`],
+    /// [`RecordError::SeveralCloudTopics`] or [`RecordError::AmbiguousBodyFrame`] when the
+    /// topics asked for are absent or the choice is ambiguous.
+    pub fn open(path: impl AsRef<Path>, config: &BagConfig) -> Result<Self, RecordError> {
         let path = path.as_ref();
-        let format = BagFormat::from_path(path)
-            .ok_or_else(|| bad(path, "a bag must end in .mcap or .bag".into()))?;
+        let format = BagFormat::from_path(path).ok_or_else(|| RecordError::NotABag {
+            path: path.to_path_buf(),
+        })?;
         let survey = Self::survey(path, format)?;
         Self::resolve(path, format, survey, config)
     }
 
-    fn survey(path: &Path, format: BagFormat) -> Result<Survey, AdapterError> {
+    fn survey(path: &Path, format: BagFormat) -> Result<Survey, RecordError> {
         let mut s = Survey::default();
         for msg in BagMessages::open(path, format)? {
             let msg = msg?;
@@ -249,7 +247,7 @@ impl Bag {
         format: BagFormat,
         mut s: Survey,
         config: &BagConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, RecordError> {
         let cloud_topic = Self::cloud_topic(path, &s, config)?;
         let (stamps, cloud_frame) = s.clouds.remove(&cloud_topic).unwrap_or_default();
         let lidar_frame = config.lidar_frame.clone().unwrap_or(cloud_frame);
@@ -265,17 +263,17 @@ impl Bag {
             Self::body_frame(path, &s, config, &tree, &odometry, &stamps, &lidar_frame)?;
         let body_t_lidar =
             Self::mounting(&s.fixed, &base_frame, &lidar_frame).ok_or_else(|| {
-                AdapterError::UnlinkedLidar {
+                RecordError::UnlinkedLidar {
                     path: path.to_path_buf(),
                     body_from: match (&config.base_frame, &odometry) {
-                        (Some(_), _) => "the base frame given".into(),
+                        (Some(_), _) => BodyFrameSource::Given,
                         (None, ResolvedOdometry::Topic(t)) => {
-                            format!("the child frame of odometry topic {t}")
+                            BodyFrameSource::OdometryTopic(t.clone())
                         }
                         (None, ResolvedOdometry::Tf { odom_frame }) => {
-                            format!("the moving child of {odom_frame:?} in /tf")
+                            BodyFrameSource::TfChild(odom_frame.clone())
                         }
-                        (None, ResolvedOdometry::None) => "the LiDAR frame".into(),
+                        (None, ResolvedOdometry::None) => BodyFrameSource::Lidar,
                     },
                     body_frame: base_frame.clone(),
                     lidar_frame: lidar_frame.clone(),
@@ -340,7 +338,7 @@ impl Bag {
         odometry: &ResolvedOdometry,
         stamps: &[f64],
         lidar_frame: &str,
-    ) -> Result<(String, (f64, f64)), AdapterError> {
+    ) -> Result<(String, (f64, f64)), RecordError> {
         Ok(match odometry {
             ResolvedOdometry::Topic(t) => {
                 let (first, last, _, child) = s.odometry.get(t).cloned().unwrap_or_default();
@@ -352,14 +350,11 @@ impl Bag {
                     None => match s.moving.moving_children(odom_frame).as_slice() {
                         [one] => (*one).to_owned(),
                         other => {
-                            return Err(bad(
-                                path,
-                                format!(
-                                    "/tf has {} moving children of {odom_frame:?} ({}): give the body frame",
-                                    other.len(),
-                                    other.join(", ")
-                                ),
-                            ));
+                            return Err(RecordError::AmbiguousBodyFrame {
+                                path: path.to_path_buf(),
+                                odom_frame: odom_frame.clone(),
+                                children: other.iter().map(|c| (*c).to_owned()).collect(),
+                            });
                         }
                     },
                 };
@@ -398,24 +393,21 @@ impl Bag {
     }
 
     /// The cloud topic: the one asked for, else the only one.
-    fn cloud_topic(path: &Path, s: &Survey, config: &BagConfig) -> Result<String, AdapterError> {
+    fn cloud_topic(path: &Path, s: &Survey, config: &BagConfig) -> Result<String, RecordError> {
         if let Some(t) = &config.cloud_topic {
             check_topic_type(path, &s.topics, t, RosMessageType::PointCloud2)?;
             return Ok(t.clone());
         }
         match of_type(s, RosMessageType::PointCloud2).as_slice() {
             [one] => Ok((*one).to_owned()),
-            [] => Err(bad(
-                path,
-                format!(
-                    "no sensor_msgs/PointCloud2 topic; the bag has {}",
-                    listing(&s.topics)
-                ),
-            )),
-            many => Err(bad(
-                path,
-                format!("several cloud topics ({}): choose one", many.join(", ")),
-            )),
+            [] => Err(RecordError::NoCloudTopic {
+                path: path.to_path_buf(),
+                available: listing(&s.topics),
+            }),
+            many => Err(RecordError::SeveralCloudTopics {
+                path: path.to_path_buf(),
+                topics: many.iter().map(|t| (*t).to_owned()).collect(),
+            }),
         }
     }
 
@@ -428,7 +420,7 @@ impl Bag {
         config: &BagConfig,
         tree: &FrameTree,
         lidar_frame: &str,
-    ) -> Result<OdometryChoice, AdapterError> {
+    ) -> Result<OdometryChoice, RecordError> {
         let chosen = |odometry| OdometryChoice {
             odometry,
             notes: Vec::new(),
@@ -510,7 +502,7 @@ impl Bag {
         format: BagFormat,
         topic: &str,
         decoder: &mut PointCloud2Decoder,
-    ) -> Result<CloudLayout, AdapterError> {
+    ) -> Result<CloudLayout, RecordError> {
         for msg in BagMessages::open(path, format)? {
             let msg = msg?;
             if msg.topic.name != topic {
@@ -522,7 +514,10 @@ impl Bag {
             };
             return Ok(decoder.decode(&cloud).map_err(at)?.layout);
         }
-        Err(bad(path, format!("topic {topic} has no message")))
+        Err(RecordError::EmptyTopic {
+            path: path.to_path_buf(),
+            topic: topic.to_owned(),
+        })
     }
 
     /// What the bag holds and how it will be read.
@@ -566,7 +561,7 @@ impl Bag {
     ///
     /// # Errors
     /// As [`Bag::open`], when the file cannot be opened again.
-    pub fn samples(&self) -> Result<BagSamples, AdapterError> {
+    pub fn samples(&self) -> Result<BagSamples, RecordError> {
         let messages = BagMessages::open(&self.summary.path, self.summary.format)?;
         Ok(BagSamples::new(
             self.summary.clone(),

@@ -7,12 +7,12 @@
 
 use std::path::Path;
 
-use crate::error::{AdapterError, MessageError};
 use crate::record::bag_file::RawMessage;
 use crate::record::ros_messages::{
     Header, ImuReading, Odometry, PointCloud2, RosMessageType, TransformStamped, decode_tf_message,
 };
 use crate::record::wire::WireReader;
+use crate::record::{MessageError, RecordError};
 
 /// The error for message `index` of `topic`.
 pub(super) fn message_error(
@@ -20,8 +20,8 @@ pub(super) fn message_error(
     topic: &str,
     index: usize,
     source: MessageError,
-) -> AdapterError {
-    AdapterError::Message {
+) -> RecordError {
+    RecordError::Message {
         path: path.to_path_buf(),
         topic: topic.to_owned(),
         index,

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::mcap_file::McapMessages;
 use crate::record::ros_messages::RosMessageType;
 use crate::record::wire::Wire;
@@ -84,7 +84,7 @@ impl std::fmt::Debug for BagMessages {
 
 impl BagMessages {
     /// The messages of the bag at `path`, in `format`.
-    pub(crate) fn open(path: &Path, format: BagFormat) -> Result<Self, AdapterError> {
+    pub(crate) fn open(path: &Path, format: BagFormat) -> Result<Self, RecordError> {
         match format {
             BagFormat::Mcap => Ok(Self::Mcap {
                 path: path.to_path_buf(),
@@ -97,7 +97,7 @@ impl BagMessages {
 }
 
 impl Iterator for BagMessages {
-    type Item = Result<RawMessage, AdapterError>;
+    type Item = Result<RawMessage, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         match self {
@@ -143,20 +143,22 @@ impl Iterator for BagMessages {
 /// Reads the `index_pos` field of a ROS 1 bag's header record and where that record ends, so
 /// that a truncated or unindexed bag is refused before the `rosbag` crate slices its memory map
 /// between the two.
-fn ros1_index_pos(path: &Path) -> Result<(u64, u64), AdapterError> {
-    let bad = |message: &str| AdapterError::Recording {
+fn ros1_index_pos(path: &Path) -> Result<(u64, u64), RecordError> {
+    let bad = |problem: &'static str| RecordError::Ros1Header {
         path: path.to_path_buf(),
-        message: message.into(),
+        problem,
     };
     let mut head = Vec::new();
     File::open(path)
-        .map_err(|e| AdapterError::io(path, e))?
+        .map_err(|e| RecordError::io(path, e))?
         .take(4096)
         .read_to_end(&mut head)
-        .map_err(|e| AdapterError::io(path, e))?;
+        .map_err(|e| RecordError::io(path, e))?;
     let rest = head
         .strip_prefix(b"#ROSBAG V2.0\n")
-        .ok_or_else(|| bad("not a ROS 1 bag (no \"#ROSBAG V2.0\" line)"))?;
+        .ok_or_else(|| RecordError::NotRos1Bag {
+            path: path.to_path_buf(),
+        })?;
     let u32_at = |b: &[u8], at: usize| -> Option<usize> {
         Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?) as usize)
     };
@@ -189,21 +191,20 @@ pub(crate) struct Ros1Messages {
 }
 
 impl Ros1Messages {
-    fn open(path: &Path) -> Result<Self, AdapterError> {
+    fn open(path: &Path) -> Result<Self, RecordError> {
         let len = std::fs::metadata(path)
-            .map_err(|e| AdapterError::io(path, e))?
+            .map_err(|e| RecordError::io(path, e))?
             .len();
         let (index_pos, header_end) = ros1_index_pos(path)?;
         if index_pos < header_end || index_pos > len {
-            return Err(AdapterError::Recording {
+            return Err(RecordError::Unindexed {
                 path: path.to_path_buf(),
-                message: format!(
-                    "truncated or unindexed ROS 1 bag: its index should start at byte {index_pos} of {len} (reindex it with `rosbag reindex`)"
-                ),
+                index_pos,
+                len,
             });
         }
-        let bag = RosBag::new(path).map_err(|e| AdapterError::io(path, e))?;
-        let ros1 = |source| AdapterError::Ros1Bag {
+        let bag = RosBag::new(path).map_err(|e| RecordError::io(path, e))?;
+        let ros1 = |source| RecordError::Ros1Bag {
             path: path.to_path_buf(),
             source,
         };
@@ -237,8 +238,8 @@ impl Ros1Messages {
     }
 
     /// Decompress the next chunk into `pending`.
-    fn load_chunk(&mut self, pos: u64) -> Result<(), AdapterError> {
-        let ros1 = |source| AdapterError::Ros1Bag {
+    fn load_chunk(&mut self, pos: u64) -> Result<(), RecordError> {
+        let ros1 = |source| RecordError::Ros1Bag {
             path: self.path.clone(),
             source,
         };
@@ -253,16 +254,12 @@ impl Ros1Messages {
         for message in chunk.messages() {
             match message.map_err(ros1)? {
                 MessageRecord::MessageData(m) => {
-                    let topic =
-                        self.topics
-                            .get(&m.conn_id)
-                            .ok_or_else(|| AdapterError::Recording {
-                                path: self.path.clone(),
-                                message: format!(
-                                    "a message of connection {} that the index does not list",
-                                    m.conn_id
-                                ),
-                            })?;
+                    let topic = self.topics.get(&m.conn_id).ok_or_else(|| {
+                        RecordError::UnknownConnection {
+                            path: self.path.clone(),
+                            connection: m.conn_id,
+                        }
+                    })?;
                     self.pending.push_back(RawMessage {
                         topic: Arc::clone(topic),
                         log_time: m.time,
@@ -277,7 +274,7 @@ impl Ros1Messages {
 }
 
 impl Iterator for Ros1Messages {
-    type Item = Result<RawMessage, AdapterError>;
+    type Item = Result<RawMessage, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {

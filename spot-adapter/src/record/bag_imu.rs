@@ -12,7 +12,7 @@ use std::path::Path;
 
 use nalgebra::UnitQuaternion;
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::bag_frames::BagFrames;
 use crate::record::bag_topics::{TopicSummary, check_topic_type};
 use crate::record::frame_tree::FrameTree;
@@ -110,13 +110,13 @@ impl ImuChoice<'_> {
     /// The IMU used, or none with the reason as a note when there is one to say.
     ///
     /// # Errors
-    /// [`AdapterError::Recording`] for an IMU topic asked for that the bag does not have,
-    /// [`AdapterError::Message`] for one of another type, [`AdapterError::UnlinkedImu`] for one
+    /// [`RecordError::NoTopic`] for an IMU topic asked for that the bag does not have,
+    /// [`RecordError::Message`] for one of another type, [`RecordError::UnlinkedImu`] for one
     /// whose frame is not joined to the body frame by fixed transforms.
     pub(super) fn resolve(
         &self,
         source: &ImuSource,
-    ) -> Result<(Option<ImuSummary>, Option<String>), AdapterError> {
+    ) -> Result<(Option<ImuSummary>, Option<String>), RecordError> {
         let topic = match source {
             ImuSource::None => return Ok((None, None)),
             ImuSource::Topic(t) => {
@@ -152,7 +152,7 @@ impl ImuChoice<'_> {
         let frame = gyro.frame();
         let Some(body_r_imu) = self.mounting(frame) else {
             if matches!(source, ImuSource::Topic(_)) {
-                return Err(AdapterError::UnlinkedImu {
+                return Err(RecordError::UnlinkedImu {
                     path: self.path.to_path_buf(),
                     topic,
                     imu_frame: frame.to_owned(),

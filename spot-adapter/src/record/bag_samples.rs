@@ -8,7 +8,6 @@ use std::collections::{HashMap, VecDeque};
 
 use slam_core::{PointCloud, Pose3};
 
-use crate::error::{AdapterError, MessageError};
 use crate::record::bag_decoding::{Decoded, cloud_header, decode, message_error, tf_kind};
 use crate::record::bag_file::{BagMessages, RawMessage};
 use crate::record::bag_summary::{BagSummary, ResolvedOdometry};
@@ -17,6 +16,7 @@ use crate::record::imu::GyroIntegrator;
 use crate::record::no_return::DroppedPoints;
 use crate::record::point_cloud2::PointCloud2Decoder;
 use crate::record::ros_messages::{ImuReading, RosMessageType};
+use crate::record::{MessageError, RecordError};
 use crate::robot::Sample;
 
 /// A bag's samples, read one message at a time (from [`Bag::samples`](crate::record::Bag::samples)).
@@ -144,7 +144,7 @@ impl BagSamples {
     }
 
     /// Take in one message.
-    fn take(&mut self, msg: &RawMessage) -> Result<(), AdapterError> {
+    fn take(&mut self, msg: &RawMessage) -> Result<(), RecordError> {
         let path = self.summary.path.clone();
         let name = &msg.topic.name;
         let counter = self.counters.entry(name.clone()).or_default();
@@ -219,7 +219,7 @@ impl BagSamples {
         })
     }
 
-    fn next_sample(&mut self) -> Result<Option<Sample>, AdapterError> {
+    fn next_sample(&mut self) -> Result<Option<Sample>, RecordError> {
         loop {
             if let Some(&(index, stamp, _)) = self.pending.front() {
                 let known = self.odometry_at(stamp).map_err(|e| {
@@ -258,7 +258,7 @@ impl BagSamples {
 }
 
 impl Iterator for BagSamples {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.done || self.left == 0 {

@@ -4,10 +4,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::error::{AdapterError, MessageError};
 use crate::record::bag_decoding::message_error;
 use crate::record::bag_file::TopicInfo;
 use crate::record::ros_messages::RosMessageType;
+use crate::record::{MessageError, RecordError};
 
 /// One topic's count and log-time span.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,13 +22,12 @@ pub struct TopicSummary {
     pub last: f64,
 }
 
-/// `name, type, name, type...` of every topic.
-pub(super) fn listing(topics: &BTreeMap<String, TopicSummary>) -> String {
+/// `(name, type)` of every topic.
+pub(super) fn listing(topics: &BTreeMap<String, TopicSummary>) -> Vec<(String, String)> {
     topics
         .values()
-        .map(|t| format!("{} ({})", t.info.name, t.info.type_name))
-        .collect::<Vec<_>>()
-        .join(", ")
+        .map(|t| (t.info.name.clone(), t.info.type_name.clone()))
+        .collect()
 }
 
 /// Check that the bag has topic `name` and that it carries `kind`.
@@ -37,11 +36,12 @@ pub(super) fn check_topic_type(
     topics: &BTreeMap<String, TopicSummary>,
     name: &str,
     kind: RosMessageType,
-) -> Result<(), AdapterError> {
+) -> Result<(), RecordError> {
     let Some(topic) = topics.get(name) else {
-        return Err(AdapterError::Recording {
+        return Err(RecordError::NoTopic {
             path: path.to_path_buf(),
-            message: format!("no topic {name}; the bag has {}", listing(topics)),
+            topic: name.to_owned(),
+            available: listing(topics),
         });
     };
     if topic.info.message_type != Some(kind) {

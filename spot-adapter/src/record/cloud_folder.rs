@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use slam_core::Pose3;
 use slam_core::io::read_tum;
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::frame_tree::PoseSeries;
 use crate::record::no_return::{DroppedPoints, ReturnFilter};
 use crate::record::time_unit::TimeUnitInference;
@@ -75,24 +75,21 @@ impl CloudFolder {
     /// Open the folder `dir`.
     ///
     /// # Errors
-    /// [`AdapterError::Io`] for an unreadable folder, [`AdapterError::Recording`] when it holds
-    /// no PCD or PLY file, the odometry does not cover every scan's stamp or (without stamps in
-    /// the names) has another count of lines; [`AdapterError::Format`] for a malformed TUM file.
-    pub fn open(dir: impl AsRef<Path>, config: &CloudFolderConfig) -> Result<Self, AdapterError> {
+    /// [`RecordError::Io`] for an unreadable folder, [`RecordError::NoScans`] when it holds
+    /// no PCD or PLY file, [`RecordError::NoOdometryAt`] when the odometry does not cover every
+    /// scan's stamp, [`RecordError::CountMismatch`] when (without stamps in the names) it has
+    /// another count of lines; [`RecordError::Format`] for a malformed TUM file.
+    pub fn open(dir: impl AsRef<Path>, config: &CloudFolderConfig) -> Result<Self, RecordError> {
         let dir = dir.as_ref().to_path_buf();
-        let bad = |path: &Path, message: String| AdapterError::Recording {
-            path: path.to_path_buf(),
-            message,
-        };
         let mut scans: Vec<PathBuf> = fs::read_dir(&dir)
-            .map_err(|e| AdapterError::io(&dir, e))?
+            .map_err(|e| RecordError::io(&dir, e))?
             .filter_map(Result::ok)
             .map(|e| e.path())
             .filter(|p| is_cloud_file(p))
             .collect();
         scans.sort();
         if scans.is_empty() {
-            return Err(bad(&dir, "no .pcd or .ply file".into()));
+            return Err(RecordError::NoScans { path: dir });
         }
         let stamp_of = |p: &PathBuf| {
             p.file_stem()?
@@ -125,8 +122,9 @@ impl CloudFolder {
                 let odometry = stamps
                     .iter()
                     .map(|&t| {
-                        series.at(t).ok_or_else(|| {
-                            bad(path, format!("no odometry around the scan stamped {t} s"))
+                        series.at(t).ok_or_else(|| RecordError::NoOdometryAt {
+                            path: path.clone(),
+                            stamp: t,
                         })
                     })
                     .collect::<Result<Vec<_>, _>>()?;
@@ -134,10 +132,12 @@ impl CloudFolder {
             }
             (None, Some((path, poses))) => {
                 if poses.len() != scans.len() {
-                    return Err(bad(
-                        path,
-                        format!("{} poses for {} scans", poses.len(), scans.len()),
-                    ));
+                    return Err(RecordError::CountMismatch {
+                        path: path.clone(),
+                        found: poses.len(),
+                        what: "poses",
+                        scans: scans.len(),
+                    });
                 }
                 (
                     poses.iter().map(|p| p.stamp).collect(),
@@ -229,7 +229,7 @@ impl CloudFolderSamples {
 }
 
 impl Iterator for CloudFolderSamples {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         let i = self.next;
@@ -243,9 +243,9 @@ impl Iterator for CloudFolderSamples {
         let cloud = match self.times.times_in_seconds(cloud) {
             Ok(c) => c,
             Err(e) => {
-                return Some(Err(AdapterError::Recording {
+                return Some(Err(RecordError::ScanTimes {
                     path: path.clone(),
-                    message: e.to_string(),
+                    source: e,
                 }));
             }
         };

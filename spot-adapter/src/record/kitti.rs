@@ -19,7 +19,7 @@ use slam_core::Pose3;
 use slam_core::io::{parse_kitti_bin, parse_kitti_poses};
 
 use super::bounded_file::{MAX_RECORDING_FILE_BYTES, read_bounded, read_bounded_text};
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::robot::Sample;
 
 /// Where a KITTI sequence's odometry comes from.
@@ -43,21 +43,20 @@ pub struct KittiSequence {
     odometry: KittiOdometry,
 }
 
-fn read_text(path: &Path) -> Result<String, AdapterError> {
+fn read_text(path: &Path) -> Result<String, RecordError> {
     read_bounded_text(path, MAX_RECORDING_FILE_BYTES)
 }
 
 /// The `Tr:` line of a KITTI `calib.txt` as a pose.
-fn parse_calib(path: &Path, text: &str) -> Result<Option<Pose3>, AdapterError> {
+fn parse_calib(path: &Path, text: &str) -> Result<Option<Pose3>, RecordError> {
     let Some(line) = text.lines().find_map(|l| l.trim().strip_prefix("Tr:")) else {
         return Ok(None);
     };
     // The pose reader checks and re-orthonormalises the rotation.
     let pose = parse_kitti_poses(line)?
         .pop()
-        .ok_or_else(|| AdapterError::Recording {
+        .ok_or_else(|| RecordError::EmptyTrLine {
             path: path.to_path_buf(),
-            message: "empty Tr line".into(),
         })?;
     Ok(Some(pose))
 }
@@ -66,28 +65,31 @@ impl KittiSequence {
     /// Open the sequence in `dir`.
     ///
     /// # Errors
-    /// [`AdapterError::Io`] without a readable `velodyne` folder, [`AdapterError::Format`] for
-    /// malformed pose, time or calibration files, [`AdapterError::Recording`] when the counts of
-    /// scans, poses and times differ or `GroundTruth` odometry is asked for without poses.
-    pub fn open(dir: impl AsRef<Path>, odometry: KittiOdometry) -> Result<Self, AdapterError> {
+    /// [`RecordError::Io`] without a readable `velodyne` folder, [`RecordError::Format`] for
+    /// malformed pose or calibration files, [`RecordError::NonFiniteTime`] for a malformed
+    /// time, [`RecordError::EmptyTrLine`] for a calibration without numbers,
+    /// [`RecordError::CountMismatch`] when the counts of scans, poses and times differ and
+    /// [`RecordError::NoGroundTruth`] when `GroundTruth` odometry is asked for without poses.
+    pub fn open(dir: impl AsRef<Path>, odometry: KittiOdometry) -> Result<Self, RecordError> {
         let dir = dir.as_ref();
         let velodyne = dir.join("velodyne");
         let mut scans: Vec<PathBuf> = fs::read_dir(&velodyne)
-            .map_err(|e| AdapterError::io(&velodyne, e))?
+            .map_err(|e| RecordError::io(&velodyne, e))?
             .filter_map(Result::ok)
             .map(|e| e.path())
             .filter(|p| p.extension().is_some_and(|x| x == "bin"))
             .collect();
         scans.sort();
-        let bad = |path: PathBuf, message: String| AdapterError::Recording { path, message };
         let poses_path = dir.join("poses.txt");
         let poses = if poses_path.exists() {
             let p = parse_kitti_poses(&read_text(&poses_path)?)?;
             if p.len() != scans.len() {
-                return Err(bad(
-                    poses_path,
-                    format!("{} poses for {} scans", p.len(), scans.len()),
-                ));
+                return Err(RecordError::CountMismatch {
+                    path: poses_path,
+                    found: p.len(),
+                    what: "poses",
+                    scans: scans.len(),
+                });
             }
             Some(p)
         } else {
@@ -100,12 +102,16 @@ impl KittiSequence {
                 .split_whitespace()
                 .map(|v| v.parse::<f64>().ok().filter(|x| x.is_finite()))
                 .collect::<Option<_>>()
-                .ok_or_else(|| bad(times_path.clone(), "a time is not a finite number".into()))?;
+                .ok_or_else(|| RecordError::NonFiniteTime {
+                    path: times_path.clone(),
+                })?;
             if t.len() != scans.len() {
-                return Err(bad(
-                    times_path,
-                    format!("{} times for {} scans", t.len(), scans.len()),
-                ));
+                return Err(RecordError::CountMismatch {
+                    path: times_path,
+                    found: t.len(),
+                    what: "times",
+                    scans: scans.len(),
+                });
             }
             t
         } else {
@@ -118,10 +124,7 @@ impl KittiSequence {
             Pose3::identity()
         };
         if odometry == KittiOdometry::GroundTruth && poses.is_none() {
-            return Err(bad(
-                poses_path,
-                "ground-truth odometry needs poses.txt".into(),
-            ));
+            return Err(RecordError::NoGroundTruth { path: poses_path });
         }
         Ok(Self {
             scans,
@@ -165,8 +168,8 @@ impl KittiSequence {
     /// Sample `i` (its scan read from disk), `None` past the end.
     ///
     /// # Errors
-    /// [`AdapterError::Format`] when the scan cannot be read.
-    pub fn sample(&self, i: usize) -> Option<Result<Sample, AdapterError>> {
+    /// [`RecordError::Format`] when the scan cannot be read.
+    pub fn sample(&self, i: usize) -> Option<Result<Sample, RecordError>> {
         let path = self.scans.get(i)?;
         let gt = self.poses.as_ref().map(|p| p[i]);
         let odom_t_body = match self.odometry {
@@ -202,7 +205,7 @@ pub struct KittiSamples {
 }
 
 impl Iterator for KittiSamples {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         let item = self.sequence.sample(self.next)?;
@@ -219,7 +222,7 @@ impl Iterator for KittiSamples {
 impl ExactSizeIterator for KittiSamples {}
 
 impl IntoIterator for KittiSequence {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
     type IntoIter = KittiSamples;
 
     fn into_iter(self) -> KittiSamples {

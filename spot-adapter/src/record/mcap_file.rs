@@ -22,7 +22,7 @@ use mcap::read::ChannelAccumulator;
 use mcap::records::{Record, op};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 
 /// One message with its channel.
 pub(crate) struct McapMessage {
@@ -186,17 +186,14 @@ fn check_chunk_records(
 impl McapMessages {
     /// The messages of the MCAP file at `path`, no record or decompressed chunk longer than
     /// `record_length_limit` bytes or [`MAX_EXPANSION`] times the file's length.
-    pub(crate) fn open(path: &Path, record_length_limit: usize) -> Result<Self, AdapterError> {
-        let mut file = File::open(path).map_err(|e| AdapterError::io(path, e))?;
-        let file_len = file
-            .metadata()
-            .map_err(|e| AdapterError::io(path, e))?
-            .len();
+    pub(crate) fn open(path: &Path, record_length_limit: usize) -> Result<Self, RecordError> {
+        let mut file = File::open(path).map_err(|e| RecordError::io(path, e))?;
+        let file_len = file.metadata().map_err(|e| RecordError::io(path, e))?.len();
         let limit = usize::try_from(file_len.saturating_mul(MAX_EXPANSION))
             .map_or(record_length_limit, |l| l.min(record_length_limit));
         let mut heads = BufReader::with_capacity(1 << 12, &mut file);
         if let Err((claimed, left)) = check_chunks(&mut heads) {
-            return Err(AdapterError::McapLength {
+            return Err(RecordError::McapLength {
                 path: path.to_path_buf(),
                 what: "uncompressed chunk: a record",
                 claimed,
@@ -204,7 +201,7 @@ impl McapMessages {
             });
         }
         drop(heads);
-        file.rewind().map_err(|e| AdapterError::io(path, e))?;
+        file.rewind().map_err(|e| RecordError::io(path, e))?;
         Ok(Self {
             path: path.to_path_buf(),
             file: BufReader::with_capacity(1 << 20, file),
@@ -219,8 +216,8 @@ impl McapMessages {
         })
     }
 
-    fn next_message(&mut self) -> Option<Result<McapMessage, AdapterError>> {
-        let mcap = |path: &Path, source| AdapterError::Mcap {
+    fn next_message(&mut self) -> Option<Result<McapMessage, RecordError>> {
+        let mcap = |path: &Path, source| RecordError::Mcap {
             path: path.to_path_buf(),
             source: Box::new(source),
         };
@@ -235,7 +232,7 @@ impl McapMessages {
                         match self.file.read(self.reader.insert(need.min(READ_STEP))) {
                             Ok(n) => break n,
                             Err(e) if e.kind() == ErrorKind::Interrupted => {}
-                            Err(e) => return Some(Err(AdapterError::io(&self.path, e))),
+                            Err(e) => return Some(Err(RecordError::io(&self.path, e))),
                         }
                     };
                     self.reader.notify_read(read);
@@ -250,7 +247,7 @@ impl McapMessages {
                 continue;
             }
             if let Err((claimed, left)) = check_strings(opcode, data) {
-                return Some(Err(AdapterError::McapLength {
+                return Some(Err(RecordError::McapLength {
                     path: self.path.clone(),
                     what: if opcode == op::SCHEMA {
                         "schema record: a string"
@@ -293,7 +290,7 @@ impl McapMessages {
 }
 
 impl Iterator for McapMessages {
-    type Item = Result<McapMessage, AdapterError>;
+    type Item = Result<McapMessage, RecordError>;
 
     /// The next message; nothing after the first error.
     fn next(&mut self) -> Option<Self::Item> {

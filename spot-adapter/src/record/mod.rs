@@ -64,10 +64,12 @@ mod bag_summary;
 mod bag_topics;
 mod bounded_file;
 mod cloud_folder;
+mod error;
 mod frame_tree;
 mod imu;
 mod kitti;
 mod mcap_file;
+mod message_error;
 mod no_return;
 mod point_cloud2;
 mod read_ahead;
@@ -86,9 +88,11 @@ pub use bag_summary::{BagSummary, ResolvedOdometry};
 pub use bag_topics::TopicSummary;
 pub use bounded_file::MAX_RECORDING_FILE_BYTES;
 pub use cloud_folder::{CloudFolder, CloudFolderConfig, CloudFolderSamples, is_cloud_folder};
+pub use error::{BodyFrameSource, CalibrationProblem, IndexLineProblem, RecordError};
 pub use frame_tree::{FrameTree, PoseSeries};
 pub use imu::{GyroCounts, GyroIntegrator, GyroStep, MAX_GYRO_GAP};
 pub use kitti::{KittiOdometry, KittiSamples, KittiSequence};
+pub use message_error::{MessageError, TimeUnitProblem};
 pub use no_return::{DroppedPoints, PointKind, ReturnFilter};
 pub use point_cloud2::{
     CloudLayout, DecodedCloud, FieldSlot, PointCloud2Config, PointCloud2Decoder, TimeFields,

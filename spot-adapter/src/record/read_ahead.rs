@@ -6,13 +6,13 @@
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::no_return::DroppedPoints;
 use crate::record::source::SampleSource;
 use crate::robot::Sample;
 
 /// One sample read, with the points the source had removed once it was read.
-type Read = (Result<Sample, AdapterError>, DroppedPoints);
+type Read = (Result<Sample, RecordError>, DroppedPoints);
 
 /// `source` read ahead on a thread of its own (see the module documentation).
 ///
@@ -51,7 +51,7 @@ fn read_into<S: SampleSource>(mut source: S, sender: &SyncSender<Read>) {
 
 impl ReadAhead {
     /// `source` read by a new thread, at most `depth` samples (at least 1) ahead. When no
-    /// thread can be started, the only sample is that error ([`AdapterError::Io`] on the path
+    /// thread can be started, the only sample is that error ([`RecordError::Io`] on the path
     /// `<read-ahead thread>`).
     pub fn new<S: SampleSource + 'static>(source: S, depth: usize) -> Self {
         let left = source.len();
@@ -71,7 +71,7 @@ impl ReadAhead {
             Err(e) => {
                 let (sender, receiver) = sync_channel(1);
                 let _ = sender.send((
-                    Err(AdapterError::io(
+                    Err(RecordError::io(
                         std::path::Path::new("<read-ahead thread>"),
                         e,
                     )),
@@ -98,7 +98,7 @@ impl ReadAhead {
 }
 
 impl Iterator for ReadAhead {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         let received = self.receiver.as_ref()?.recv();
@@ -166,14 +166,11 @@ mod tests {
     }
 
     /// 20 samples with one no-return each, then an error at sample 12 when `fail`.
-    fn source(fail: bool) -> ReturnFiltered<std::vec::IntoIter<Result<Sample, AdapterError>>> {
+    fn source(fail: bool) -> ReturnFiltered<std::vec::IntoIter<Result<Sample, RecordError>>> {
         let samples: Vec<_> = (0..20)
             .map(|i| {
                 if fail && i == 12 {
-                    Err(AdapterError::Recording {
-                        path: "x".into(),
-                        message: "cut".into(),
-                    })
+                    Err(RecordError::NotFound { path: "x".into() })
                 } else {
                     Ok(sample(
                         i,

@@ -28,7 +28,7 @@ use super::bounded_file::{
     MAX_RECORDING_FILE_BYTES, check_regular_file, open_regular_file, read_bounded,
     read_bounded_text,
 };
-use crate::error::AdapterError;
+use crate::record::{CalibrationProblem, IndexLineProblem, RecordError};
 use crate::robot::Sample;
 
 const INDEX: &str = "index.txt";
@@ -48,28 +48,26 @@ struct LineFile {
 }
 
 impl LineFile {
-    fn create(path: PathBuf, header: &str) -> Result<Self, AdapterError> {
-        let file = File::create(&path).map_err(|e| AdapterError::io(&path, e))?;
+    fn create(path: PathBuf, header: &str) -> Result<Self, RecordError> {
+        let file = File::create(&path).map_err(|e| RecordError::io(&path, e))?;
         let mut out = BufWriter::new(file);
-        writeln!(out, "{header}").map_err(|e| AdapterError::io(&path, e))?;
+        writeln!(out, "{header}").map_err(|e| RecordError::io(&path, e))?;
         Ok(Self { path, out })
     }
 
-    fn pose(&mut self, pose: &StampedPose) -> Result<(), AdapterError> {
+    fn pose(&mut self, pose: &StampedPose) -> Result<(), RecordError> {
         write_tum_line(&mut self.out, pose).map_err(|e| match e {
-            FormatError::Stream(source) => AdapterError::io(&self.path, source),
+            FormatError::Stream(source) => RecordError::io(&self.path, source),
             other => other.into(),
         })
     }
 
-    fn line(&mut self, text: &str) -> Result<(), AdapterError> {
-        writeln!(self.out, "{text}").map_err(|e| AdapterError::io(&self.path, e))
+    fn line(&mut self, text: &str) -> Result<(), RecordError> {
+        writeln!(self.out, "{text}").map_err(|e| RecordError::io(&self.path, e))
     }
 
-    fn finish(mut self) -> Result<(), AdapterError> {
-        self.out
-            .flush()
-            .map_err(|e| AdapterError::io(&self.path, e))
+    fn finish(mut self) -> Result<(), RecordError> {
+        self.out.flush().map_err(|e| RecordError::io(&self.path, e))
     }
 }
 
@@ -91,18 +89,17 @@ impl RecordingWriter {
     /// `body_t_lidar`; writes the calibration at once.
     ///
     /// # Errors
-    /// [`AdapterError::Io`] when the folders or files cannot be created.
-    pub fn create(dir: impl AsRef<Path>, body_t_lidar: Pose3) -> Result<Self, AdapterError> {
+    /// [`RecordError::Io`] when the folders or files cannot be created.
+    pub fn create(dir: impl AsRef<Path>, body_t_lidar: Pose3) -> Result<Self, RecordError> {
         let dir = dir.as_ref().to_path_buf();
         let clouds = dir.join(CLOUDS);
-        fs::create_dir_all(&clouds).map_err(|e| AdapterError::io(&clouds, e))?;
+        fs::create_dir_all(&clouds).map_err(|e| RecordError::io(&clouds, e))?;
         let path = dir.join(CALIBRATION);
-        fs::write(&path, calibration_text(&body_t_lidar))
-            .map_err(|e| AdapterError::io(&path, e))?;
+        fs::write(&path, calibration_text(&body_t_lidar)).map_err(|e| RecordError::io(&path, e))?;
         // A stale ground truth from an earlier recording in the same folder would disagree.
         let stale = dir.join(GROUND_TRUTH);
         if stale.exists() {
-            fs::remove_file(&stale).map_err(|e| AdapterError::io(&stale, e))?;
+            fs::remove_file(&stale).map_err(|e| RecordError::io(&stale, e))?;
         }
         Ok(Self {
             index: LineFile::create(dir.join(INDEX), &format!("{HEADER}\n# index stamp cloud"))?,
@@ -118,37 +115,37 @@ impl RecordingWriter {
     /// Write one sample: its cloud file, its index line and its poses.
     ///
     /// # Errors
-    /// [`AdapterError::Recording`] when the sample's mounting differs from the recording's,
-    /// its stamp does not increase, or only some samples carry ground truth;
-    /// [`AdapterError::Format`] or [`AdapterError::Io`] when a file cannot be written.
-    pub fn write(&mut self, sample: &Sample) -> Result<(), AdapterError> {
-        let err = |message: String| AdapterError::Recording {
-            path: self.dir.clone(),
-            message,
-        };
+    /// [`RecordError::MountingChanged`] when the sample's mounting differs from the recording's,
+    /// [`RecordError::StampNotIncreasing`] when its stamp does not increase,
+    /// [`RecordError::PartialGroundTruth`] when only some samples carry ground truth;
+    /// [`RecordError::Format`] or [`RecordError::Io`] when a file cannot be written.
+    pub fn write(&mut self, sample: &Sample) -> Result<(), RecordError> {
+        let path = || self.dir.clone();
         let d = self.body_t_lidar.inverse() * sample.body_t_lidar;
         if d.translation.vector.norm() > 1e-9 || d.rotation.angle() > 1e-9 {
-            return Err(err(format!(
-                "sample {} has another body_T_lidar than the recording",
-                self.written
-            )));
+            return Err(RecordError::MountingChanged {
+                path: path(),
+                sample: self.written,
+            });
         }
         if let Some(last) = self.last_stamp
             && sample.stamp.partial_cmp(&last) != Some(std::cmp::Ordering::Greater)
         {
-            return Err(err(format!(
-                "stamp {} does not follow {last}",
-                sample.stamp
-            )));
+            return Err(RecordError::StampNotIncreasing {
+                path: path(),
+                stamp: sample.stamp,
+                last,
+            });
         }
         // The first sample decides whether the recording carries ground truth.
         if self.written == 0 && sample.ground_truth.is_some() {
             self.ground_truth = Some(LineFile::create(self.dir.join(GROUND_TRUTH), TUM_HEADER)?);
         }
         if sample.ground_truth.is_some() != self.ground_truth.is_some() {
-            return Err(err(
-                "ground truth must be given for all samples or none".into()
-            ));
+            return Err(RecordError::PartialGroundTruth {
+                path: path(),
+                sample: self.written,
+            });
         }
         let entry = IndexEntry {
             index: self.written as u64,
@@ -179,8 +176,8 @@ impl RecordingWriter {
     /// Flush the index and the trajectories; returns the folder.
     ///
     /// # Errors
-    /// [`AdapterError::Io`] when a file cannot be written.
-    pub fn finish(self) -> Result<PathBuf, AdapterError> {
+    /// [`RecordError::Io`] when a file cannot be written.
+    pub fn finish(self) -> Result<PathBuf, RecordError> {
         self.index.finish()?;
         self.odometry.finish()?;
         if let Some(gt) = self.ground_truth {
@@ -215,7 +212,7 @@ impl std::fmt::Debug for LineReader {
 }
 
 impl LineReader {
-    fn open(path: PathBuf) -> Result<Self, AdapterError> {
+    fn open(path: PathBuf) -> Result<Self, RecordError> {
         let file = open_regular_file(&path, MAX_RECORDING_FILE_BYTES)?;
         Ok(Self {
             lines: BufReader::new(file).lines(),
@@ -225,10 +222,10 @@ impl LineReader {
     }
 
     /// The next line that is neither blank nor a comment, with its 1-based number.
-    fn next_entry(&mut self) -> Result<Option<(usize, String)>, AdapterError> {
+    fn next_entry(&mut self) -> Result<Option<(usize, String)>, RecordError> {
         for line in self.lines.by_ref() {
             self.line += 1;
-            let line = line.map_err(|e| AdapterError::io(&self.path, e))?;
+            let line = line.map_err(|e| RecordError::io(&self.path, e))?;
             let trimmed = line.trim();
             if !(trimmed.is_empty() || trimmed.starts_with('#')) {
                 return Ok(Some((self.line, trimmed.to_owned())));
@@ -237,22 +234,22 @@ impl LineReader {
         Ok(None)
     }
 
-    fn error(&self, line: usize, message: impl std::fmt::Display) -> AdapterError {
-        AdapterError::Recording {
-            path: self.path.clone(),
-            message: format!("line {line}: {message}"),
-        }
-    }
-
     /// The next pose of a TUM file, `None` at its end.
-    fn next_pose(&mut self) -> Result<Option<StampedPose>, AdapterError> {
+    fn next_pose(&mut self) -> Result<Option<StampedPose>, RecordError> {
         let Some((line, text)) = self.next_entry()? else {
             return Ok(None);
         };
         match parse_tum(&text) {
             Ok(mut poses) if poses.len() == 1 => Ok(poses.pop()),
-            Ok(_) => Err(self.error(line, "expected one pose")),
-            Err(FormatError::Line { message, .. }) => Err(self.error(line, message)),
+            Ok(_) => Err(RecordError::NotOnePose {
+                path: self.path.clone(),
+                line,
+            }),
+            // Numbered as the line of the file, not of the one line parsed.
+            Err(FormatError::Line { message, .. }) => Err(RecordError::PoseLine {
+                path: self.path.clone(),
+                source: FormatError::Line { line, message },
+            }),
             Err(other) => Err(other.into()),
         }
     }
@@ -271,27 +268,25 @@ pub struct IndexEntry {
 
 impl IndexEntry {
     /// The entry of one index line, or what is wrong with it.
-    fn parse(text: &str) -> Result<Self, String> {
+    fn parse(text: &str) -> Result<Self, IndexLineProblem> {
         let fields: Vec<&str> = text.split_whitespace().collect();
         let [index, stamp, cloud] = fields.as_slice() else {
-            return Err("expected: index stamp cloud".into());
+            return Err(IndexLineProblem::FieldCount);
         };
         let index = index
             .parse::<u64>()
-            .map_err(|_| format!("index {index:?} is not a whole number"))?;
+            .map_err(|_| IndexLineProblem::Index((*index).to_owned()))?;
         let stamp = stamp
             .parse::<f64>()
             .ok()
             .filter(|s| s.is_finite())
-            .ok_or_else(|| format!("stamp {stamp:?} is not a finite number"))?;
+            .ok_or_else(|| IndexLineProblem::Stamp((*stamp).to_owned()))?;
         let relative = Path::new(cloud);
         if !relative
             .components()
             .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
         {
-            return Err(format!(
-                "cloud path {cloud:?} must be relative and stay inside the recording"
-            ));
+            return Err(IndexLineProblem::CloudOutside((*cloud).to_owned()));
         }
         Ok(Self {
             index,
@@ -311,18 +306,19 @@ impl IndexEntry {
 /// [`IndexEntry`] per other line.
 ///
 /// # Errors
-/// [`AdapterError::Recording`] naming `index.txt` and the line: not three fields, an index that
-/// is not a whole number, a stamp that is not finite, a cloud path that is absolute or leaves
-/// the folder (`..`).
-pub fn parse_index(text: &str) -> Result<Vec<IndexEntry>, AdapterError> {
+/// [`RecordError::IndexLine`] naming `index.txt`, the line and its [`IndexLineProblem`]: not
+/// three fields, an index that is not a whole number, a stamp that is not finite, a cloud path
+/// that is absolute or leaves the folder (`..`).
+pub fn parse_index(text: &str) -> Result<Vec<IndexEntry>, RecordError> {
     text.lines()
         .enumerate()
         .map(|(k, l)| (k + 1, l.trim()))
         .filter(|(_, l)| !(l.is_empty() || l.starts_with('#')))
         .map(|(line, l)| {
-            IndexEntry::parse(l).map_err(|message| AdapterError::Recording {
+            IndexEntry::parse(l).map_err(|problem| RecordError::IndexLine {
                 path: PathBuf::from(INDEX),
-                message: format!("line {line}: {message}"),
+                line,
+                problem,
             })
         })
         .collect()
@@ -343,53 +339,54 @@ pub fn calibration_text(body_t_lidar: &Pose3) -> String {
 /// line.
 ///
 /// # Errors
-/// [`AdapterError::Recording`] naming `calibration.txt`: no such line, not 7 finite numbers, or
-/// a quaternion that is not unit.
-pub fn parse_calibration(text: &str) -> Result<Pose3, AdapterError> {
-    let bad = |message: String| AdapterError::Recording {
+/// [`RecordError::Calibration`] naming `calibration.txt` and its [`CalibrationProblem`]: no
+/// such line, not 7 finite numbers, or a quaternion that is not unit.
+pub fn parse_calibration(text: &str) -> Result<Pose3, RecordError> {
+    let bad = |problem: CalibrationProblem| RecordError::Calibration {
         path: PathBuf::from(CALIBRATION),
-        message,
+        problem,
     };
     let line = text
         .lines()
         .map(str::trim)
         .find(|l| l.starts_with("body_T_lidar"))
-        .ok_or_else(|| bad("no body_T_lidar line".into()))?;
+        .ok_or_else(|| bad(CalibrationProblem::NoLine))?;
     let v: Vec<f64> = line
         .split_whitespace()
         .skip(1)
         .map(str::parse)
         .collect::<Result<_, _>>()
-        .map_err(|e| bad(format!("body_T_lidar: {e}")))?;
+        .map_err(|e| bad(CalibrationProblem::NotANumber(e)))?;
     if v.len() != 7 || !v.iter().all(|x| x.is_finite()) {
-        return Err(bad("body_T_lidar needs 7 finite numbers".into()));
+        return Err(bad(CalibrationProblem::NotSevenFinite));
     }
     let q = quaternion_from_xyzw([v[3], v[4], v[5], v[6]])
-        .ok_or_else(|| bad("body_T_lidar quaternion is not unit".into()))?;
+        .ok_or_else(|| bad(CalibrationProblem::NonUnitQuaternion))?;
     Ok(Pose3::from_parts(Translation3::new(v[0], v[1], v[2]), q))
 }
 
 /// Errors of an in-memory parse of the file `name`, renamed to the file's full `path`.
-fn at_path(e: AdapterError, name: &str, path: &Path) -> AdapterError {
-    match e {
-        AdapterError::Recording { path: p, message } if p == Path::new(name) => {
-            AdapterError::Recording {
-                path: path.to_path_buf(),
-                message,
-            }
-        }
-        other => other,
+fn at_path(mut e: RecordError, name: &str, path: &Path) -> RecordError {
+    if let RecordError::Calibration { path: p, .. } | RecordError::IndexLine { path: p, .. } =
+        &mut e
+        && p == Path::new(name)
+    {
+        *p = path.to_path_buf();
     }
+    e
 }
 
 impl Recording {
     /// Open the recording in `dir`, checking it whole in one streaming pass.
     ///
     /// # Errors
-    /// [`AdapterError::Io`] or [`AdapterError::Format`] when a file is missing or malformed,
-    /// [`AdapterError::Recording`] when the files disagree (counts, stamps) or a cloud path
-    /// leaves the folder.
-    pub fn open(dir: impl AsRef<Path>) -> Result<Self, AdapterError> {
+    /// [`RecordError::Io`] or [`RecordError::Format`] when a file is missing or malformed;
+    /// [`RecordError::NotRegularFile`], [`RecordError::FileTooLarge`] or
+    /// [`RecordError::NotUtf8`] for a file that cannot be read whole; [`RecordError::Calibration`],
+    /// [`RecordError::IndexLine`] or [`RecordError::PoseLine`] for a malformed line; and
+    /// [`RecordError::MissingPose`], [`RecordError::ExtraPose`] or
+    /// [`RecordError::StampMismatch`] when the files disagree.
+    pub fn open(dir: impl AsRef<Path>) -> Result<Self, RecordError> {
         let dir = dir.as_ref().to_path_buf();
         let cal_path = dir.join(CALIBRATION);
         let cal = read_bounded_text(&cal_path, MAX_RECORDING_FILE_BYTES)?;
@@ -412,7 +409,7 @@ impl Recording {
     }
 
     /// The entries (stamp, cloud path, poses) without reading the clouds.
-    fn entries(&self) -> Result<Entries, AdapterError> {
+    fn entries(&self) -> Result<Entries, RecordError> {
         Ok(Entries {
             dir: self.dir.clone(),
             index: LineReader::open(self.dir.join(INDEX))?,
@@ -460,8 +457,8 @@ impl Recording {
     /// when the recording has none.
     ///
     /// # Errors
-    /// [`AdapterError::Format`] when the file cannot be read.
-    pub fn read_ground_truth(&self) -> Result<Option<Vec<StampedPose>>, AdapterError> {
+    /// [`RecordError::Format`] when the file cannot be read.
+    pub fn read_ground_truth(&self) -> Result<Option<Vec<StampedPose>>, RecordError> {
         if !self.has_ground_truth {
             return Ok(None);
         }
@@ -471,8 +468,8 @@ impl Recording {
     /// The whole odometry trajectory, one pose per scan.
     ///
     /// # Errors
-    /// [`AdapterError::Format`] when the file cannot be read.
-    pub fn read_odometry(&self) -> Result<Vec<StampedPose>, AdapterError> {
+    /// [`RecordError::Format`] when the file cannot be read.
+    pub fn read_odometry(&self) -> Result<Vec<StampedPose>, RecordError> {
         Ok(read_tum(self.dir.join(ODOMETRY))?)
     }
 
@@ -502,30 +499,43 @@ struct Entry {
 }
 
 impl Entries {
-    fn read(&mut self) -> Result<Option<Entry>, AdapterError> {
+    fn read(&mut self) -> Result<Option<Entry>, RecordError> {
         let Some((line, text)) = self.index.next_entry()? else {
             // The trajectories must end with the index.
             for reader in std::iter::once(&mut self.odometry).chain(self.ground_truth.as_mut()) {
                 if let Some((line, _)) = reader.next_entry()? {
-                    return Err(reader.error(line, "more poses than scans in the index"));
+                    return Err(RecordError::ExtraPose {
+                        path: reader.path.clone(),
+                        line,
+                    });
                 }
             }
             return Ok(None);
         };
-        let entry = IndexEntry::parse(&text).map_err(|m| self.index.error(line, m))?;
+        let entry = IndexEntry::parse(&text).map_err(|problem| RecordError::IndexLine {
+            path: self.index.path.clone(),
+            line,
+            problem,
+        })?;
         let (stamp, cloud) = (entry.stamp, self.dir.join(entry.cloud));
         // Refused when the folder is opened, not only when the scan is reached.
         check_regular_file(&cloud, MAX_RECORDING_FILE_BYTES)?;
-        let pose_of = |reader: &mut LineReader| -> Result<Pose3, AdapterError> {
+        let pose_of = |reader: &mut LineReader| -> Result<Pose3, RecordError> {
             let at = reader.line;
             let pose = reader
                 .next_pose()?
-                .ok_or_else(|| reader.error(at + 1, format!("no pose for scan stamped {stamp}")))?;
+                .ok_or_else(|| RecordError::MissingPose {
+                    path: reader.path.clone(),
+                    line: at + 1,
+                    stamp,
+                })?;
             if (pose.stamp - stamp).abs() > STAMP_TOLERANCE {
-                return Err(reader.error(
-                    reader.line,
-                    format!("pose stamped {} but its scan {}", pose.stamp, stamp),
-                ));
+                return Err(RecordError::StampMismatch {
+                    path: reader.path.clone(),
+                    line: reader.line,
+                    pose_stamp: pose.stamp,
+                    scan_stamp: stamp,
+                });
             }
             Ok(pose.pose)
         };
@@ -544,7 +554,7 @@ impl Entries {
 }
 
 impl Iterator for Entries {
-    type Item = Result<Entry, AdapterError>;
+    type Item = Result<Entry, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.done {
@@ -564,12 +574,12 @@ impl Iterator for Entries {
 #[derive(Debug)]
 pub struct RecordingSamples {
     body_t_lidar: Pose3,
-    entries: Result<Entries, Option<AdapterError>>,
+    entries: Result<Entries, Option<RecordError>>,
     left: usize,
 }
 
 impl Iterator for RecordingSamples {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         // As many samples as the recording had when it was opened (the exact length), unless an
@@ -615,7 +625,7 @@ impl Iterator for RecordingSamples {
 impl ExactSizeIterator for RecordingSamples {}
 
 impl IntoIterator for Recording {
-    type Item = Result<Sample, AdapterError>;
+    type Item = Result<Sample, RecordError>;
     type IntoIter = RecordingSamples;
 
     /// Every sample in order, each cloud read when reached; the iterator owns what it reads

@@ -6,7 +6,7 @@
 use nalgebra::{Translation3, Vector3};
 use slam_core::{Pose3, quaternion_from_xyzw};
 
-use crate::error::MessageError;
+use crate::record::MessageError;
 use crate::record::wire::{Wire, WireReader};
 
 /// The message types a bag reader understands, by their ROS name.

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use slam_core::Pose3;
 use slam_core::io::StampedPose;
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::bag::{Bag, BagConfig};
 use crate::record::bag_file::BagFormat;
 use crate::record::bag_samples::BagSamples;
@@ -22,7 +22,7 @@ use crate::robot::Sample;
 
 /// A stream of samples from a recording, with the points its reader removed. `Send`, so that
 /// it can be read ahead on a thread of its own ([`ReadAhead`](crate::record::ReadAhead)).
-pub trait SampleSource: ExactSizeIterator<Item = Result<Sample, AdapterError>> + Send {
+pub trait SampleSource: ExactSizeIterator<Item = Result<Sample, RecordError>> + Send {
     /// Points removed from the samples read so far (non-finite and no-return).
     fn dropped_points(&self) -> DroppedPoints;
 }
@@ -64,8 +64,8 @@ impl<I> ReturnFiltered<I> {
     }
 }
 
-impl<I: Iterator<Item = Result<Sample, AdapterError>>> Iterator for ReturnFiltered<I> {
-    type Item = Result<Sample, AdapterError>;
+impl<I: Iterator<Item = Result<Sample, RecordError>>> Iterator for ReturnFiltered<I> {
+    type Item = Result<Sample, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         Some(self.samples.next()?.map(|mut s| {
@@ -81,12 +81,12 @@ impl<I: Iterator<Item = Result<Sample, AdapterError>>> Iterator for ReturnFilter
     }
 }
 
-impl<I: ExactSizeIterator<Item = Result<Sample, AdapterError>>> ExactSizeIterator
+impl<I: ExactSizeIterator<Item = Result<Sample, RecordError>>> ExactSizeIterator
     for ReturnFiltered<I>
 {
 }
 
-impl<I: ExactSizeIterator<Item = Result<Sample, AdapterError>> + Send> SampleSource
+impl<I: ExactSizeIterator<Item = Result<Sample, RecordError>> + Send> SampleSource
     for ReturnFiltered<I>
 {
     fn dropped_points(&self) -> DroppedPoints {
@@ -111,19 +111,19 @@ pub enum RecordingKind {
 /// `.mcap`).
 ///
 /// # Errors
-/// [`AdapterError::Recording`] when the path is none of the kinds.
-pub fn detect(path: &Path) -> Result<(RecordingKind, PathBuf), AdapterError> {
-    let bad = |message: &str| AdapterError::Recording {
-        path: path.to_path_buf(),
-        message: message.into(),
-    };
+/// [`RecordError::NotFound`] for a path that is no file or folder, [`RecordError::NotABag`]
+/// for a file that is not `.mcap` or `.bag`, [`RecordError::NoMcapFile`] or
+/// [`RecordError::SplitMcap`] for a ROS 2 bag folder without one `.mcap`, and
+/// [`RecordError::UnknownKind`] for a folder of none of the kinds.
+pub fn detect(path: &Path) -> Result<(RecordingKind, PathBuf), RecordError> {
+    let path_buf = || path.to_path_buf();
     if path.is_file() {
         return BagFormat::from_path(path)
             .map(|f| (RecordingKind::Bag(f), path.to_path_buf()))
-            .ok_or_else(|| bad("a file must be a .mcap or .bag bag"));
+            .ok_or_else(|| RecordError::NotABag { path: path_buf() });
     }
     if !path.is_dir() {
-        return Err(bad("no such file or folder"));
+        return Err(RecordError::NotFound { path: path_buf() });
     }
     if path.join("index.txt").is_file() {
         return Ok((RecordingKind::SpotNav, path.to_path_buf()));
@@ -133,7 +133,7 @@ pub fn detect(path: &Path) -> Result<(RecordingKind, PathBuf), AdapterError> {
     }
     if path.join("metadata.yaml").is_file() {
         let mut mcaps: Vec<PathBuf> = std::fs::read_dir(path)
-            .map_err(|e| AdapterError::io(path, e))?
+            .map_err(|e| RecordError::io(path, e))?
             .filter_map(Result::ok)
             .map(|e| e.path())
             .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
@@ -141,18 +141,17 @@ pub fn detect(path: &Path) -> Result<(RecordingKind, PathBuf), AdapterError> {
         mcaps.sort();
         return match mcaps.as_slice() {
             [one] => Ok((RecordingKind::Bag(BagFormat::Mcap), one.clone())),
-            [] => Err(bad(
-                "a ROS 2 bag folder without an .mcap file (sqlite3 bags are not read)",
-            )),
-            _ => Err(bad("a ROS 2 bag split over several .mcap files: give one")),
+            [] => Err(RecordError::NoMcapFile { path: path_buf() }),
+            many => Err(RecordError::SplitMcap {
+                path: path_buf(),
+                files: many.len(),
+            }),
         };
     }
     if is_cloud_folder(path) {
         return Ok((RecordingKind::CloudFolder, path.to_path_buf()));
     }
-    Err(bad(
-        "not a bag, a spot-nav recording (index.txt), a KITTI sequence (velodyne/) or a folder of .pcd/.ply scans",
-    ))
+    Err(RecordError::UnknownKind { path: path_buf() })
 }
 
 /// How to open a recording; each field applies to the kinds that name it.
@@ -197,7 +196,7 @@ impl std::fmt::Debug for OpenedSource {
 ///
 /// # Errors
 /// As [`detect`] and the kind's reader.
-pub fn open_recording(path: &Path, config: &SourceConfig) -> Result<OpenedSource, AdapterError> {
+pub fn open_recording(path: &Path, config: &SourceConfig) -> Result<OpenedSource, RecordError> {
     let (kind, path) = detect(path)?;
     let returns = config.bag.cloud.returns;
     Ok(match kind {

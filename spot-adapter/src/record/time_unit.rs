@@ -13,7 +13,7 @@
 
 use slam_core::PointCloud;
 
-use crate::error::MessageError;
+use crate::record::{MessageError, TimeUnitProblem};
 
 /// The least spread (seconds) of per-point times that differ.
 const MIN_SPREAD: f64 = 1e-5;
@@ -65,7 +65,7 @@ impl TimeUnit {
         }
     }
 
-    fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Self::SecondsRelative => "s since the stamp",
             Self::NanosecondsRelative => "ns since the stamp",
@@ -169,7 +169,7 @@ impl TimeUnitInference {
                     max,
                     stamp: 0.0,
                     period: self.max_scan_period,
-                    problem: "the cloud's channels differ in length".into(),
+                    problem: TimeUnitProblem::ChannelLengths,
                 };
                 if let Some(r) = ring {
                     out = out.with_ring(r).map_err(bad)?;
@@ -198,7 +198,7 @@ impl TimeUnitInference {
         max: f64,
     ) -> Result<TimeUnit, MessageError> {
         let period = self.max_scan_period;
-        let error = |problem: String| MessageError::TimeUnit {
+        let error = |problem: TimeUnitProblem| MessageError::TimeUnit {
             field: field(),
             min,
             max,
@@ -211,7 +211,7 @@ impl TimeUnitInference {
             return Ok(self.unit.unwrap_or(TimeUnit::SecondsRelative));
         }
         if !(min.is_finite() && max.is_finite()) {
-            return Err(error("a time is not finite".into()));
+            return Err(error(TimeUnitProblem::NotFinite));
         }
         // A unit fits when it puts every point within one period of the stamp, and spreads
         // differing times over at least 10 us (the 0.04 degrees a 10 Hz LiDAR turns in that
@@ -228,10 +228,7 @@ impl TimeUnitInference {
             return if fits(unit) {
                 Ok(unit)
             } else {
-                Err(error(format!(
-                    "the unit decided earlier ({}) does not fit",
-                    unit.name()
-                )))
+                Err(error(TimeUnitProblem::DecidedUnitDoesNotFit { unit }))
             };
         }
         let spread = |u: TimeUnit| u.offset(max, stamp) - u.offset(min, stamp);
@@ -242,9 +239,7 @@ impl TimeUnitInference {
             .copied()
             .reduce(|a, b| if spread(b) > spread(a) { b } else { a })
         else {
-            return Err(error(
-                "no unit (s or ns, absolute or since the stamp) fits".into(),
-            ));
+            return Err(error(TimeUnitProblem::NoUnitFits));
         };
         if spread(best) == 0.0 {
             // All times equal: nothing to decide from; take the preferred unit for this cloud.
@@ -256,11 +251,10 @@ impl TimeUnitInference {
                 && spread(u) >= 0.1 * spread(best)
                 && (u.offset(min, stamp) - best.offset(min, stamp)).abs() > 1e-6
         }) {
-            return Err(error(format!(
-                "both {} and {} fit",
-                best.name(),
-                other.name()
-            )));
+            return Err(error(TimeUnitProblem::TwoUnitsFit {
+                first: best,
+                second: *other,
+            }));
         }
         self.unit = Some(best);
         Ok(best)
@@ -291,7 +285,13 @@ mod tests {
         let mut fresh = PointCloud2Decoder::new(PointCloud2Config::default());
         let err = fresh.decode(&cloud(&data, 0.05)).unwrap_err();
         assert!(
-            matches!(&err, MessageError::TimeUnit { problem, .. } if problem.contains("both")),
+            matches!(
+                &err,
+                MessageError::TimeUnit {
+                    problem: TimeUnitProblem::TwoUnitsFit { .. },
+                    ..
+                }
+            ) && err.to_string().contains("both"),
             "{err}"
         );
         // Equal times decide nothing.

@@ -3,7 +3,7 @@
 //! giving the byte order, every primitive aligned to its size counted from after that header,
 //! strings with a terminating NUL). One reader serves both, so each message type is decoded once.
 
-use crate::error::MessageError;
+use crate::record::MessageError;
 
 /// Which serialisation a payload uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

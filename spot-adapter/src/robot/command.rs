@@ -3,7 +3,7 @@
 
 use slam_core::Pose2;
 
-use crate::error::AdapterError;
+use crate::robot::RobotError;
 
 /// A body-frame velocity (Spot's `SE2VelocityCommand` in the `body` frame), held until the next
 /// command or, on a real robot, until its end time.
@@ -80,16 +80,14 @@ impl Se2Trajectory {
     /// A trajectory through `points` in `frame`.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidTrajectory`] for no points, a non-finite time or pose, or times
+    /// [`RobotError::InvalidTrajectory`] for no points, a non-finite time or pose, or times
     /// that do not increase.
     pub fn new(
         frame: TrajectoryFrame,
         points: Vec<Se2TrajectoryPoint>,
-    ) -> Result<Self, AdapterError> {
-        let bad = |point: usize, problem: &'static str| AdapterError::InvalidTrajectory {
-            point,
-            problem,
-        };
+    ) -> Result<Self, RobotError> {
+        let bad =
+            |point: usize, problem: &'static str| RobotError::InvalidTrajectory { point, problem };
         if points.is_empty() {
             return Err(bad(0, "a trajectory needs at least one point"));
         }
@@ -214,7 +212,7 @@ mod tests {
         let empty = Se2Trajectory::new(TrajectoryFrame::Odom, vec![]);
         assert!(matches!(
             empty,
-            Err(AdapterError::InvalidTrajectory { point: 0, .. })
+            Err(RobotError::InvalidTrajectory { point: 0, .. })
         ));
         let backwards = Se2Trajectory::new(
             TrajectoryFrame::Odom,
@@ -226,12 +224,12 @@ mod tests {
         );
         assert!(matches!(
             backwards,
-            Err(AdapterError::InvalidTrajectory { point: 2, .. })
+            Err(RobotError::InvalidTrajectory { point: 2, .. })
         ));
         let nan = Se2Trajectory::new(TrajectoryFrame::Odom, vec![point(0.0, f64::NAN, 0.0)]);
         assert!(matches!(
             nan,
-            Err(AdapterError::InvalidTrajectory { point: 0, .. })
+            Err(RobotError::InvalidTrajectory { point: 0, .. })
         ));
     }
 }

@@ -1,7 +1,7 @@
 //! What a robot is, as data: its geometry and how fast it may move.
 
-use crate::error::AdapterError;
 use crate::robot::geometry::SpotGeometry;
+use slam_core::InvalidSetting;
 
 /// How fast the robot may be commanded to move; commands beyond these are clamped to them.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,15 +29,15 @@ impl MotionLimits {
     /// Every limit finite and positive.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad limit.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    /// [`InvalidSetting`] naming the first bad limit.
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         for (setting, value) in [
             ("max_forward_speed", self.max_forward_speed),
             ("max_lateral_speed", self.max_lateral_speed),
             ("max_yaw_rate", self.max_yaw_rate),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(AdapterError::InvalidConfig {
+                return Err(InvalidSetting {
                     setting,
                     value,
                     expected: "finite and positive",

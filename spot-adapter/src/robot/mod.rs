@@ -9,6 +9,7 @@
 
 mod command;
 mod description;
+mod error;
 mod geometry;
 mod interface;
 mod sample;
@@ -17,6 +18,7 @@ pub use command::{
     MobilityCommand, Se2Trajectory, Se2TrajectoryPoint, TrajectoryFrame, VelocityCommand,
 };
 pub use description::{MotionLimits, RobotDescription};
+pub use error::RobotError;
 pub use geometry::SpotGeometry;
 pub use interface::Robot;
 pub use sample::Sample;

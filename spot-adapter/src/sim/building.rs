@@ -24,7 +24,7 @@
 
 use nalgebra::{Point3, Vector2, Vector3};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::ray_cast::{BoxGrid, HitTarget, RayHit};
 use crate::sim::solid_box::{BoxId, SolidBox};
 
@@ -70,7 +70,7 @@ impl Room {
 /// let grid = building.occupancy_grid(0.1)?;
 /// let (x, y) = grid.geometry().cell_coords(corner);
 /// assert!(grid.is_free_signed(x, y));
-/// # Ok::<(), spot_adapter::AdapterError>(())
+/// # Ok::<(), spot_adapter::sim::SimError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct Building {
@@ -118,11 +118,11 @@ impl Building {
     /// robot's collision check. Returns the handle to remove it with.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidBox`] unless every corner coordinate is finite and `min < max` on
+    /// [`SimError::InvalidBox`] unless every corner coordinate is finite and `min < max` on
     /// every axis.
-    pub fn add_box(&mut self, solid: SolidBox) -> Result<BoxId, AdapterError> {
+    pub fn add_box(&mut self, solid: SolidBox) -> Result<BoxId, SimError> {
         if !solid.is_proper() {
-            return Err(AdapterError::InvalidBox);
+            return Err(SimError::InvalidBox);
         }
         let id = BoxId(self.next_id);
         self.next_id += 1;
@@ -146,14 +146,14 @@ impl Building {
     /// Move the box added as `id` to `solid`'s place (a walking person), keeping its handle.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidBox`] for a malformed box or an `id` not in the building.
-    pub fn move_box(&mut self, id: BoxId, solid: SolidBox) -> Result<(), AdapterError> {
+    /// [`SimError::InvalidBox`] for a malformed box or an `id` not in the building.
+    pub fn move_box(&mut self, id: BoxId, solid: SolidBox) -> Result<(), SimError> {
         let k = self
             .added
             .iter()
             .position(|&a| a == id)
             .filter(|_| solid.is_proper())
-            .ok_or(AdapterError::InvalidBox)?;
+            .ok_or(SimError::InvalidBox)?;
         self.boxes[self.generated + k] = solid;
         self.index = BoxGrid::new(&self.boxes, 1.0);
         Ok(())

@@ -21,9 +21,10 @@ use std::path::{Path, PathBuf};
 use slam_core::PointCloud;
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 
-use crate::error::AdapterError;
+use crate::record::RecordError;
 use crate::record::is_cloud_folder;
 use crate::robot::Sample;
+use crate::sim::SimError;
 
 /// The LiDAR's true trajectory in a cloud folder.
 pub const CLOUD_FOLDER_GROUND_TRUTH: &str = "ground_truth.tum";
@@ -68,7 +69,7 @@ impl CloudFormat {
 /// let folder = CloudFolder::open(&dir, &CloudFolderConfig::default())?;
 /// assert_eq!(folder.stamps(), [0.0, 0.2]);
 /// # std::fs::remove_dir_all(&dir).ok();
-/// # Ok::<(), spot_adapter::AdapterError>(())
+/// # Ok::<(), spot_adapter::sim::SimError>(())
 /// ```
 #[derive(Debug)]
 pub struct CloudFolderWriter {
@@ -83,17 +84,15 @@ impl CloudFolderWriter {
     /// Create the folder `dir` (or take an empty or scan-free one).
     ///
     /// # Errors
-    /// [`AdapterError::Io`] when the folder cannot be created; [`AdapterError::Recording`] when
-    /// it already holds PLY or PCD files (they would be read as scans of this run).
-    pub fn create(dir: impl AsRef<Path>, format: CloudFormat) -> Result<Self, AdapterError> {
+    /// [`SimError::Record`] with [`RecordError::Io`] when the folder cannot be created, or
+    /// [`RecordError::FolderHoldsScans`] when it already holds PLY or PCD files (they would be
+    /// read as scans of this run).
+    pub fn create(dir: impl AsRef<Path>, format: CloudFormat) -> Result<Self, SimError> {
         let dir = dir.as_ref().to_path_buf();
         if is_cloud_folder(&dir) {
-            return Err(AdapterError::Recording {
-                path: dir,
-                message: "already holds .ply or .pcd files".into(),
-            });
+            return Err(RecordError::FolderHoldsScans { path: dir }.into());
         }
-        fs::create_dir_all(&dir).map_err(|e| AdapterError::io(&dir, e))?;
+        fs::create_dir_all(&dir).map_err(|e| RecordError::io(&dir, e))?;
         Ok(Self {
             dir,
             format,
@@ -106,34 +105,40 @@ impl CloudFolderWriter {
     /// Write one sample's scan; its poses are kept for [`CloudFolderWriter::finish`].
     ///
     /// # Errors
-    /// [`AdapterError::Recording`] when its stamp (to the nanosecond, as its file is named)
-    /// does not follow the last one, or only some samples carry ground truth;
-    /// [`AdapterError::Format`] when the scan cannot be written.
-    pub fn write(&mut self, sample: &Sample) -> Result<(), AdapterError> {
-        let err = |message: String| AdapterError::Recording {
-            path: self.dir.clone(),
-            message,
-        };
+    /// [`SimError::Record`] with [`RecordError::StampNotIncreasing`] when its stamp (to the
+    /// nanosecond, as its file is named) does not follow the last one,
+    /// [`RecordError::StampNotANumber`] when it is not a number, or
+    /// [`RecordError::PartialGroundTruth`] when only some samples carry ground truth;
+    /// [`SimError::Record`] with [`RecordError::Format`] when the scan cannot be written.
+    pub fn write(&mut self, sample: &Sample) -> Result<(), SimError> {
         let name = format!("{:016.9}", sample.stamp);
         // The stamp a reader takes from the name, so the trajectories agree with it exactly.
-        let stamp: f64 = name
-            .parse()
-            .map_err(|_| err(format!("stamp {} is not a number", sample.stamp)))?;
-        if self.odometry.last().is_some_and(|last| stamp <= last.stamp) {
-            return Err(err(format!("stamp {name} does not follow the last scan's")));
+        let stamp: f64 = name.parse().map_err(|_| RecordError::StampNotANumber {
+            path: self.dir.clone(),
+            stamp: sample.stamp,
+        })?;
+        if let Some(last) = self.odometry.last().filter(|last| stamp <= last.stamp) {
+            return Err(RecordError::StampNotIncreasing {
+                path: self.dir.clone(),
+                stamp,
+                last: last.stamp,
+            }
+            .into());
         }
         if sample.ground_truth.is_some() != (self.ground_truth.len() == self.written) {
-            return Err(err(format!(
-                "sample {} differs from the first in carrying ground truth",
-                self.written
-            )));
+            return Err(RecordError::PartialGroundTruth {
+                path: self.dir.clone(),
+                sample: self.written,
+            }
+            .into());
         }
         let cloud = plain(&sample.cloud);
         let path = self.dir.join(format!("{name}.{}", self.format.extension()));
         match self.format {
-            CloudFormat::Ply => write_ply(&path, &cloud, PlyEncoding::BinaryLittleEndian)?,
-            CloudFormat::Pcd => write_pcd(&path, &cloud, PcdEncoding::Binary)?,
+            CloudFormat::Ply => write_ply(&path, &cloud, PlyEncoding::BinaryLittleEndian),
+            CloudFormat::Pcd => write_pcd(&path, &cloud, PcdEncoding::Binary),
         }
+        .map_err(RecordError::from)?;
         self.odometry.push(StampedPose {
             stamp,
             pose: sample.odom_t_body * sample.body_t_lidar,
@@ -151,11 +156,14 @@ impl CloudFolderWriter {
     /// Write the trajectories and return the folder.
     ///
     /// # Errors
-    /// [`AdapterError::Format`] when a trajectory file cannot be written.
-    pub fn finish(self) -> Result<PathBuf, AdapterError> {
-        write_tum(self.dir.join(CLOUD_FOLDER_ODOMETRY), &self.odometry)?;
+    /// [`SimError::Record`] with [`RecordError::Format`] when a trajectory file cannot be
+    /// written.
+    pub fn finish(self) -> Result<PathBuf, SimError> {
+        write_tum(self.dir.join(CLOUD_FOLDER_ODOMETRY), &self.odometry)
+            .map_err(RecordError::from)?;
         if !self.ground_truth.is_empty() {
-            write_tum(self.dir.join(CLOUD_FOLDER_GROUND_TRUTH), &self.ground_truth)?;
+            write_tum(self.dir.join(CLOUD_FOLDER_GROUND_TRUTH), &self.ground_truth)
+                .map_err(RecordError::from)?;
         }
         Ok(self.dir)
     }

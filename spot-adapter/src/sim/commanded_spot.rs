@@ -4,11 +4,11 @@
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::{Pose2, Pose3};
 
-use crate::error::AdapterError;
 use crate::robot::{
     MobilityCommand, Robot, RobotDescription, Sample, Se2Trajectory, TrajectoryFrame,
     VelocityCommand,
 };
+use crate::sim::SimError;
 use crate::sim::building::Building;
 use crate::sim::lidar::SpinningLidar;
 use crate::sim::odometry::OdometryModel;
@@ -75,7 +75,7 @@ enum Active {
 /// let sample = spot.step(VelocityCommand::new(0.5, 0.0));
 /// assert!(sample.cloud.len() > 20_000);
 /// assert!((spot.position() - start).norm() > 0.09);
-/// # Ok::<(), spot_adapter::AdapterError>(())
+/// # Ok::<(), spot_adapter::sim::SimError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct CommandedSpot {
@@ -100,23 +100,23 @@ impl CommandedSpot {
     /// `config`'s LiDAR, odometry drift, geometry, motion limits and seed.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry or limit settings or a yaw
-    /// that is not finite; [`AdapterError::BlockedEndpoint`] when the start is not free floor
+    /// [`SimError::InvalidConfig`] for invalid LiDAR, odometry or limit settings or a yaw
+    /// that is not finite; [`SimError::BlockedEndpoint`] when the start is not free floor
     /// for the robot.
     pub fn new(
         building: Building,
         position: Vector2<f64>,
         yaw: f64,
         config: &SimulationConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, SimError> {
         let lidar = SpinningLidar::new(config.lidar.clone())?;
         config.limits.validate()?;
         if !yaw.is_finite() {
-            return Err(AdapterError::invalid("yaw", yaw, "finite (radians)"));
+            return Err(SimError::invalid("yaw", yaw, "finite (radians)"));
         }
         let half_width = config.spot.half_width;
         if !(position.iter().all(|v| v.is_finite()) && building.clearance(position) >= half_width) {
-            return Err(AdapterError::BlockedEndpoint {
+            return Err(SimError::BlockedEndpoint {
                 which: "start",
                 x: position.x,
                 y: position.y,
@@ -223,8 +223,8 @@ impl CommandedSpot {
     /// the LiDAR sees it and the collision check counts it (also when it walks into the robot).
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for a speed that is not finite and positive or ends less
-    /// than 1 cm apart; [`AdapterError::InvalidBox`] for a malformed size.
+    /// [`SimError::InvalidConfig`] for a speed that is not finite and positive or ends less
+    /// than 1 cm apart; [`SimError::InvalidBox`] for a malformed size.
     pub fn add_walker(
         &mut self,
         from: Vector2<f64>,
@@ -232,9 +232,9 @@ impl CommandedSpot {
         speed: f64,
         half_size: Vector2<f64>,
         height: f64,
-    ) -> Result<BoxId, AdapterError> {
+    ) -> Result<BoxId, SimError> {
         if !(speed.is_finite() && speed > 0.0) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "speed",
                 speed,
                 "finite and positive (m/s)",
@@ -242,7 +242,7 @@ impl CommandedSpot {
         }
         let length = (to - from).norm();
         if !(length.is_finite() && length >= 0.01) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "walker path length",
                 length,
                 "finite and at least 0.01 m",
@@ -318,13 +318,13 @@ impl CommandedSpot {
 }
 
 impl Robot for CommandedSpot {
-    type Error = AdapterError;
+    type Error = SimError;
 
     fn description(&self) -> &RobotDescription {
         &self.description
     }
 
-    fn next_sample(&mut self) -> Result<Sample, AdapterError> {
+    fn next_sample(&mut self) -> Result<Sample, SimError> {
         if !self.sensed {
             return Ok(self.sense());
         }
@@ -335,13 +335,13 @@ impl Robot for CommandedSpot {
         Ok(self.step(command))
     }
 
-    fn send(&mut self, command: &MobilityCommand) -> Result<(), AdapterError> {
+    fn send(&mut self, command: &MobilityCommand) -> Result<(), SimError> {
         self.active = match command {
             MobilityCommand::Velocity(v) => Active::Velocity(*v),
             MobilityCommand::Trajectory(t) => match t.frame() {
                 TrajectoryFrame::Odom => Active::Trajectory(t.clone(), self.stamp),
                 other => {
-                    return Err(AdapterError::UnsupportedFrame {
+                    return Err(SimError::UnsupportedFrame {
                         frame: other.name(),
                     });
                 }
@@ -350,7 +350,7 @@ impl Robot for CommandedSpot {
         Ok(())
     }
 
-    fn stop(&mut self) -> Result<(), AdapterError> {
+    fn stop(&mut self) -> Result<(), SimError> {
         self.active = Active::Velocity(VelocityCommand::default());
         Ok(())
     }

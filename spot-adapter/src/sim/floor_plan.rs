@@ -4,7 +4,7 @@
 use nalgebra::Vector2;
 use slam_core::{BitGrid, GridGeometry};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::building::Building;
 
 /// Boxes whose bottom lies at or below this height (metres) block a walking robot; lintels above
@@ -50,9 +50,9 @@ impl Building {
     /// overlaps it (conservative, so thin walls are never lost) or it lies outside the building.
     ///
     /// # Errors
-    /// [`AdapterError::Grid`] for a resolution that is not finite and positive or a grid too
+    /// [`SimError::Grid`] for a resolution that is not finite and positive or a grid too
     /// large.
-    pub fn occupancy_grid(&self, resolution: f64) -> Result<BitGrid, AdapterError> {
+    pub fn occupancy_grid(&self, resolution: f64) -> Result<BitGrid, SimError> {
         let geometry = GridGeometry::try_new(Vector2::zeros(), resolution)?;
         let width = (self.size.x / resolution).ceil().max(1.0);
         let height = (self.size.y / resolution).ceil().max(1.0);

@@ -3,7 +3,7 @@
 
 use nalgebra::{Point3, Vector2};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::building::{Building, Room};
 use crate::sim::rng::SimRng;
 use crate::sim::solid_box::{BoxKind, SolidBox};
@@ -70,7 +70,7 @@ impl Default for BuildingConfig {
 }
 
 impl BuildingConfig {
-    fn validate(&self) -> Result<(), AdapterError> {
+    fn validate(&self) -> Result<(), SimError> {
         // (name of the range's low end, of its high end, the range, its floor, the requirement)
         let ranges = [
             (
@@ -132,15 +132,15 @@ impl BuildingConfig {
         ];
         for (low, high, (lo, hi), floor, expected) in ranges {
             if !(lo.is_finite() && lo >= floor) {
-                return Err(AdapterError::invalid(low, lo, expected));
+                return Err(SimError::invalid(low, lo, expected));
             }
             if !(hi.is_finite() && hi >= lo) {
-                return Err(AdapterError::invalid(high, hi, expected));
+                return Err(SimError::invalid(high, hi, expected));
             }
         }
         let t = self.wall_thickness;
         if !(t.is_finite() && t > 0.0 && t < 0.5 * self.corridor_width.0) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "wall_thickness",
                 t,
                 "positive and below half the corridor width (metres)",
@@ -150,21 +150,21 @@ impl BuildingConfig {
             && self.door_height > 1.0
             && self.door_height < self.ceiling_height.0)
         {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "door_height",
                 self.door_height,
                 "between 1 m and the lowest ceiling",
             ));
         }
         if self.door_width.1 + 1.2 > self.room_width.0 {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "door_width.1",
                 self.door_width.1,
                 "at least 1.2 m below room_width.0",
             ));
         }
         if self.furniture_per_room.0 > self.furniture_per_room.1 {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "furniture_per_room.0",
                 self.furniture_per_room.0 as f64,
                 "at most furniture_per_room.1",
@@ -304,8 +304,8 @@ impl Building {
     /// Generate the building for `seed`.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] when a range in `config` is not usable.
-    pub fn generate(seed: u64, config: &BuildingConfig) -> Result<Self, AdapterError> {
+    /// [`SimError::InvalidConfig`] when a range in `config` is not usable.
+    pub fn generate(seed: u64, config: &BuildingConfig) -> Result<Self, SimError> {
         config.validate()?;
         let mut rng = SimRng::new(seed, 0xb111_d146);
         let draw = |rng: &mut SimRng, r: (f64, f64)| rng.range(r.0, r.1);

@@ -6,7 +6,7 @@ use std::f64::consts::TAU;
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::setting_checks::{require_non_negative, require_positive};
 
 /// Seconds over which the shake fades in after the start and out before the end.
@@ -65,10 +65,10 @@ impl HandShake {
     /// Every setting valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first amplitude that is negative or not
+    /// [`SimError::InvalidConfig`] naming the first amplitude that is negative or not
     /// finite (`hand_shake.height`, `.roll`, `.pitch`, `.yaw`), or a step frequency that is
     /// not finite and positive (`hand_shake.step_frequency`).
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         require_non_negative(&[
             ("hand_shake.height", self.height),
             ("hand_shake.roll", self.roll),

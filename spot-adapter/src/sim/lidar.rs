@@ -5,7 +5,7 @@
 use nalgebra::{Point3, Vector3};
 use slam_core::{PointCloud, Pose3, interpolate};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::building::Building;
 use crate::sim::rng::SimRng;
 
@@ -101,10 +101,10 @@ impl LidarConfig {
     /// Every setting valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting: zero rings or columns,
+    /// [`SimError::InvalidConfig`] naming the first bad setting: zero rings or columns,
     /// elevations outside ±90° or rings not spaced upwards, non-positive or non-finite ranges
     /// or rates, negative noise, or a dropout probability outside `[0, 1]`.
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         let c = self;
         let right_angle = std::f64::consts::FRAC_PI_2;
         let checks = [
@@ -157,7 +157,7 @@ impl LidarConfig {
         ];
         match checks.iter().find(|c| !c.2) {
             Some(&(setting, value, _, expected)) => {
-                Err(AdapterError::invalid(setting, value, expected))
+                Err(SimError::invalid(setting, value, expected))
             }
             None => Ok(()),
         }
@@ -180,7 +180,7 @@ impl LidarConfig {
 /// let cloud = lidar.scan(&building, &world_t_lidar, &mut SimRng::new(1, 2));
 /// assert!(cloud.len() > 25_000, "walls, floor and ceiling return almost every ray");
 /// assert_eq!(cloud.ring().map(<[u16]>::len), Some(cloud.len()));
-/// # Ok::<(), spot_adapter::AdapterError>(())
+/// # Ok::<(), spot_adapter::sim::SimError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct SpinningLidar {
@@ -194,7 +194,7 @@ impl SpinningLidar {
     ///
     /// # Errors
     /// As [`LidarConfig::validate`].
-    pub fn new(config: LidarConfig) -> Result<Self, AdapterError> {
+    pub fn new(config: LidarConfig) -> Result<Self, SimError> {
         config.validate()?;
         let c = &config;
         let mut directions = Vec::with_capacity(c.rays());

@@ -20,6 +20,7 @@
 mod building;
 mod cloud_folder_writer;
 mod commanded_spot;
+mod error;
 mod floor_plan;
 mod gait_sway;
 mod generator;
@@ -42,6 +43,7 @@ pub use cloud_folder_writer::{
     CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat,
 };
 pub use commanded_spot::CommandedSpot;
+pub use error::SimError;
 pub use floor_plan::OBSTACLE_HEIGHT;
 pub use gait_sway::GaitSway;
 pub use generator::BuildingConfig;

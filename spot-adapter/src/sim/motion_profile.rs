@@ -1,7 +1,7 @@
 //! How the simulated sensor moves along its route: Spot's walk, Spot turning at corners
 //! at its full yaw rate, or a person carrying the LiDAR.
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::hand_shake::HandShake;
 use crate::sim::setting_checks::require_positive;
 
@@ -68,9 +68,9 @@ impl FastTurnsConfig {
     /// Every setting valid.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first setting that is not finite and
+    /// [`SimError::InvalidConfig`] naming the first setting that is not finite and
     /// positive (`fast_turns.acceleration`, `fast_turns.yaw_acceleration`).
-    pub fn validate(&self) -> Result<(), AdapterError> {
+    pub fn validate(&self) -> Result<(), SimError> {
         require_positive(&[
             (
                 "fast_turns.acceleration",
@@ -139,11 +139,11 @@ impl HandheldConfig {
     /// Every setting valid for a LiDAR turning at `rotation_rate` (hertz).
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] naming the first bad setting (`handheld.speed`,
+    /// [`SimError::InvalidConfig`] naming the first bad setting (`handheld.speed`,
     /// `.acceleration`, `.turn_rate`, `.turn_acceleration`, `.height`, `.sample_rate`: not
     /// finite and positive; `handheld.corner_speed` outside `[0, speed]`;
     /// `handheld.sample_rate` above `rotation_rate`), or as [`HandShake::validate`].
-    pub fn validate(&self, rotation_rate: f64) -> Result<(), AdapterError> {
+    pub fn validate(&self, rotation_rate: f64) -> Result<(), SimError> {
         require_positive(&[
             ("handheld.speed", self.speed, "finite and positive (m/s)"),
             (
@@ -173,14 +173,14 @@ impl HandheldConfig {
             ),
         ])?;
         if !(0.0..=self.speed).contains(&self.corner_speed) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "handheld.corner_speed",
                 self.corner_speed,
                 "within [0, speed] (m/s)",
             ));
         }
         if self.sample_rate > rotation_rate {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "handheld.sample_rate",
                 self.sample_rate,
                 "at most the LiDAR's rotation rate (hertz): a sample is one whole sweep",

@@ -4,7 +4,7 @@
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use slam_core::Pose3;
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::rng::SimRng;
 use crate::sim::setting_checks::require_non_negative;
 
@@ -61,9 +61,9 @@ impl OdometryModel {
     /// (`odom_T_body = identity` at the first pose), as Spot's does after power-on.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for negative or non-finite values or a vertical fraction
+    /// [`SimError::InvalidConfig`] for negative or non-finite values or a vertical fraction
     /// outside `[-1, 1]`.
-    pub fn new(config: OdometryDriftConfig, seed: u64) -> Result<Self, AdapterError> {
+    pub fn new(config: OdometryDriftConfig, seed: u64) -> Result<Self, SimError> {
         let c = &config;
         require_non_negative(&[
             ("drift_rate", c.drift_rate),
@@ -71,7 +71,7 @@ impl OdometryModel {
             ("translation_noise", c.translation_noise),
         ])?;
         if !(-1.0..=1.0).contains(&c.vertical_fraction) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "vertical_fraction",
                 c.vertical_fraction,
                 "within [-1, 1]",

@@ -5,7 +5,7 @@ use nalgebra::{Translation3, UnitQuaternion, Vector2, Vector3};
 use slam_core::io::StampedPose;
 use slam_core::{Pose2, Pose3};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::building::Building;
 
 /// Half the length of the chord whose direction gives the heading (metres): the robot starts
@@ -25,11 +25,11 @@ impl Route {
     /// A route through `points` in order. With `closed`, the route returns to the first point.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for fewer than two points, non-finite points, or a route
+    /// [`SimError::InvalidConfig`] for fewer than two points, non-finite points, or a route
     /// of zero length.
-    pub fn new(mut points: Vec<Vector2<f64>>, closed: bool) -> Result<Self, AdapterError> {
+    pub fn new(mut points: Vec<Vector2<f64>>, closed: bool) -> Result<Self, SimError> {
         if points.len() < 2 || !points.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "points",
                 points.len() as f64,
                 "at least two, all finite",
@@ -44,11 +44,7 @@ impl Route {
             cumulative.push(cumulative[cumulative.len() - 1] + (w[1] - w[0]).norm());
         }
         if cumulative[cumulative.len() - 1] <= 0.0 {
-            return Err(AdapterError::invalid(
-                "route length",
-                0.0,
-                "positive (metres)",
-            ));
+            return Err(SimError::invalid("route length", 0.0, "positive (metres)"));
         }
         Ok(Self {
             points,
@@ -131,22 +127,22 @@ impl Route {
     /// sample is the route's end (the start again for a closed route).
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for a speed or rate that is not finite and positive.
+    /// [`SimError::InvalidConfig`] for a speed or rate that is not finite and positive.
     pub fn walk(
         &self,
         speed: f64,
         rate: f64,
         body_height: f64,
-    ) -> Result<Vec<StampedPose>, AdapterError> {
+    ) -> Result<Vec<StampedPose>, SimError> {
         if !(speed.is_finite() && speed > 0.0) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "speed",
                 speed,
                 "finite and positive (m/s)",
             ));
         }
         if !(rate.is_finite() && rate > 0.0) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "rate",
                 rate,
                 "finite and positive (hertz)",

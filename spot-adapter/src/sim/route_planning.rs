@@ -8,7 +8,7 @@ use nalgebra::Vector2;
 use pathfind::{AStar, filter_path};
 use slam_core::{Cell, Planner};
 
-use crate::error::AdapterError;
+use crate::sim::SimError;
 use crate::sim::building::Building;
 use crate::sim::route::Route;
 
@@ -38,18 +38,18 @@ impl Route {
     /// and leaves through the centres of the start's and the goal's cells.
     ///
     /// # Errors
-    /// [`AdapterError::BlockedEndpoint`] when start or goal is within the clearance of an
-    /// obstacle or outside the building, [`AdapterError::NoRoute`] when they are not connected,
-    /// [`AdapterError::InvalidConfig`] for a clearance that is negative or not finite, and
-    /// [`AdapterError::Grid`] for an unusable resolution.
+    /// [`SimError::BlockedEndpoint`] when start or goal is within the clearance of an
+    /// obstacle or outside the building, [`SimError::NoRoute`] when they are not connected,
+    /// [`SimError::InvalidConfig`] for a clearance that is negative or not finite, and
+    /// [`SimError::Grid`] for an unusable resolution.
     pub fn between(
         building: &Building,
         start: Vector2<f64>,
         goal: Vector2<f64>,
         config: &RouteConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, SimError> {
         if !(config.clearance.is_finite() && config.clearance >= 0.0) {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "clearance",
                 config.clearance,
                 "finite and non-negative (metres)",
@@ -64,11 +64,11 @@ impl Route {
             &building.occupancy_grid(config.resolution)?,
             config.clearance + 1.5 * config.resolution,
         )
-        .map_err(AdapterError::NavigationGrid)?;
+        .map_err(SimError::NavigationGrid)?;
         let to_cell = |which: &'static str, p: Vector2<f64>| {
             grid.cell_at(p)
                 .filter(|&c| !grid.is_blocked(c))
-                .ok_or(AdapterError::BlockedEndpoint {
+                .ok_or(SimError::BlockedEndpoint {
                     which,
                     x: p.x,
                     y: p.y,
@@ -77,8 +77,8 @@ impl Route {
         let (s, g): (Cell, Cell) = (to_cell("start", start)?, to_cell("goal", goal)?);
         let path = AStar::new(&grid)
             .plan(s, g)
-            .map_err(AdapterError::Planner)?
-            .ok_or(AdapterError::NoRoute)?;
+            .map_err(SimError::Planner)?
+            .ok_or(SimError::NoRoute)?;
         let filtered = filter_path(&grid, &path);
         let mut kept = vec![start];
         kept.extend(filtered.waypoints.iter().map(|&c| grid.cell_center(c)));
@@ -101,8 +101,8 @@ impl Route {
 /// `goal` is measured against: [`Route::between`] keeps a wider berth and can go round.
 ///
 /// # Errors
-/// [`AdapterError::NavigationGrid`] for an `inflation` that is negative or not finite,
-/// [`AdapterError::Grid`] for an unusable resolution, [`AdapterError::Planner`] when the planner
+/// [`SimError::NavigationGrid`] for an `inflation` that is negative or not finite,
+/// [`SimError::Grid`] for an unusable resolution, [`SimError::Planner`] when the planner
 /// fails.
 pub fn shortest_length(
     building: &Building,
@@ -110,17 +110,14 @@ pub fn shortest_length(
     goal: Vector2<f64>,
     inflation: f64,
     resolution: f64,
-) -> Result<Option<f64>, AdapterError> {
+) -> Result<Option<f64>, SimError> {
     let grid = inflate(&building.occupancy_grid(resolution)?, inflation)
-        .map_err(AdapterError::NavigationGrid)?;
+        .map_err(SimError::NavigationGrid)?;
     let free = |p: Vector2<f64>| grid.cell_at(p).filter(|&c| !grid.is_blocked(c));
     let (Some(s), Some(g)) = (free(start), free(goal)) else {
         return Ok(None);
     };
-    let Some(path) = AStar::new(&grid)
-        .plan(s, g)
-        .map_err(AdapterError::Planner)?
-    else {
+    let Some(path) = AStar::new(&grid).plan(s, g).map_err(SimError::Planner)? else {
         return Ok(None);
     };
     let filtered = filter_path(&grid, &path);
@@ -136,16 +133,16 @@ impl Route {
     /// tours that enter rooms, e.g. through [`Room::entry_point`](crate::sim::Room::entry_point)s.
     ///
     /// # Errors
-    /// As [`Route::between`] for any leg; [`AdapterError::InvalidConfig`] for fewer than two
+    /// As [`Route::between`] for any leg; [`SimError::InvalidConfig`] for fewer than two
     /// waypoints.
     pub fn through(
         building: &Building,
         waypoints: &[Vector2<f64>],
         closed: bool,
         config: &RouteConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, SimError> {
         if waypoints.len() < 2 {
-            return Err(AdapterError::invalid(
+            return Err(SimError::invalid(
                 "waypoints",
                 waypoints.len() as f64,
                 "at least two points for a tour",

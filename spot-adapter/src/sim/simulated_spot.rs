@@ -5,9 +5,9 @@
 use slam_core::io::StampedPose;
 use slam_core::{Pose3, interpolate};
 
-use crate::error::AdapterError;
 use crate::record::{Recording, RecordingWriter};
 use crate::robot::{MotionLimits, Sample, SpotGeometry};
+use crate::sim::SimError;
 use crate::sim::building::Building;
 use crate::sim::gait_sway::GaitSway;
 use crate::sim::generator::BuildingConfig;
@@ -104,7 +104,7 @@ impl SimulationConfig {
 ///     assert!(sample.cloud.len() > 20_000);
 ///     assert!(sample.ground_truth.is_some());
 /// }
-/// # Ok::<(), spot_adapter::AdapterError>(())
+/// # Ok::<(), spot_adapter::sim::SimError>(())
 /// ```
 #[derive(Clone, Debug)]
 pub struct SimulatedSpot {
@@ -162,13 +162,13 @@ impl SimulatedSpot {
     /// A run along `route` through `building`, moving as `config.motion` says.
     ///
     /// # Errors
-    /// [`AdapterError::InvalidConfig`] for invalid LiDAR, odometry, speed, rate, gait sway,
+    /// [`SimError::InvalidConfig`] for invalid LiDAR, odometry, speed, rate, gait sway,
     /// motion limit or motion profile settings.
     pub fn new(
         building: Building,
         route: &Route,
         config: &SimulationConfig,
-    ) -> Result<Self, AdapterError> {
+    ) -> Result<Self, SimError> {
         let lidar = SpinningLidar::new(config.lidar.clone())?;
         let sway = &config.gait_sway;
         require_non_negative(&[
@@ -245,7 +245,7 @@ impl SimulatedSpot {
     ///
     /// # Errors
     /// As [`Building::generate`] and [`SimulatedSpot::new`].
-    pub fn corridor_loop(config: &SimulationConfig) -> Result<Self, AdapterError> {
+    pub fn corridor_loop(config: &SimulationConfig) -> Result<Self, SimError> {
         let building = Building::generate(config.seed, &config.building)?;
         let route = Route::corridor_loop(&building);
         Self::new(building, &route, config)
@@ -307,13 +307,14 @@ impl SimulatedSpot {
     /// Run the remaining samples into a recording in `dir` and open it.
     ///
     /// # Errors
-    /// As [`RecordingWriter::write`], [`RecordingWriter::finish`] and [`Recording::open`].
-    pub fn record(self, dir: impl AsRef<std::path::Path>) -> Result<Recording, AdapterError> {
+    /// [`SimError::Record`] as [`RecordingWriter::write`], [`RecordingWriter::finish`] and
+    /// [`Recording::open`].
+    pub fn record(self, dir: impl AsRef<std::path::Path>) -> Result<Recording, SimError> {
         let mut writer = RecordingWriter::create(dir, self.body_t_lidar)?;
         for sample in self {
             writer.write(&sample)?;
         }
-        Recording::open(writer.finish()?)
+        Ok(Recording::open(writer.finish()?)?)
     }
 
     /// Whether the run yields no sample (never, for a valid route).

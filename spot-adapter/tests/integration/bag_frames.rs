@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use slam_core::Pose3;
-use spot_adapter::AdapterError;
+use spot_adapter::record::RecordError;
 use spot_adapter::record::{
     Bag, BagConfig, OdometrySource, ResolvedOdometry, SourceConfig, open_recording,
 };
@@ -65,7 +65,7 @@ fn odometry_asked_for_that_does_not_reach_the_clouds_names_the_frames() {
         };
         let err = Bag::open(&path, &config).unwrap_err();
         assert!(
-            matches!(&err, AdapterError::UnlinkedLidar { body_frame, lidar_frame, .. } if body_frame.is_empty() && lidar_frame == "lidar"),
+            matches!(&err, RecordError::UnlinkedLidar { body_frame, lidar_frame, .. } if body_frame.is_empty() && lidar_frame == "lidar"),
             "{err}"
         );
         let text = err.to_string();

@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion};
-use spot_adapter::AdapterError;
+use spot_adapter::record::RecordError;
 use spot_adapter::record::{
     Bag, BagConfig, GyroCounts, ImuSource, OdometrySource, SourceConfig, open_recording,
 };
@@ -241,7 +241,7 @@ fn an_imu_not_joined_to_the_body_is_left_out_or_an_error() {
         )
         .unwrap_err();
         assert!(
-            matches!(&err, AdapterError::UnlinkedImu { imu_frame, body_frame, .. } if imu_frame == "imu_link" && body_frame == "lidar"),
+            matches!(&err, RecordError::UnlinkedImu { imu_frame, body_frame, .. } if imu_frame == "imu_link" && body_frame == "lidar"),
             "{err}"
         );
         for said in ["/tf_static: not in the bag", "--no-imu", "--base-frame"] {

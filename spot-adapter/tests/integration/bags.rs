@@ -21,14 +21,15 @@ use std::sync::OnceLock;
 
 use slam_core::PointCloud;
 use slam_core::io::StampedPose;
+use spot_adapter::MessageError;
 use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
+use spot_adapter::record::RecordError;
 use spot_adapter::record::{
     Bag, BagConfig, ImuSource, OdometrySource, PointCloud2Config, Recording, ResolvedOdometry,
     TimeUnit,
 };
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_adapter::{AdapterError, MessageError};
 
 /// Scans of the simulated lap put in the bags.
 const SCANS: usize = 40;
@@ -244,11 +245,11 @@ fn recorded_clouds(dir: &Path) -> Vec<PointCloud> {
         .collect()
 }
 
-fn layout_bag(dir: &Path, topic: &str) -> Result<Bag, AdapterError> {
+fn layout_bag(dir: &Path, topic: &str) -> Result<Bag, RecordError> {
     layout_bag_in(&layouts(dir), topic)
 }
 
-fn layout_bag_in(path: &Path, topic: &str) -> Result<Bag, AdapterError> {
+fn layout_bag_in(path: &Path, topic: &str) -> Result<Bag, RecordError> {
     Bag::open(
         path,
         &BagConfig {
@@ -319,9 +320,9 @@ fn every_layout_decodes_to_the_recorded_cloud() {
 }
 
 /// The topic, index and reason of a message error.
-fn message_error(err: &AdapterError) -> Option<(&str, usize, &MessageError)> {
+fn message_error(err: &RecordError) -> Option<(&str, usize, &MessageError)> {
     match err {
-        AdapterError::Message {
+        RecordError::Message {
             topic,
             index,
             source,
@@ -332,7 +333,7 @@ fn message_error(err: &AdapterError) -> Option<(&str, usize, &MessageError)> {
 }
 
 /// Open `path` and read every sample: whatever the bytes, an answer and no panic.
-fn read_all(path: &Path) -> Result<usize, AdapterError> {
+fn read_all(path: &Path) -> Result<usize, RecordError> {
     let bag = Bag::open(path, &BagConfig::default())?;
     let mut n = 0;
     for s in bag.samples()? {
@@ -392,7 +393,9 @@ fn bad_bags_are_clear_errors() {
         assert!(
             matches!(
                 err,
-                AdapterError::Mcap { .. } | AdapterError::Recording { .. }
+                RecordError::Mcap { .. }
+                    | RecordError::Unindexed { .. }
+                    | RecordError::Ros1Header { .. }
             ),
             "{err}"
         );
@@ -408,7 +411,7 @@ fn bad_bags_are_clear_errors() {
     )
     .unwrap_err();
     assert!(
-        matches!(&err, AdapterError::Message { topic, index: 0, source, .. } if topic == "/odom" && matches!(**source, MessageError::UnknownType { .. })),
+        matches!(&err, RecordError::Message { topic, index: 0, source, .. } if topic == "/odom" && matches!(**source, MessageError::UnknownType { .. })),
         "{err}"
     );
     // A LiDAR frame the tf tree does not hold.
@@ -421,7 +424,7 @@ fn bad_bags_are_clear_errors() {
     )
     .unwrap_err();
     assert!(
-        matches!(&err, AdapterError::UnlinkedLidar { body_frame, lidar_frame, .. } if body_frame == "base_link" && lidar_frame == "camera"),
+        matches!(&err, RecordError::UnlinkedLidar { body_frame, lidar_frame, .. } if body_frame == "base_link" && lidar_frame == "camera"),
         "{err}"
     );
     // A cloud without coordinates, and times that fit no unit.

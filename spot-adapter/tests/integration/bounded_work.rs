@@ -5,7 +5,7 @@
 #![cfg(unix)]
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-use spot_adapter::AdapterError;
+use spot_adapter::record::RecordError;
 use spot_adapter::record::{
     Bag, BagConfig, Header, PointCloud2, PointCloud2Config, PointCloud2Decoder, PointField,
 };
@@ -97,7 +97,7 @@ fn mcap_record(opcode: u8, body: &[u8]) -> Vec<u8> {
     out
 }
 
-fn open_mcap(name: &str, records: &[Vec<u8>]) -> Result<Bag, AdapterError> {
+fn open_mcap(name: &str, records: &[Vec<u8>]) -> Result<Bag, RecordError> {
     let dir = std::env::temp_dir().join(format!("spot-adapter-bounded-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
@@ -119,7 +119,7 @@ fn open_mcap_with_long_strings() {
     channel.extend_from_slice(&u32::MAX.to_le_bytes());
     channel.extend_from_slice(b"/points");
     match open_mcap("channel.mcap", &[header.clone(), mcap_record(4, &channel)]) {
-        Err(AdapterError::McapLength {
+        Err(RecordError::McapLength {
             what,
             claimed,
             left: 7,
@@ -137,7 +137,7 @@ fn open_mcap_with_long_strings() {
     assert!(
         matches!(
             err,
-            AdapterError::McapLength {
+            RecordError::McapLength {
                 what: "schema record: a string",
                 ..
             }
@@ -153,7 +153,7 @@ fn open_mcap_with_long_strings() {
         &[mcap_record(1, &long), mcap_record(12, &long)],
     )
     .unwrap_err();
-    assert!(matches!(err, AdapterError::Mcap { .. }), "{err}");
+    assert!(matches!(err, RecordError::Mcap { .. }), "{err}");
 }
 
 #[test]
@@ -182,7 +182,7 @@ fn records_past_their_uncompressed_mcap_chunk_are_refused() {
     let filler = mcap_record(12, &[0; 120]);
     let header = mcap_record(1, &[0, 0, 0, 0, 0, 0, 0, 0]);
     match open_mcap("chunk.mcap", &[header, mcap_record(6, &chunk), filler]) {
-        Err(AdapterError::McapLength {
+        Err(RecordError::McapLength {
             what,
             claimed: 100,
             left: 11,
@@ -199,7 +199,7 @@ fn open_mcap_claiming_a_gigabyte() {
     record.extend_from_slice(&((1u64 << 30) - 16).to_le_bytes());
     record.extend_from_slice(&[0; 12]);
     let err = open_mcap("claim.mcap", &[record]).unwrap_err();
-    assert!(matches!(err, AdapterError::Mcap { .. }), "{err}");
+    assert!(matches!(err, RecordError::Mcap { .. }), "{err}");
 }
 
 #[test]

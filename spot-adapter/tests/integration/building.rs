@@ -172,7 +172,7 @@ fn routes_stay_clear_of_obstacles() {
     let wall = Vector2::new(0.05, 3.0);
     assert!(matches!(
         Route::between(&b, wall, rooms[0].entry_point(), &config),
-        Err(spot_adapter::AdapterError::BlockedEndpoint { which: "start", .. })
+        Err(spot_adapter::sim::SimError::BlockedEndpoint { which: "start", .. })
     ));
 }
 

@@ -8,11 +8,12 @@ use std::fs;
 use std::path::PathBuf;
 
 use slam_core::io::read_tum;
-use spot_adapter::AdapterError;
+use spot_adapter::record::RecordError;
 use spot_adapter::record::{
     CloudFolder, CloudFolderConfig, RecordingKind, SourceConfig, open_recording,
 };
 use spot_adapter::robot::Sample;
+use spot_adapter::sim::SimError;
 use spot_adapter::sim::{
     CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat, LidarConfig,
     MotionProfile, SimulatedSpot, SimulationConfig,
@@ -157,7 +158,7 @@ fn a_spot_run_written_as_pcd_files_carries_the_lidars_poses() {
     // A folder that holds scans already is not written over.
     assert!(matches!(
         CloudFolderWriter::create(&dir, CloudFormat::Ply),
-        Err(AdapterError::Recording { .. })
+        Err(SimError::Record(RecordError::FolderHoldsScans { .. }))
     ));
     fs::remove_dir_all(&dir).unwrap();
 }

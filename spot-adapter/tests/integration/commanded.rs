@@ -5,10 +5,10 @@
 
 use nalgebra::{Point3, Vector2};
 use slam_core::Pose2;
-use spot_adapter::AdapterError;
 use spot_adapter::robot::{
     MobilityCommand, Robot, Se2Trajectory, Se2TrajectoryPoint, TrajectoryFrame, VelocityCommand,
 };
+use spot_adapter::sim::SimError;
 use spot_adapter::sim::{
     BoxKind, Building, BuildingConfig, CommandedSpot, SimulationConfig, SolidBox,
 };
@@ -93,7 +93,7 @@ fn an_odometry_frame_trajectory_is_tracked_by_the_robots_own_odometry() {
     let vision = Se2Trajectory::new(TrajectoryFrame::Vision, trajectory.points().to_vec()).unwrap();
     assert!(matches!(
         spot.send(&vision.into()),
-        Err(AdapterError::UnsupportedFrame { frame: "vision" })
+        Err(SimError::UnsupportedFrame { frame: "vision" })
     ));
 }
 

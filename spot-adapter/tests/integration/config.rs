@@ -5,6 +5,7 @@
 use nalgebra::Vector2;
 use spot_adapter::AdapterError;
 use spot_adapter::nav::{LocaliserConfig, NavigatorConfig, StuckConfig};
+use spot_adapter::sim::SimError;
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, FastTurnsConfig, HandShake, HandheldConfig,
     LidarConfig, MotionProfile, OdometryDriftConfig, OdometryModel, Route, RouteConfig,
@@ -13,11 +14,12 @@ use spot_adapter::sim::{
 
 /// Whether `r` is the invalid-setting error naming `setting`, with the value given.
 #[allow(clippy::needless_pass_by_value)] // Takes the results straight from the calls.
-fn invalid<T: std::fmt::Debug>(r: Result<T, AdapterError>, setting: &str) -> bool {
-    match r {
-        Err(AdapterError::InvalidConfig { setting: s, .. }) if s == setting => true,
-        other => {
-            eprintln!("expected an invalid {setting}, got {other:?}");
+fn invalid<T: std::fmt::Debug, E: Into<AdapterError>>(r: Result<T, E>, setting: &str) -> bool {
+    let r = r.map_err(Into::into);
+    match r.as_ref().map_err(AdapterError::invalid_setting) {
+        Err(Some(s)) if s.setting == setting => true,
+        _ => {
+            eprintln!("expected an invalid {setting}, got {r:?}");
             false
         }
     }
@@ -72,7 +74,7 @@ fn bad_settings_are_rejected() {
     r.resolution = 0.0;
     assert!(matches!(
         Route::between(&b, p, p, &r),
-        Err(AdapterError::Grid(_))
+        Err(SimError::Grid(_))
     ));
 
     let mut s = SimulationConfig::default();
@@ -126,7 +128,7 @@ fn refuses<T: std::fmt::Debug, C: Default>(
     setting: &str,
     bad: &[f64],
     set: impl Fn(&mut C, f64),
-    build: impl Fn(&C) -> Result<T, AdapterError>,
+    build: impl Fn(&C) -> Result<T, SimError>,
 ) {
     for &value in bad {
         let mut config = C::default();
@@ -175,7 +177,7 @@ fn bad_sensor_settings_are_rejected() {
 }
 
 /// A simulation of `config` on a short route (no scan is cast).
-fn simulate(config: &SimulationConfig) -> Result<SimulatedSpot, AdapterError> {
+fn simulate(config: &SimulationConfig) -> Result<SimulatedSpot, SimError> {
     let b = Building::generate(0, &BuildingConfig::default()).unwrap();
     let c = b.corridor_loop();
     let route = Route::new(vec![c[0], c[1], c[2]], false).unwrap();

@@ -7,7 +7,6 @@
 use crate::common::{Start, building_and_map, run_legs};
 use nalgebra::Vector2;
 use registration::{IcpConfig, PointToPlaneIcp};
-use spot_adapter::AdapterError;
 use spot_adapter::nav::{DriveOutcome, LocaliserConfig, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::Robot;
@@ -177,7 +176,7 @@ fn a_non_finite_goal_is_an_error_before_any_step() {
         matches!(
             result,
             Err(spot_adapter::DriveError::Navigation(
-                AdapterError::NonFiniteGoal { .. }
+                spot_adapter::nav::NavError::NonFiniteGoal { .. }
             ))
         ),
         "{result:?}"

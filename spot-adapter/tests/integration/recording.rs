@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector2};
 use slam_core::io::{write_kitti_bin, write_kitti_poses};
 use slam_core::{PointCloud, Pose3};
-use spot_adapter::AdapterError;
+use spot_adapter::record::{CalibrationProblem, IndexLineProblem, RecordError};
 use spot_adapter::record::{
     IndexEntry, KittiOdometry, KittiSequence, MAX_RECORDING_FILE_BYTES, Recording, RecordingWriter,
     calibration_text, parse_calibration, parse_index,
@@ -56,7 +56,7 @@ fn recording_round_trip() {
         ));
     }
     // The owning iterator yields the same samples, boxed like any other sample source.
-    let stream: Box<dyn Iterator<Item = Result<spot_adapter::robot::Sample, AdapterError>>> =
+    let stream: Box<dyn Iterator<Item = Result<spot_adapter::robot::Sample, RecordError>>> =
         Box::new(Recording::open(&dir).unwrap().into_iter());
     let mut count = 0;
     for (got, want) in stream.map(Result::unwrap).zip(&expected) {
@@ -91,17 +91,17 @@ fn recording_without_ground_truth() {
     with_truth.ground_truth = Some(Pose3::identity());
     assert!(matches!(
         w.write(&with_truth),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::PartialGroundTruth { sample: 1, .. })
     ));
     assert!(matches!(
         w.write(&samples[0]),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::StampNotIncreasing { .. })
     ));
     let mut moved = samples[3].clone();
     moved.body_t_lidar = Pose3::translation(0.0, 0.0, 0.5);
     assert!(matches!(
         w.write(&moved),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::MountingChanged { sample: 1, .. })
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -116,20 +116,20 @@ fn inconsistent_recordings_are_errors() {
     std::fs::write(dir.join("odometry.tum"), cut[..cut.len() - 1].join("\n")).unwrap();
     assert!(matches!(
         Recording::open(&dir),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::MissingPose { .. })
     ));
     std::fs::write(dir.join("odometry.tum"), odo).unwrap();
     assert!(Recording::open(&dir).is_ok());
     std::fs::write(dir.join("calibration.txt"), "body_T_lidar 0 0 0.3 0 0 0\n").unwrap();
     assert!(matches!(
         Recording::open(&dir),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::Calibration {
+            problem: CalibrationProblem::NotSevenFinite,
+            ..
+        })
     ));
     std::fs::remove_dir_all(&dir).unwrap();
-    assert!(matches!(
-        Recording::open(&dir),
-        Err(AdapterError::Io { .. })
-    ));
+    assert!(matches!(Recording::open(&dir), Err(RecordError::Io { .. })));
 }
 
 /// The index may only name clouds inside the recording's folder, and a broken line is reported
@@ -143,9 +143,13 @@ fn index_lines_are_checked_when_opening() {
         let edited = index.replacen("clouds/000001.pcd", bad, 1);
         std::fs::write(dir.join("index.txt"), edited).unwrap();
         match Recording::open(&dir) {
-            Err(AdapterError::Recording { path, message }) => {
+            Err(RecordError::IndexLine {
+                path,
+                line,
+                problem: IndexLineProblem::CloudOutside(_),
+            }) => {
                 assert!(path.ends_with("index.txt"), "{path:?}");
-                assert!(message.starts_with("line 4:"), "{message}");
+                assert_eq!(line, 4);
             }
             other => panic!("{bad}: {other:?}"),
         }
@@ -155,10 +159,10 @@ fn index_lines_are_checked_when_opening() {
     assert_ne!(edited, index);
     std::fs::write(dir.join("index.txt"), edited).unwrap();
     match Recording::open(&dir) {
-        Err(AdapterError::Recording { path, message }) => {
+        Err(RecordError::StampMismatch { path, line, .. }) => {
             assert!(path.ends_with("odometry.tum"), "{path:?}");
             // The odometry file has one header line, the index two.
-            assert!(message.starts_with("line 3:"), "{message}");
+            assert_eq!(line, 3);
         }
         other => panic!("{other:?}"),
     }
@@ -211,7 +215,7 @@ fn kitti_folder_reads_scans_poses_times_and_calibration() {
     std::fs::remove_file(dir.join("poses.txt")).unwrap();
     assert!(matches!(
         KittiSequence::open(&dir, KittiOdometry::GroundTruth),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::NoGroundTruth { .. })
     ));
     let seq = KittiSequence::open(&dir, KittiOdometry::None).unwrap();
     assert_eq!(
@@ -221,7 +225,7 @@ fn kitti_folder_reads_scans_poses_times_and_calibration() {
     std::fs::write(dir.join("times.txt"), "0.0\n0.1\n").unwrap();
     assert!(matches!(
         KittiSequence::open(&dir, KittiOdometry::None),
-        Err(AdapterError::Recording { .. })
+        Err(RecordError::CountMismatch { what: "times", .. })
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -234,12 +238,14 @@ fn kitti_folder_reads_scans_poses_times_and_calibration() {
 fn devices_and_oversized_files_are_refused() {
     let dir = temp_dir("devices");
     let _ = short_run().record(&dir).unwrap();
-    let refused = |dir: &std::path::Path, name: &str, what: &str| match Recording::open(dir) {
-        Err(AdapterError::Recording { path, message }) => {
-            assert!(path.ends_with(name), "{path:?}");
-            assert!(message.contains(what), "{message}");
-        }
-        other => panic!("{name}: {other:?}"),
+    let refused = |dir: &std::path::Path, name: &str, what: &str| {
+        let e = Recording::open(dir).unwrap_err();
+        let (RecordError::NotRegularFile { path } | RecordError::FileTooLarge { path, .. }) = &e
+        else {
+            panic!("{name}: {e:?}");
+        };
+        assert!(path.ends_with(name), "{path:?}");
+        assert!(e.to_string().contains(what), "{e}");
     };
     for name in ["clouds/000002.pcd", "index.txt", "calibration.txt"] {
         let file = dir.join(name);
@@ -281,8 +287,8 @@ fn index_and_calibration_text_round_trip() {
         ("0 0.1 /dev/zero", 1),
     ] {
         match parse_index(bad) {
-            Err(AdapterError::Recording { message, .. }) => {
-                assert!(message.starts_with(&format!("line {line}:")), "{message}");
+            Err(e @ RecordError::IndexLine { line: l, .. }) if l == line => {
+                assert!(e.to_string().contains(&format!("line {line}:")), "{e}");
             }
             other => panic!("{bad}: {other:?}"),
         }

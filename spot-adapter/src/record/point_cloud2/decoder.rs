@@ -4,7 +4,7 @@
 
 use slam_core::PointCloud;
 
-use crate::error::MessageError;
+use crate::record::MessageError;
 use crate::record::no_return::{DroppedPoints, PointKind, ReturnFilter};
 use crate::record::point_cloud2::columns::Rows;
 use crate::record::point_cloud2::layout::{CloudLayout, TimeFields};

@@ -7,7 +7,7 @@ use std::fmt;
 
 use slam_core::io::Scalar;
 
-use crate::error::MessageError;
+use crate::record::MessageError;
 use crate::record::ros_messages::{PointCloud2, PointField};
 
 /// Names a per-point time goes by, tried in this order.
@@ -137,12 +137,7 @@ impl CloudLayout {
         let coordinate = |axis: &'static str| -> Result<FieldSlot, MessageError> {
             let f = field(axis).ok_or_else(|| MessageError::MissingCoordinate {
                 axis,
-                fields: cloud
-                    .fields
-                    .iter()
-                    .map(|f| f.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(","),
+                fields: cloud.fields.iter().map(|f| f.name.clone()).collect(),
             })?;
             let s = slot(f, step)?;
             if s.scalar.is_integer() {
