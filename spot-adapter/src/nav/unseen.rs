@@ -17,11 +17,6 @@ use slam_core::Cell;
 /// something that moved on, or that the sensor cannot see from here. `None` when the last scan
 /// sees one of them (something stands there now: wait for it) or there are none.
 // Cell offsets within a few cells of a map cell: the casts are exact.
-#[allow(
-    clippy::cast_possible_truncation,
-    clippy::cast_sign_loss,
-    clippy::cast_precision_loss
-)]
 pub(crate) fn unseen_blockers(
     live: &LiveLayer,
     blocked: &[Cell],
