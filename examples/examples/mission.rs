@@ -24,13 +24,13 @@ use serde::Serialize;
 use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
 use spot_adapter::nav::{
-    Goal, NavigationMap, NavigationMapConfig, NavigationStep, Navigator, NavigatorConfig,
-    PlannerKind,
+    DriveOutcome, Goal, NavigationMap, NavigationMapConfig, Navigator, NavigatorConfig,
+    PlannerKind, drive,
 };
 use spot_adapter::pipelines::{
     loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places, slam_config,
 };
-use spot_adapter::robot::{MobilityCommand, Robot};
+use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
     Building, CommandedSpot, Route, RouteConfig, SimRng, SimulatedSpot, SimulationConfig,
     shortest_length,
@@ -297,7 +297,7 @@ fn random_goals(
 
 /// What one leg did, measured on the ground truth.
 struct Leg {
-    outcome: &'static str,
+    outcome: DriveOutcome,
     cycles: usize,
     walked: f64,
     worst: f64,
@@ -305,8 +305,8 @@ struct Leg {
     planned: Vec<Vector2<f64>>,
 }
 
-/// Runs `nav` on `spot` to `goal` (map frame) until it arrives, stops or reaches the scan
-/// limit, through the `Robot` interface; appends the estimate and the truth (map frame).
+/// Runs `nav` on `spot` to `goal` (map frame) through `nav::drive` until it arrives, stops or
+/// reaches the scan limit; appends the estimate and the truth (map frame).
 fn leg<R: Registrator>(
     nav: &mut Navigator<R>,
     spot: &mut CommandedSpot,
@@ -321,14 +321,15 @@ fn leg<R: Registrator>(
     let mut planned = Vec::new();
     let mut progress = Progress::new(label, "scans", None);
     let goal_world = frames.to_world(goal);
-    let mut outcome = "gave_up";
-    for cycle in 0..MAX_CYCLES {
-        let sample = spot.next_sample()?;
-        let t = Instant::now();
-        let step = nav.step(&sample, Goal::from(goal))?;
-        cycle_ms.push(t.elapsed().as_secs_f64() * 1e3);
-        let truth = frames.world_t_map.inverse() * sample.ground_truth.context("simulated")?;
-        let estimate = nav.pose();
+    let mut truth_missing = false;
+    let report = drive(spot, nav, Goal::from(goal), MAX_CYCLES, |cycle| {
+        cycle_ms.push(cycle.navigator_ms);
+        let Some(world_t_body) = cycle.sample.ground_truth else {
+            truth_missing = true;
+            return;
+        };
+        let truth = frames.world_t_map.inverse() * world_t_body;
+        let estimate = cycle.estimate;
         worst = worst.max(
             (estimate.translation.vector - truth.translation.vector)
                 .xy()
@@ -337,43 +338,32 @@ fn leg<R: Registrator>(
         walked += last.map_or(0.0, |p| (truth.translation.vector.xy() - p).norm());
         last = Some(truth.translation.vector.xy());
         trajectories.0.push(StampedPose {
-            stamp: sample.stamp,
+            stamp: cycle.sample.stamp,
             pose: estimate,
         });
         trajectories.1.push(StampedPose {
-            stamp: sample.stamp,
+            stamp: cycle.sample.stamp,
             pose: truth,
         });
-        if planned.is_empty() && !nav.waypoints().is_empty() {
+        if planned.is_empty() && !cycle.waypoints.is_empty() {
             planned.push(estimate.translation.vector.xy());
-            planned.extend_from_slice(nav.waypoints());
-        }
-        match step {
-            NavigationStep::Walk(command) => spot.send(&MobilityCommand::Velocity(command))?,
-            NavigationStep::Hold => spot.stop()?,
-            other => {
-                outcome = match other {
-                    NavigationStep::Arrived => "arrived",
-                    NavigationStep::NoPath => "no_path",
-                    NavigationStep::Blocked => "blocked",
-                    _ => "lost",
-                };
-                spot.stop()?;
-                break;
-            }
+            planned.extend_from_slice(cycle.waypoints);
         }
         progress.update(
-            cycle as u64 + 1,
+            cycle_ms.len() as u64,
             format!(
                 "{walked:.1} m walked, {:.1} m to go",
-                (goal_world - spot.position()).norm()
+                (goal_world - world_t_body.translation.vector.xy()).norm()
             ),
         );
-    }
+    })?;
     progress.finish();
+    if truth_missing {
+        bail!("the simulated Spot gave a sample without its ground truth");
+    }
     Ok(Leg {
-        outcome,
-        cycles: cycle_ms.len(),
+        outcome: report.outcome,
+        cycles: report.cycles,
         walked,
         worst,
         cycle_ms,
@@ -533,8 +523,8 @@ fn mission(args: &Args) -> Result<()> {
         let times = Timings::new(walk.cycle_ms.iter().copied());
         let summary = LegSummary {
             goal: [goal.x, goal.y],
-            outcome: walk.outcome,
-            reached: walk.outcome == "arrived" && error <= REACHED_WITHIN,
+            outcome: walk.outcome.name(),
+            reached: walk.outcome == DriveOutcome::Arrived && error <= REACHED_WITHIN,
             final_error_m: error,
             collisions,
             cycles: walk.cycles,

@@ -2,6 +2,9 @@
 //! the goal is reached, no path is left, or the cycles run out; the robot is stopped on every
 //! way out, errors included.
 
+use std::time::Instant;
+
+use nalgebra::Vector2;
 use slam_core::{Pose3, Registrator};
 
 use crate::nav::DriveError;
@@ -24,6 +27,20 @@ pub enum DriveOutcome {
     GaveUp,
 }
 
+impl DriveOutcome {
+    /// A short name for reports: `arrived`, `no_path`, `blocked`, `lost`, `gave_up`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Arrived => "arrived",
+            Self::NoPath => "no_path",
+            Self::Blocked => "blocked",
+            Self::Lost => "lost",
+            Self::GaveUp => "gave_up",
+        }
+    }
+}
+
 /// What a drive did: how it ended and the cycles it took.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DriveReport {
@@ -42,6 +59,12 @@ pub struct DriveCycle<'a> {
     pub step: &'a NavigationStep,
     /// The navigator's estimate of the body pose after localising (map frame).
     pub estimate: Pose3,
+    /// The waypoints still ahead after this cycle (map frame, metres, ending at the goal;
+    /// empty without a plan).
+    pub waypoints: &'a [Vector2<f64>],
+    /// Milliseconds the navigator took for the cycle (localise, fuse, plan, command), without
+    /// the robot's own time.
+    pub navigator_ms: f64,
 }
 
 /// Drive `robot` with `navigator` toward `goal` (map frame, metres, optionally with a heading) for at most `max_cycles`
@@ -63,13 +86,17 @@ pub fn drive<R: Robot, G: Registrator>(
     let result = (|| {
         for cycle in 1..=max_cycles {
             let sample = robot.next_sample().map_err(DriveError::Robot)?;
+            let started = Instant::now();
             let step = navigator
                 .step(&sample, goal)
                 .map_err(DriveError::Navigation)?;
+            let navigator_ms = started.elapsed().as_secs_f64() * 1e3;
             observe(&DriveCycle {
                 sample: &sample,
                 step: &step,
                 estimate: navigator.pose(),
+                waypoints: navigator.waypoints(),
+                navigator_ms,
             });
             let outcome = match step {
                 NavigationStep::Walk(command) => {
