@@ -1,0 +1,325 @@
+//! Tests of `tracker.rs`.
+
+use nalgebra::Matrix6;
+
+use super::*;
+use crate::cloud::PointCloud;
+
+/// A registrator whose basin is a cone: from a guess within `width` radians of heading of
+/// `answer` it finds `answer` (matching `share` of the scan); from farther it converges to a
+/// wrong pose matching little, or fails.
+struct Basin {
+    answer: Pose3,
+    width: f64,
+    share: f64,
+    /// The share the wrong minimum matches.
+    wrong_share: f64,
+}
+
+fn alignment(pose: Pose3, inlier_ratio: f64) -> Alignment {
+    Alignment {
+        pose,
+        converged: true,
+        iterations: 3,
+        inliers: 100,
+        inlier_ratio,
+        rmse: 0.01,
+        information: Matrix6::identity(),
+        min_eigenvalue_ratio: 1.0,
+    }
+}
+
+impl Registrator for Basin {
+    type Source = ();
+    type Target = ();
+    fn prepare_source(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn prepare_target(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
+        let off = (guess.inverse() * self.answer).rotation.angle();
+        if off <= self.width {
+            Ok(alignment(self.answer, self.share))
+        } else if off <= 2.0 * self.width {
+            // A wrong minimum near the guess.
+            Ok(alignment(*guess, self.wrong_share))
+        } else {
+            Err(RegistrationError::TooFewCorrespondences {
+                found: 3,
+                required: 20,
+            })
+        }
+    }
+    fn align_within(
+        &self,
+        s: &(),
+        t: &(),
+        guess: &Pose3,
+        _: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        self.align(s, t, guess)
+    }
+}
+
+fn yawed(degrees: f64) -> Pose3 {
+    turned(&Pose3::identity(), degrees.to_radians())
+}
+
+#[test]
+fn a_turn_beyond_the_basin_is_recovered_from_a_turned_heading() {
+    let mut tracker = Tracker::new(TrackerConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+    let scan = Basin {
+        answer: yawed(0.0),
+        width: 12f64.to_radians(),
+        share: 0.9,
+        wrong_share: 0.35,
+    };
+    // Warm up: predictions right, 90 % matched.
+    for _ in 0..5 {
+        assert!(
+            tracker
+                .track(&scan, &(), Some(&()), &[yawed(1.0)], 10.0)
+                .tracked()
+        );
+    }
+    // A sudden turn: the prediction 50 degrees off. From it the registration fails; from
+    // the heading turned by 40 or 60 degrees it finds the answer.
+    let turn = Basin {
+        answer: yawed(50.0),
+        ..scan
+    };
+    let outcome = tracker.track(&turn, &(), Some(&()), &[yawed(0.0)], 10.0);
+    assert!(outcome.tracked() && outcome.recovered, "{outcome:?}");
+    assert!((outcome.pose.rotation.angle().to_degrees() - 50.0).abs() < 1e-9);
+    assert_eq!(tracker.health().recovered, 1);
+    // The reach widened after the turn.
+    assert!(tracker.reach() > 3.0, "{}", tracker.reach());
+    // A wrong minimum matching much less than usual is suspect and retried too.
+    let near = Basin {
+        answer: yawed(20.0),
+        ..scan
+    };
+    let outcome = tracker.track(&near, &(), Some(&()), &[yawed(-2.0)], 10.0);
+    assert!(
+        outcome.recovered && outcome.alignment.is_some(),
+        "{outcome:?}"
+    );
+    assert!((outcome.pose.rotation.angle().to_degrees() - 20.0).abs() < 1e-9);
+}
+
+/// A corridor whose far pairs slide a scan: a stage reaching farther than 3 m moves the
+/// guess 5 m along it; nearer, a guess within 1 m of `answer` converges to it, and a farther
+/// one stays where it is (matching 70 %).
+struct SlidingCorridor {
+    answer: Pose3,
+}
+
+impl Registrator for SlidingCorridor {
+    type Source = ();
+    type Target = ();
+    fn prepare_source(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn prepare_target(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
+        let off = (guess.translation.vector - self.answer.translation.vector).norm();
+        Ok(if off <= 1.0 {
+            alignment(self.answer, 0.9)
+        } else {
+            alignment(*guess, 0.7)
+        })
+    }
+    fn align_within(
+        &self,
+        s: &(),
+        t: &(),
+        guess: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        if reach.distance > 3.0 {
+            let slid = Translation3::new(5.0, 0.0, 0.0) * *guess;
+            Ok(alignment(slid, 0.7))
+        } else {
+            self.align(s, t, guess)
+        }
+    }
+}
+
+#[test]
+fn a_scan_a_wide_reach_slides_along_a_corridor_is_found_at_the_initial_reach() {
+    let mut tracker = Tracker::new(TrackerConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+    // Turns the prediction misses by 15 degrees widen the reach beyond 3 m.
+    let turning = Basin {
+        answer: yawed(0.0),
+        width: 20f64.to_radians(),
+        share: 0.9,
+        wrong_share: 0.35,
+    };
+    for _ in 0..10 {
+        assert!(
+            tracker
+                .track(&turning, &(), Some(&()), &[yawed(15.0)], 10.0)
+                .tracked()
+        );
+    }
+    assert!(tracker.reach() > 3.0, "{}", tracker.reach());
+    // The wide stages slide the scan 5 m (refused as too large a correction) from the
+    // prediction and from every turned heading; the initial reach converges.
+    let corridor = SlidingCorridor {
+        answer: Pose3::from_parts(Translation3::new(0.3, 0.0, 0.0), UnitQuaternion::identity()),
+    };
+    let outcome = tracker.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
+    assert!(outcome.tracked() && outcome.recovered, "{outcome:?}");
+    assert!(
+        (outcome.pose.translation.x - 0.3).abs() < 1e-12,
+        "{outcome:?}"
+    );
+    // Without the retries the scan falls back for the refused correction.
+    let mut strict = Tracker::new(TrackerConfig {
+        retry: false,
+        ..TrackerConfig::default()
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    for _ in 0..10 {
+        strict.track(&turning, &(), Some(&()), &[yawed(15.0)], 10.0);
+    }
+    let outcome = strict.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
+    assert_eq!(outcome.fallback, Some(FallbackReason::CorrectionTooLarge));
+}
+
+#[test]
+fn without_retries_a_lost_scan_falls_back_with_its_reason_and_losses_are_counted() {
+    let config = TrackerConfig {
+        retry: false,
+        ..TrackerConfig::default()
+    };
+    let mut tracker = Tracker::new(config).unwrap_or_else(|e| panic!("{e}"));
+    let far = Basin {
+        answer: yawed(90.0),
+        width: 10f64.to_radians(),
+        share: 0.9,
+        wrong_share: 0.2,
+    };
+    for k in 1..=4 {
+        let outcome = tracker.track(&far, &(), Some(&()), &[yawed(0.0)], 10.0);
+        assert_eq!(
+            outcome.fallback,
+            Some(FallbackReason::TooFewCorrespondences)
+        );
+        assert_eq!(outcome.pose, yawed(0.0), "the prediction is kept");
+        assert_eq!(tracker.health().consecutive_fallbacks, k);
+    }
+    assert!(tracker.is_lost());
+    assert_eq!(
+        tracker.health().losses,
+        1,
+        "counted once per run of fallbacks"
+    );
+    let outcome = tracker.track(&far, &(), None, &[yawed(0.0)], 10.0);
+    assert_eq!(outcome.fallback, Some(FallbackReason::NoTarget));
+    // A wrong minimum matching too little is refused, with the refused alignment kept.
+    let wrong = Basin {
+        answer: yawed(15.0),
+        ..far
+    };
+    let outcome = tracker.track(&wrong, &(), Some(&()), &[yawed(0.0)], 10.0);
+    assert_eq!(outcome.fallback, Some(FallbackReason::TooFewInliers));
+    assert!(outcome.refused.is_some());
+    assert_eq!(tracker.health().fallbacks.total(), 6);
+    assert!(tracker.health().fallback_ratio() > 0.99);
+}
+
+#[test]
+fn every_bad_setting_is_refused_by_name() {
+    let d = TrackerConfig::default();
+    let cases = [
+        (
+            TrackerConfig {
+                coarse_kernel: 0.0,
+                ..d
+            },
+            "TrackerConfig::coarse_kernel",
+        ),
+        (
+            TrackerConfig {
+                coarse_kernel: f64::NAN,
+                ..d
+            },
+            "TrackerConfig::coarse_kernel",
+        ),
+        (
+            TrackerConfig {
+                min_inlier_ratio: -0.1,
+                ..d
+            },
+            "TrackerConfig::min_inlier_ratio",
+        ),
+        (
+            TrackerConfig {
+                min_inlier_ratio: 1.5,
+                ..d
+            },
+            "TrackerConfig::min_inlier_ratio",
+        ),
+        (
+            TrackerConfig {
+                suspect_ratio: f64::NAN,
+                ..d
+            },
+            "TrackerConfig::suspect_ratio",
+        ),
+        (
+            TrackerConfig {
+                max_translation_correction: 0.0,
+                ..d
+            },
+            "TrackerConfig::max_translation_correction",
+        ),
+        (
+            TrackerConfig {
+                max_rotation_correction: -1.0,
+                ..d
+            },
+            "TrackerConfig::max_rotation_correction",
+        ),
+        (
+            TrackerConfig {
+                arbitration_distance: f64::INFINITY,
+                ..d
+            },
+            "TrackerConfig::arbitration_distance",
+        ),
+        (
+            TrackerConfig {
+                retry_turn_step: 0.0,
+                ..d
+            },
+            "TrackerConfig::retry_turn_step",
+        ),
+        (
+            TrackerConfig { lost_after: 0, ..d },
+            "TrackerConfig::lost_after",
+        ),
+        (
+            TrackerConfig {
+                reach: ReachConfig {
+                    sigmas: 0.0,
+                    ..d.reach
+                },
+                ..d
+            },
+            "ReachConfig::sigmas",
+        ),
+    ];
+    for (config, setting) in cases {
+        assert_eq!(
+            Tracker::new(config).err().map(|e| e.setting),
+            Some(setting),
+            "{config:?}"
+        );
+    }
+}
