@@ -21,6 +21,7 @@
 
 mod cloud_file;
 mod kitti;
+mod lzf;
 mod pcd;
 mod ply;
 mod point_record;

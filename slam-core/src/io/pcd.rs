@@ -5,6 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::lzf::lzf_decompress;
 use super::point_record::{ascii_record, binary_record};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
@@ -52,7 +53,7 @@ fn line_err(line: usize, message: impl Into<String>) -> FormatError {
     }
 }
 
-fn byte_err(offset: usize, message: impl Into<String>) -> FormatError {
+pub(super) fn byte_err(offset: usize, message: impl Into<String>) -> FormatError {
     FormatError::Byte {
         offset,
         message: message.into(),
@@ -316,75 +317,6 @@ fn push_point(
     }
     sink.xyz.push(nalgebra::Point3::new(p[0], p[1], p[2]));
     Ok(())
-}
-
-/// Most bytes one byte of LZF data can expand to: a 3-byte back reference copies 264 bytes.
-const LZF_MAX_EXPANSION: usize = 88;
-
-/// Decompress PCL's LZF blocks (`binary_compressed`).
-fn lzf_decompress(input: &[u8], out_len: usize, base: usize) -> Result<Vec<u8>, FormatError> {
-    if out_len > input.len().saturating_mul(LZF_MAX_EXPANSION) {
-        return Err(byte_err(
-            base,
-            format!(
-                "{} bytes of LZF data cannot decompress to the {out_len} bytes stated",
-                input.len()
-            ),
-        ));
-    }
-    // Grow with the output rather than trusting the stated size up front.
-    let mut out = Vec::with_capacity(out_len.min(input.len().saturating_mul(4)));
-    let mut ip = 0;
-    while ip < input.len() {
-        let ctrl = usize::from(input[ip]);
-        ip += 1;
-        if ctrl < 32 {
-            let n = ctrl + 1;
-            let lit = input
-                .get(ip..ip + n)
-                .ok_or_else(|| byte_err(base + ip, "LZF literal runs past the data"))?;
-            out.extend_from_slice(lit);
-            ip += n;
-        } else {
-            let mut len = ctrl >> 5;
-            if len == 7 {
-                len += usize::from(
-                    *input
-                        .get(ip)
-                        .ok_or_else(|| byte_err(base + ip, "LZF data truncated"))?,
-                );
-                ip += 1;
-            }
-            let lo = usize::from(
-                *input
-                    .get(ip)
-                    .ok_or_else(|| byte_err(base + ip, "LZF data truncated"))?,
-            );
-            ip += 1;
-            let back = ((ctrl & 0x1f) << 8) + lo + 1;
-            let start = out
-                .len()
-                .checked_sub(back)
-                .ok_or_else(|| byte_err(base + ip, "LZF back reference before the start"))?;
-            for k in 0..len + 2 {
-                let b = out[start + k];
-                out.push(b);
-            }
-        }
-        if out.len() > out_len {
-            return Err(byte_err(
-                base + ip,
-                "LZF data decompresses past its stated size",
-            ));
-        }
-    }
-    if out.len() != out_len {
-        return Err(byte_err(
-            base + ip,
-            format!("LZF data gave {} bytes, {} stated", out.len(), out_len),
-        ));
-    }
-    Ok(out)
 }
 
 /// Parse a PCD file held in memory.
