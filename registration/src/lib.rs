@@ -57,6 +57,7 @@ mod kernel;
 mod lidar_layout;
 mod loam;
 mod loam_features;
+mod loam_matching;
 mod matcher;
 mod neighbour_cache;
 mod place_index;
