@@ -18,6 +18,7 @@
 //! multi-path).
 
 mod building;
+mod building_config;
 mod cloud_folder_writer;
 mod commanded_spot;
 mod error;
@@ -39,6 +40,7 @@ mod speed_profile;
 mod timed_walk;
 
 pub use building::{Building, Room};
+pub use building_config::BuildingConfig;
 pub use cloud_folder_writer::{
     CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat,
 };
@@ -46,7 +48,6 @@ pub use commanded_spot::CommandedSpot;
 pub use error::SimError;
 pub use floor_plan::OBSTACLE_HEIGHT;
 pub use gait_sway::GaitSway;
-pub use generator::BuildingConfig;
 pub use hand_shake::HandShake;
 pub use lidar::{LidarConfig, SpinningLidar};
 pub use motion_profile::{FastTurnsConfig, HandheldConfig, MotionProfile};
