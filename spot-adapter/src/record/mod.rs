@@ -74,6 +74,7 @@ mod no_return;
 mod point_cloud2;
 mod read_ahead;
 mod recording;
+mod recording_writer;
 mod ros_messages;
 mod source;
 mod time_unit;
@@ -100,9 +101,9 @@ pub use point_cloud2::{
 };
 pub use read_ahead::ReadAhead;
 pub use recording::{
-    IndexEntry, Recording, RecordingSamples, RecordingWriter, calibration_text, parse_calibration,
-    parse_index,
+    IndexEntry, Recording, RecordingSamples, calibration_text, parse_calibration, parse_index,
 };
+pub use recording_writer::RecordingWriter;
 pub use ros_messages::{
     Header, ImuReading, Odometry, PointCloud2, PointField, RosMessageType, TransformStamped,
 };

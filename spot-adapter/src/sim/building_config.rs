@@ -39,7 +39,7 @@ pub struct BuildingConfig {
     /// the corridor's far ends tell a LiDAR how far it walked along it: registration that
     /// keeps every PCA normal slips there (a LiDAR-only lap ends 1.34 m off), registration on
     /// plane-like normals does not (1.1 cm). The rooms behind the shut doors are left out of
-    /// [`Building::rooms`]. Default false.
+    /// [`Building::rooms`](crate::sim::Building::rooms). Default false.
     pub blank_corridor: bool,
 }
 
