@@ -327,6 +327,24 @@ fn drifting_odometry(truth: &[Pose3]) -> Vec<Pose3> {
     odom
 }
 
+/// Feeds scan `k` (0.2 s apart) of `world` seen from `truth`, with the odometry `odom`.
+fn feed<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &mut GraphSlam<R, C, O>,
+    world: &[Point3<f64>],
+    k: usize,
+    truth: &Pose3,
+    odom: Pose3,
+) -> ScanOutcome {
+    let cloud = scan(world, truth);
+    slam.process(&ScanInput {
+        stamp: k as f64 * 0.2,
+        odom_t_body: Some(odom),
+        body_t_lidar: Pose3::identity(),
+        cloud: &cloud,
+        gyro_orientation: None,
+    })
+}
+
 /// Settings for the loop with the test ICP.
 fn loop_config() -> GraphSlamConfig {
     GraphSlamConfig {
@@ -671,14 +689,7 @@ fn lap_with_odometry_jump(
         } else {
             *gt
         };
-        let cloud = scan(&world, gt);
-        slam.process(&ScanInput {
-            stamp: k as f64 * 0.2,
-            odom_t_body: Some(odom),
-            body_t_lidar: Pose3::identity(),
-            cloud: &cloud,
-            gyro_orientation: None,
-        });
+        feed(&mut slam, &world, k, gt, odom);
     }
     let end = slam.current_lidar_pose().unwrap();
     let err = (end.translation.vector - truth[n - 1].translation.vector).norm();
@@ -851,14 +862,7 @@ fn an_overflowing_keyframe_pose_is_reported_as_such() {
     let config = no_loop_config();
     let mut slam = brute_engine(config).unwrap();
     for (k, gt) in truth.iter().take(6).enumerate() {
-        let cloud = scan(&world, gt);
-        slam.process(&ScanInput {
-            stamp: k as f64 * 0.2,
-            odom_t_body: Some(*gt),
-            body_t_lidar: Pose3::identity(),
-            cloud: &cloud,
-            gyro_orientation: None,
-        });
+        feed(&mut slam, &world, k, gt, *gt);
     }
     // Points 500 m away match nothing, so no registration can stand in for the odometry.
     let far: PointCloud = PointCloud::from_points(
@@ -940,14 +944,7 @@ fn loop_steps(config: &GraphSlamConfig) -> (Vec<LoopOutcome>, slam_core::SlamRep
     .unwrap();
     let mut outcomes = Vec::new();
     for (k, (gt, od)) in truth.iter().zip(&odom).enumerate() {
-        let cloud = scan(&world, gt);
-        slam.process(&ScanInput {
-            stamp: k as f64 * 0.2,
-            odom_t_body: Some(*od),
-            body_t_lidar: Pose3::identity(),
-            cloud: &cloud,
-            gyro_orientation: None,
-        });
+        feed(&mut slam, &world, k, gt, *od);
         loop {
             match slam.loop_closure_step() {
                 LoopOutcome::Idle => break,
@@ -1050,14 +1047,7 @@ fn a_local_map_the_backend_cannot_build_is_counted_and_each_scan_falls_back() {
     )
     .unwrap();
     for (k, gt) in truth.iter().take(20).enumerate() {
-        let cloud = scan(&world, gt);
-        slam.process(&ScanInput {
-            stamp: k as f64 * 0.2,
-            odom_t_body: Some(*gt),
-            body_t_lidar: Pose3::identity(),
-            cloud: &cloud,
-            gyro_orientation: None,
-        });
+        feed(&mut slam, &world, k, gt, *gt);
     }
     let report = slam.report();
     let no_target = report.tracking.fallbacks.get(FallbackReason::NoTarget);
