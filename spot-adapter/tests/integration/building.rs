@@ -213,7 +213,10 @@ fn the_shortest_way_is_straight_where_it_can_be_and_never_longer_than_a_route() 
     assert!(shortest_length(&b, s, g, f64::NAN, res).is_err());
     assert!(shortest_length(&b, s, g, -0.1, res).is_err());
     for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
-        assert!(shortest_length(&b, s, g, 0.3, bad).is_err(), "resolution {bad}");
+        assert!(
+            shortest_length(&b, s, g, 0.3, bad).is_err(),
+            "resolution {bad}"
+        );
     }
     // Endpoints that are not finite have no cell: no way, not a panic.
     let nan = Vector2::new(f64::NAN, 1.0);
