@@ -14,7 +14,7 @@ use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
-use crate::voxel_window::VoxelWindow;
+use crate::voxel_window::{KeptNormal, VoxelKey, VoxelWindow};
 
 /// A prepared target: its points indexed for queries, or, for a local map updated in place
 /// ([`MapRegistrator::empty_map`](slam_core::MapRegistrator::empty_map)), the voxel window
@@ -43,6 +43,16 @@ struct Window {
     normals: Option<(usize, f64)>,
     normals_up_front: bool,
     min_points: usize,
+    /// What the current index's points are, slot by slot, so that the normals it computes can
+    /// be kept in their voxels for the next index.
+    built: OnceCell<BuiltFrom>,
+}
+
+/// The voxels an index of a window was built from, in its slot order.
+struct BuiltFrom {
+    keys: Vec<VoxelKey>,
+    counts: Vec<u32>,
+    kept: Vec<Option<KeptNormal>>,
 }
 
 /// Target points, their k-d tree and (optionally) unit normals.
@@ -109,13 +119,45 @@ impl PreparedTarget {
                 normals,
                 normals_up_front,
                 min_points,
+                built: OnceCell::new(),
             })),
+        }
+    }
+
+    /// Keeps in the window's voxels the normals the current index computed or reused, for the
+    /// next index: a keyframe entering or leaving the window moves a centroid by millimetres,
+    /// and recomputing every normal an alignment touches cost more than the alignment itself
+    /// (see [`crate::voxel_window::MAX_NORMAL_REUSE`] for how long one is kept).
+    fn keep_normals(&mut self) {
+        let Some(w) = self.window.as_mut() else {
+            return;
+        };
+        let (Some(Ok(index)), Some(built)) = (self.index.take(), w.built.take()) else {
+            return;
+        };
+        for (i, key) in built.keys.iter().enumerate() {
+            let Some(normal) = index.computed_normal(i) else {
+                continue;
+            };
+            let kept = match built.kept[i] {
+                Some(k) => KeptNormal {
+                    reused: k.reused + 1,
+                    ..k
+                },
+                None => KeptNormal {
+                    normal,
+                    count: built.counts[i],
+                    reused: 0,
+                },
+            };
+            w.voxels.keep_normal(key, kept);
         }
     }
 
     /// Adds `source` moved by `pose` under `key` to an in-place map (replacing what `key`
     /// held); a target prepared whole is left as it is.
     pub(crate) fn add_part(&mut self, key: u32, source: &[Point3<f64>], pose: &Pose3) {
+        self.keep_normals();
         if let Some(w) = self.window.as_mut() {
             w.voxels.add(key, source, pose);
             self.index = OnceCell::new();
@@ -125,6 +167,7 @@ impl PreparedTarget {
 
     /// Removes what `key` added to an in-place map.
     pub(crate) fn remove_part(&mut self, key: u32) {
+        self.keep_normals();
         if let Some(w) = self.window.as_mut() {
             w.voxels.remove(key);
             self.index = OnceCell::new();
@@ -147,7 +190,19 @@ impl PreparedTarget {
                         required: 1,
                     });
                 };
-                let index = TargetIndex::new(w.voxels.centroids(), w.normals, w.min_points)?;
+                let snapshot = w.voxels.snapshot();
+                let index = TargetIndex::new(snapshot.centroids, w.normals, w.min_points)?;
+                for (i, kept) in snapshot.kept.iter().enumerate() {
+                    if let Some(k) = kept {
+                        index.set_normal(i, k.normal);
+                    }
+                }
+                // Set only here, right after the index it describes is built.
+                let _ = w.built.set(BuiltFrom {
+                    keys: snapshot.keys,
+                    counts: snapshot.counts,
+                    kept: snapshot.kept,
+                });
                 if w.normals_up_front {
                     index.compute_all_normals();
                 }
@@ -325,6 +380,20 @@ impl TargetIndex {
         let cache = self.normals.as_ref()?;
         *cache.cells[i]
             .get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k, cache.min_planarity))
+    }
+
+    /// The normal of point `i` when computed (or set) already: `Some(None)` for one that is not
+    /// plane-like enough; `None` when not computed or the target has no normals.
+    fn computed_normal(&self, i: usize) -> Option<Option<Vector3<f64>>> {
+        self.normals.as_ref()?.cells.get(i)?.get().copied()
+    }
+
+    /// Sets the normal of point `i` (one kept from an earlier index of the same voxel); a
+    /// normal computed already stays.
+    fn set_normal(&self, i: usize, normal: Option<Vector3<f64>>) {
+        if let Some(cell) = self.normals.as_ref().and_then(|c| c.cells.get(i)) {
+            let _ = cell.set(normal);
+        }
     }
 
     /// Computes every normal not computed yet, on the machine's cores (each point's normal is

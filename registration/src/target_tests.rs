@@ -200,3 +200,83 @@ fn one_absurd_point_leaves_a_scan_registering_as_without_it() {
         assert!(apart.rotation.angle() < 1e-6, "{apart:?}");
     }
 }
+
+/// Normals kept from one index of an in-place map for the next agree with the normals the
+/// current centroids give (computed afresh on an index of the same points), are recomputed
+/// after `MAX_NORMAL_REUSE` indexes, and are not reused for a voxel whose points doubled.
+#[test]
+fn kept_normals_agree_with_fresh_ones_and_expire() {
+    use crate::voxel_window::MAX_NORMAL_REUSE;
+    use slam_core::{MapRegistrator, Registrator};
+    let icp = crate::PointToPlaneIcp::default();
+    // A room: floor and two walls, every 5 cm.
+    let mut room = Vec::new();
+    for i in 0..60 {
+        for j in 0..40 {
+            let (a, b) = (f64::from(i) * 0.05, f64::from(j) * 0.05);
+            room.push(Point3::new(a, b, 0.0));
+            room.push(Point3::new(a, 0.0, b * 0.5));
+            room.push(Point3::new(0.0, b, a * 0.3));
+        }
+    }
+    let cloud = PointCloud::from_points(room.iter().map(|p| p.cast::<f32>()).collect());
+    let source = icp.prepare_source(&cloud).unwrap();
+    let mut map = icp.empty_map().unwrap();
+    let mut reused_seen = 0;
+    let mut inside = 0;
+    for k in 0u32..(2 * MAX_NORMAL_REUSE + 4) {
+        // Keyframes a few centimetres apart, three in the window.
+        let pose = Pose3::new(
+            nalgebra::Vector3::new(0.013 * f64::from(k), 0.007 * f64::from(k % 3), 0.0),
+            nalgebra::Vector3::new(0.0, 0.0, 0.002 * f64::from(k % 4)),
+        );
+        icp.add_to_map(&mut map, k, &source, &pose);
+        if let Some(old) = k.checked_sub(3) {
+            icp.remove_from_map(&mut map, old);
+        }
+        let window = map.window.as_ref().unwrap();
+        let kept = window.voxels.snapshot().kept;
+        let index = map.index().unwrap();
+        let fresh = TargetIndex::new(index.points.clone(), Some((10, 0.0)), 3).unwrap();
+        for (i, kept) in kept.iter().enumerate() {
+            let Some(kept) = kept else { continue };
+            reused_seen += 1;
+            assert!(kept.reused < MAX_NORMAL_REUSE, "keyframe {k}: {kept:?}");
+            assert_eq!(
+                index.normal(i),
+                kept.normal,
+                "a kept normal is the one used"
+            );
+            let (Some(a), Some(b)) = (kept.normal, fresh.normal(i)) else {
+                panic!("keyframe {k}, point {i}: a plane's normal is missing");
+            };
+            // Inside a face (a fresh normal within 2 degrees of an axis; at an edge the ten
+            // neighbours mix two faces and any normal between them is as good), the kept
+            // normal is within 3 degrees of the fresh one, either sign.
+            if b.amax() > 2f64.to_radians().cos() {
+                assert!(a.dot(&b).abs() > 3f64.to_radians().cos(), "{a:?} vs {b:?}");
+                inside += 1;
+            }
+        }
+        // Every normal used, as an alignment against a map touches most of them.
+        index.compute_all_normals();
+    }
+    assert!(
+        reused_seen > 1000 && inside * 2 > reused_seen,
+        "normals were reused: {reused_seen}, {inside} inside a face"
+    );
+    // A voxel whose points more than doubled since its normal was computed gets a fresh one.
+    let mut map = icp.empty_map().unwrap();
+    let at = Pose3::identity();
+    icp.add_to_map(&mut map, 0, &source, &at);
+    map.index().unwrap().compute_all_normals();
+    icp.add_to_map(&mut map, 1, &source, &at);
+    let kept = map.window.as_ref().unwrap().voxels.snapshot().kept;
+    assert!(kept.iter().all(Option::is_some), "twice the points: kept");
+    icp.add_to_map(&mut map, 2, &source, &at);
+    let kept = map.window.as_ref().unwrap().voxels.snapshot().kept;
+    assert!(
+        kept.iter().all(Option::is_none),
+        "three times: computed afresh"
+    );
+}

@@ -6,7 +6,7 @@ use rustc_hash::FxHashMap;
 use slam_core::Pose3;
 
 /// Integer voxel coordinates.
-type VoxelKey = [i64; 3];
+pub(crate) type VoxelKey = [i64; 3];
 
 /// One source's points as added: each moved point with its voxel.
 type Part = Vec<(VoxelKey, Vector3<f64>)>;
@@ -16,6 +16,34 @@ type Part = Vec<(VoxelKey, Vector3<f64>)>;
 struct Cell {
     sum: Vector3<f64>,
     count: u32,
+    /// The voxel's normal as an index of the window last computed or reused it.
+    normal: Option<KeptNormal>,
+}
+
+/// A voxel's normal kept from one index of the window for the next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct KeptNormal {
+    /// The normal (`None`: the neighbourhood was not plane-like enough).
+    pub(crate) normal: Option<Vector3<f64>>,
+    /// The voxel's point count when the normal was computed.
+    pub(crate) count: u32,
+    /// Indexes it has been reused by since.
+    pub(crate) reused: u32,
+}
+
+/// A kept normal is reused by at most this many indexes of the window in a row, then computed
+/// afresh: the neighbours it came from move as keyframes enter and leave the window.
+pub(crate) const MAX_NORMAL_REUSE: u32 = 8;
+
+/// The window's centroids with their voxels and the normals kept for them.
+pub(crate) struct Snapshot {
+    pub(crate) keys: Vec<VoxelKey>,
+    pub(crate) centroids: Vec<Point3<f64>>,
+    /// Per centroid: the voxel's kept normal when it may be reused (its count within a factor
+    /// two of the count it was computed at, reused fewer than [`MAX_NORMAL_REUSE`] times).
+    pub(crate) kept: Vec<Option<KeptNormal>>,
+    /// Per centroid: the voxel's point count.
+    pub(crate) counts: Vec<u32>,
 }
 
 /// Points of sources placed in the world, thinned to one centroid per cubic voxel: the same
@@ -59,6 +87,7 @@ impl VoxelWindow {
             let cell = self.cells.entry(k).or_insert(Cell {
                 sum: Vector3::zeros(),
                 count: 0,
+                normal: None,
             });
             cell.sum += w;
             cell.count += 1;
@@ -86,11 +115,40 @@ impl VoxelWindow {
     }
 
     /// The voxel centroids.
+    #[cfg(test)]
     pub(crate) fn centroids(&self) -> Vec<Point3<f64>> {
-        self.cells
-            .values()
-            .map(|c| Point3::from(c.sum / f64::from(c.count)))
-            .collect()
+        self.snapshot().centroids
+    }
+
+    /// The voxel centroids with their keys, counts and reusable normals.
+    pub(crate) fn snapshot(&self) -> Snapshot {
+        let n = self.cells.len();
+        let mut snapshot = Snapshot {
+            keys: Vec::with_capacity(n),
+            centroids: Vec::with_capacity(n),
+            kept: Vec::with_capacity(n),
+            counts: Vec::with_capacity(n),
+        };
+        for (k, c) in &self.cells {
+            snapshot.keys.push(*k);
+            snapshot
+                .centroids
+                .push(Point3::from(c.sum / f64::from(c.count)));
+            snapshot.kept.push(c.normal.filter(|kept| {
+                kept.reused < MAX_NORMAL_REUSE
+                    && c.count <= kept.count.saturating_mul(2)
+                    && kept.count <= c.count.saturating_mul(2)
+            }));
+            snapshot.counts.push(c.count);
+        }
+        snapshot
+    }
+
+    /// Keeps `normal` for voxel `key` (ignored when the voxel is gone).
+    pub(crate) fn keep_normal(&mut self, key: &VoxelKey, normal: KeptNormal) {
+        if let Some(cell) = self.cells.get_mut(key) {
+            cell.normal = Some(normal);
+        }
     }
 
     /// Number of occupied voxels.
