@@ -31,34 +31,88 @@ const CHUNK: usize = 1 << 12;
 pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
     let times = cloud.time()?;
     let mut out = cloud.clone();
+    let path = SweepPath::new(times, twist);
     // In chunks on the machine's cores; each point's result does not depend on the chunking.
     out.points_mut()
         .par_chunks_mut(CHUNK)
         .zip(times.par_chunks(CHUNK))
         .for_each(|(points, times)| {
-            // Points of one column share a firing time and sit next to each other: one exp
-            // per run.
-            let mut cached: Option<(f32, crate::Pose3)> = None;
             for (p, &t) in points.iter_mut().zip(times) {
-                let pose = match cached {
-                    Some((ct, pose)) if ct.to_bits() == t.to_bits() => pose,
-                    _ => {
-                        let pose = se3_exp(&(twist * f64::from(t)));
-                        cached = Some((t, pose));
-                        pose
-                    }
-                };
-                let q: Point3<f32> = (pose * p.cast::<f64>()).cast::<f32>();
-                *p = q;
+                *p = path.moved(&p.cast::<f64>(), t).cast::<f32>();
             }
         });
     Some(out)
 }
 
+/// The sensor's poses over a sweep, `exp(t * twist)`, as poses at evenly spaced times that a
+/// point's own time blends between: one exponential per step of time instead of one per point
+/// (a dense scan's 44,000 voxels have as many distinct times).
+struct SweepPath {
+    twist: Vector6<f64>,
+    /// The first time, and steps per second.
+    start: f64,
+    rate: f64,
+    /// Poses at `start + k / rate`; empty when the steps would be too many (each point's pose
+    /// is then exact).
+    poses: Vec<crate::Pose3>,
+}
+
+/// The turn between two consecutive poses of a [`SweepPath`], at most 1 mrad: blending the two
+/// moves of a point `r` metres away then misses the exact one by under `r * 1.25e-7` (the chord
+/// of the blend against the arc), 0.025 mm at 200 m.
+const STEP_TURN: f64 = 1e-3;
+
+/// At most this many steps a sweep (a turn of 4 rad within one sweep); beyond, each point's
+/// pose is computed exactly.
+const MAX_STEPS: usize = 4096;
+
+impl SweepPath {
+    fn new(times: &[f32], twist: &Vector6<f64>) -> Self {
+        let (lo, hi) = times
+            .iter()
+            .filter(|t| t.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+                (lo.min(f64::from(t)), hi.max(f64::from(t)))
+            });
+        let turn = twist.fixed_rows::<3>(3).norm() * (hi - lo);
+        // A straight move (no turn) is linear in time: one step is exact.
+        let steps = (turn / STEP_TURN).ceil();
+        let mut path = Self {
+            twist: *twist,
+            start: lo,
+            rate: 0.0,
+            poses: Vec::new(),
+        };
+        if hi > lo && steps.is_finite() && steps <= MAX_STEPS as f64 {
+            let steps = (steps as usize).max(1);
+            path.rate = steps as f64 / (hi - lo);
+            path.poses = (0..=steps)
+                .map(|k| se3_exp(&(twist * (lo + k as f64 / path.rate))))
+                .collect();
+        }
+        path
+    }
+
+    /// `p`, measured at time `t`, in the frame of the sweep's start.
+    fn moved(&self, p: &Point3<f64>, t: f32) -> Point3<f64> {
+        let t = f64::from(t);
+        let s = (t - self.start) * self.rate;
+        let last = self.poses.len().saturating_sub(1);
+        if last == 0 || !(0.0..=last as f64).contains(&s) {
+            return se3_exp(&(self.twist * t)) * p;
+        }
+        // `s` is within the steps: the cast neither wraps nor saturates.
+        let k = (s as usize).min(last - 1);
+        let a = s - k as f64;
+        let (from, to) = (self.poses[k] * p, self.poses[k + 1] * p);
+        from + (to - from) * a
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{pose3_from_xyz_rpy, se3_log};
+    use crate::geometry::{pose3_from_xyz_rpy, se3_exp, se3_log};
 
     /// A static scene seen by a sensor turning and moving during its sweep: deskewing with the
     /// true motion gives back the scene in the start frame.
@@ -86,5 +140,34 @@ mod tests {
             assert!((p.cast::<f64>() - w).norm() < 1e-5, "{p} vs {w}");
         }
         assert!(deskew(&PointCloud::from_points(vec![Point3::origin()]), &twist).is_none());
+    }
+
+    /// Every point of a fast sweep (3 rad/s and 2 m/s over 0.1 s, points out to 100 m, times in
+    /// any order, one of them not finite) lands within 0.02 mm of where its own exact pose puts
+    /// it.
+    #[test]
+    fn blending_between_steps_matches_each_points_own_pose() {
+        let twist = Vector6::new(2.0, -0.5, 0.3, 0.4, -0.6, 2.9);
+        let mut points = Vec::new();
+        let mut times = Vec::new();
+        for k in 0..2000u32 {
+            let a = f64::from(k) * 0.731;
+            let r = 1.0 + f64::from(k % 100);
+            points.push(Point3::new(r * a.cos(), r * a.sin(), 0.1 * r * (2.0 * a).sin()).cast());
+            times.push(0.1 * f64::from((k * 7919) % 2000) as f32 / 2000.0);
+        }
+        times[17] = f32::NAN;
+        let cloud = PointCloud::from_points(points.clone())
+            .with_time(times.clone())
+            .unwrap();
+        let fixed = deskew(&cloud, &twist).unwrap();
+        for (i, ((p, q), &t)) in points.iter().zip(fixed.points()).zip(&times).enumerate() {
+            let exact = (se3_exp(&(twist * f64::from(t))) * p.cast::<f64>()).cast::<f32>();
+            if i == 17 {
+                assert!(!q.x.is_finite(), "a point without a time has no place");
+                continue;
+            }
+            assert!((q - exact).norm() < 2e-5, "point {i}: {q} vs {exact}");
+        }
     }
 }
