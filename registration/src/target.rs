@@ -136,7 +136,7 @@ impl PreparedTarget {
             return;
         };
         for (i, key) in built.keys.iter().enumerate() {
-            let Some(normal) = index.computed_normal(i) else {
+            let Some(&normal) = index.computed_normal(i) else {
                 continue;
             };
             let kept = match built.kept[i] {
@@ -382,10 +382,10 @@ impl TargetIndex {
             .get_or_init(|| pca_normal(&self.points, &self.tree, i, cache.k, cache.min_planarity))
     }
 
-    /// The normal of point `i` when computed (or set) already: `Some(None)` for one that is not
-    /// plane-like enough; `None` when not computed or the target has no normals.
-    fn computed_normal(&self, i: usize) -> Option<Option<Vector3<f64>>> {
-        self.normals.as_ref()?.cells.get(i)?.get().copied()
+    /// The normal of point `i` when computed (or set) already (`&None` for a neighbourhood not
+    /// plane-like enough); `None` when not computed yet or the target has no normals.
+    fn computed_normal(&self, i: usize) -> Option<&Option<Vector3<f64>>> {
+        self.normals.as_ref()?.cells.get(i)?.get()
     }
 
     /// Sets the normal of point `i` (one kept from an earlier index of the same voxel); a
