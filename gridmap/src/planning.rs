@@ -264,6 +264,18 @@ pub struct PlanningGrid {
     blocked: BitGrid,
     clearance: Vec<f32>,
     costs: Vec<f32>,
+    roomy: RoomyCache,
+}
+
+/// The last roomy mask asked for ([`PlanningGrid::roomy`]) with its clearance, kept up to date
+/// by [`PlanningGrid::refresh`]. A cache: grids equal but for it compare equal.
+#[derive(Clone, Debug, Default)]
+struct RoomyCache(std::sync::OnceLock<(f32, BitGrid)>);
+
+impl PartialEq for RoomyCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl PlanningGrid {
@@ -282,6 +294,7 @@ impl PlanningGrid {
             clearance: vec![0.0; w as usize * h as usize],
             costs: vec![1.0; w as usize * h as usize],
             config,
+            roomy: RoomyCache::default(),
         };
         grid.recompute(
             occupancy,
@@ -355,7 +368,11 @@ impl PlanningGrid {
                 self.clearance[i] = metres as f32;
                 self.costs[i] = self.config.cost.multiplier(metres);
                 // The same test as `inflate`, so that the blocked cells are `inflate`'s.
-                self.blocked.set(Cell::new(x, y), d2 <= limit)?;
+                let blocked = d2 <= limit;
+                self.blocked.set(Cell::new(x, y), blocked)?;
+                if let Some((min_clearance, roomy)) = self.roomy.0.get_mut() {
+                    roomy.set(Cell::new(x, y), blocked || (metres as f32) < *min_clearance)?;
+                }
             }
         }
         Ok(())
@@ -386,6 +403,55 @@ impl PlanningGrid {
     #[must_use]
     pub fn clearance(&self) -> &[f32] {
         &self.clearance
+    }
+
+    /// The blocked cells and every cell closer than `min_clearance` metres to an obstacle: the
+    /// grid on which straight segments between a path's waypoints keep room to spare. The mask
+    /// of the last clearance asked for is kept and kept up to date by [`Self::refresh`], so a
+    /// navigator that asks every plan builds it once per map; another clearance is computed
+    /// afresh. A clearance beyond the reach blocks every cell (clearances are capped there).
+    ///
+    /// ```
+    /// use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid, PlanningGridConfig};
+    /// use nalgebra::{Point3, Vector2};
+    /// use slam_core::PointCloud;
+    ///
+    /// // A room of 4 m by 4 m, its walls sampled every 5 cm at the LiDAR's height.
+    /// let mut walls = Vec::new();
+    /// for i in 0..=80 {
+    ///     let a = i as f32 * 0.05;
+    ///     walls.extend([[a, 0.0], [a, 4.0], [0.0, a], [4.0, a]].map(|[x, y]| Point3::new(x, y, 0.5)));
+    /// }
+    /// let occupancy = OccupancyGridBuilder::new(OccupancyGridConfig::default())?
+    ///     .build(&PointCloud::from_points(walls), 0.5)?;
+    /// let planning = PlanningGrid::new(&occupancy, PlanningGridConfig::default())?;
+    /// let roomy = planning.roomy(0.6);
+    /// let cell = |x, y| planning.blocked().cell_at(Vector2::new(x, y)).unwrap();
+    /// // 0.45 m from a wall: free to stand on, not roomy; the middle is both.
+    /// assert!(!planning.blocked().is_blocked(cell(2.0, 0.45)) && roomy.is_blocked(cell(2.0, 0.45)));
+    /// assert!(!roomy.is_blocked(cell(2.0, 2.0)));
+    /// # Ok::<(), gridmap::GridMapError>(())
+    /// ```
+    #[must_use]
+    pub fn roomy(&self, min_clearance: f64) -> std::borrow::Cow<'_, BitGrid> {
+        let limit = min_clearance as f32;
+        let mask = || {
+            let mut roomy = self.blocked.clone();
+            let w = self.blocked.width() as usize;
+            for (k, &d) in self.clearance.iter().enumerate() {
+                if d < limit {
+                    // The cell exists: k indexes the grid's cells.
+                    let _ = roomy.set(Cell::new((k % w) as u32, (k / w) as u32), true);
+                }
+            }
+            roomy
+        };
+        let (kept, roomy) = self.roomy.0.get_or_init(|| (limit, mask()));
+        if kept.to_bits() == limit.to_bits() {
+            std::borrow::Cow::Borrowed(roomy)
+        } else {
+            std::borrow::Cow::Owned(mask())
+        }
     }
 
     /// Whether the cost is on (a positive weight): plan with a cost-aware planner; otherwise

@@ -89,6 +89,9 @@ proptest! {
         let mut occupancy = random_occupancy(w, h, density, 5, seed);
         let cfg = config(seed % 2 == 0, 0.3, weight);
         let mut layer = PlanningGrid::new(&occupancy, cfg.clone()).unwrap();
+        // The roomy mask asked for before the change is kept and refreshed with the layer.
+        let min_clearance = 0.45;
+        let _ = layer.roomy(min_clearance);
         let (x0, y0) = (rect.0 % w, rect.1 % h);
         let changed = CellRect { x0, y0, x1: (x0 + rect.2).min(w), y1: (y0 + rect.3).min(h) };
         let mut s = seed.rotate_left(17) | 1;
@@ -109,6 +112,17 @@ proptest! {
             prop_assert!((a - b).abs() < 1e-6);
         }
         prop_assert_eq!(layer.step_costs(), rebuilt.step_costs());
+        // Against the mask from its definition on the rebuilt layer: blocked, or nearer an
+        // obstacle than the clearance.
+        let mut want = rebuilt.blocked().clone();
+        for (k, &d) in rebuilt.clearance().iter().enumerate() {
+            if d < min_clearance as f32 {
+                want.set(Cell::new(k as u32 % w, k as u32 / w), true).unwrap();
+            }
+        }
+        prop_assert_eq!(&*layer.roomy(min_clearance), &want);
+        prop_assert_eq!(&*rebuilt.roomy(min_clearance), &want);
+        prop_assert_eq!(&*layer.roomy(0.7), &*rebuilt.roomy(0.7));
     }
 }
 

@@ -171,7 +171,7 @@ fn waypoints_along(
 ) -> Vec<Vector2<f64>> {
     let grid = planning.blocked();
     // Shortcuts only where they keep room to spare; in narrow places the path's cells.
-    let roomy = roomy_grid(planning, shortcut_clearance);
+    let roomy = planning.roomy(shortcut_clearance);
     let filtered = filter_path(&roomy, path);
     let mut waypoints: Vec<Vector2<f64>> = filtered
         .waypoints
@@ -186,24 +186,6 @@ fn waypoints_along(
         waypoints.push(goal);
     }
     waypoints
-}
-
-/// The planning grid with every cell closer than `shortcut_clearance` (metres) to an obstacle
-/// blocked too: the grid straight segments between waypoints must keep to.
-fn roomy_grid(planning: &PlanningGrid, shortcut_clearance: f64) -> BitGrid {
-    let grid = planning.blocked();
-    let limit = shortcut_clearance as f32;
-    let clearance = planning.clearance();
-    let mut roomy = grid.clone();
-    let w = grid.width() as usize;
-    for (k, &d) in clearance.iter().enumerate() {
-        if d < limit {
-            let c = Cell::new((k % w) as u32, (k / w) as u32);
-            // The cell exists: k indexes the grid's cells.
-            let _ = roomy.set(c, true);
-        }
-    }
-    roomy
 }
 
 /// Length of a chain of 8-connected cells, in cells.
