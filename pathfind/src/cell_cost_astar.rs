@@ -40,6 +40,26 @@ struct Node {
     stamp: u32,
 }
 
+/// What a [`CellCostAStar`] keeps for the next planner on the same grid
+/// ([`CellCostAStar::into_memory`], [`CellCostAStar::with_memory`]): the grid's component labels
+/// and the search records.
+pub struct CellCostMemory {
+    labelled: BitGrid,
+    components: Components,
+    closed: ClosedSet,
+    nodes: Vec<Node>,
+    generation: u32,
+}
+
+impl std::fmt::Debug for CellCostMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CellCostMemory")
+            .field("width", &self.labelled.width())
+            .field("height", &self.labelled.height())
+            .finish_non_exhaustive()
+    }
+}
+
 /// Generations run from 1 to this value, then the stamps are cleared once.
 const MAX_GENERATION: u32 = u32::MAX >> 1;
 
@@ -144,6 +164,9 @@ impl Units {
 pub struct CellCostAStar<'g> {
     grid: &'g BitGrid,
     costs: &'g [f32],
+    /// The grid `components` labels (a copy, so that a planner built again from this one's
+    /// memory can tell whether the grid changed).
+    labelled: BitGrid,
     components: Components,
     closed: ClosedSet,
     nodes: Vec<Node>,
@@ -178,6 +201,60 @@ impl<'g> CellCostAStar<'g> {
     /// [`PathfindError::CellCostsTooLarge`] when the largest multiplier times the free cells
     /// exceeds `2^46 / sqrt(2)` (about 5e13).
     pub fn new(grid: &'g BitGrid, costs: &'g [f32]) -> Result<Self, PathfindError> {
+        Self::build(grid, costs, None)
+    }
+
+    /// [`CellCostAStar::new`] reusing what an earlier planner kept ([`Self::into_memory`]): on
+    /// the grid that planner had (compared cell by cell) the component labels are kept, and on
+    /// a grid of the same size the search records' memory; only the costs are checked again.
+    /// A navigator that plans again and again on one map builds the labels once per map change.
+    /// The paths are those of a new planner.
+    ///
+    /// ```
+    /// use pathfind::CellCostAStar;
+    /// use slam_core::{BitGrid, Cell, Planner};
+    ///
+    /// let mut grid = BitGrid::new(20, 20)?;
+    /// let costs = vec![1.0; 400];
+    /// let mut planner = CellCostAStar::new(&grid, &costs)?;
+    /// assert!(planner.plan(Cell::new(0, 0), Cell::new(19, 19))?.is_some());
+    /// let memory = planner.into_memory();
+    /// // A wall across the grid: the labels are made again, and the goal is out of reach.
+    /// for y in 0..20 {
+    ///     grid.set(Cell::new(10, y), true)?;
+    /// }
+    /// let mut planner = CellCostAStar::with_memory(&grid, &costs, memory)?;
+    /// assert_eq!(planner.plan(Cell::new(0, 0), Cell::new(19, 19))?, None);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`CellCostAStar::new`].
+    pub fn with_memory(
+        grid: &'g BitGrid,
+        costs: &'g [f32],
+        memory: CellCostMemory,
+    ) -> Result<Self, PathfindError> {
+        Self::build(grid, costs, Some(memory))
+    }
+
+    /// What a later planner on the same grid can reuse ([`Self::with_memory`]).
+    #[must_use]
+    pub fn into_memory(self) -> CellCostMemory {
+        CellCostMemory {
+            labelled: self.labelled,
+            components: self.components,
+            closed: self.closed,
+            nodes: self.nodes,
+            generation: self.generation,
+        }
+    }
+
+    fn build(
+        grid: &'g BitGrid,
+        costs: &'g [f32],
+        memory: Option<CellCostMemory>,
+    ) -> Result<Self, PathfindError> {
         let largest = check_costs(grid, costs)?;
         // The costliest simple path visits every free cell once: keep it and its priority (g
         // plus a heuristic of at most the grid's octile diameter) below 2^62.
@@ -202,20 +279,39 @@ impl<'g> CellCostAStar<'g> {
         } else {
             Queue::Heap(KeyHeap::default())
         };
+        let same_size = |m: &CellCostMemory| {
+            (m.labelled.width(), m.labelled.height()) == (grid.width(), grid.height())
+        };
+        let memory = match memory.filter(same_size) {
+            Some(m) if m.labelled == *grid => m,
+            Some(m) => CellCostMemory {
+                labelled: grid.clone(),
+                components: Components::new(grid),
+                ..m
+            },
+            None => CellCostMemory {
+                labelled: grid.clone(),
+                components: Components::new(grid),
+                closed: ClosedSet::new(grid),
+                nodes: vec![
+                    Node {
+                        g: 0,
+                        parent: 0,
+                        stamp: 0,
+                    };
+                    grid.len()
+                ],
+                generation: 0,
+            },
+        };
         Ok(Self {
             grid,
             costs,
-            components: Components::new(grid),
-            closed: ClosedSet::new(grid),
-            nodes: vec![
-                Node {
-                    g: 0,
-                    parent: 0,
-                    stamp: 0,
-                };
-                grid.len()
-            ],
-            generation: 0,
+            labelled: memory.labelled,
+            components: memory.components,
+            closed: memory.closed,
+            nodes: memory.nodes,
+            generation: memory.generation,
             open,
             same_f: Vec::new(),
             current_f: 0,

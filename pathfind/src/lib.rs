@@ -68,7 +68,7 @@ mod path_filter;
 mod search_space;
 
 pub use astar::AStar;
-pub use cell_cost_astar::{CellCostAStar, CostedPath};
+pub use cell_cost_astar::{CellCostAStar, CellCostMemory, CostedPath};
 pub use components::Components;
 pub use dijkstra::Dijkstra;
 pub use error::PathfindError;

@@ -162,6 +162,50 @@ proptest! {
             }
         }
     }
+
+    /// A planner built from an earlier one's memory, on the same grid or after cells flipped
+    /// (walls that cut or join components) and costs changed, answers as a new planner and as
+    /// the brute force: stale component labels would call a joined goal unreachable.
+    #[test]
+    fn a_planner_from_memory_answers_as_a_new_one(
+        w in 2u32..50, h in 2u32..50, density in 0u32..=45, seed in any::<u64>(), kind in 0u8..4,
+        rounds in proptest::collection::vec((0usize..40, any::<u64>(), any::<u64>(), any::<u64>()), 1..6),
+    ) {
+        let mut grid = random_grid(w, h, density, seed);
+        let mut costs = random_costs(grid.len(), kind, seed);
+        let mut memory = CellCostAStar::new(&grid, &costs).unwrap().into_memory();
+        let mut r = xorshift(seed.rotate_left(7));
+        for (flips, a, b, cost_seed) in rounds {
+            for _ in 0..flips {
+                let c = Cell::new((r() % u64::from(w)) as u32, (r() % u64::from(h)) as u32);
+                let blocked = grid.is_blocked(c);
+                grid.set(c, !blocked).unwrap();
+            }
+            if cost_seed % 3 == 0 {
+                costs = random_costs(grid.len(), kind, cost_seed);
+            }
+            let mut reused = CellCostAStar::with_memory(&grid, &costs, memory).unwrap();
+            let mut fresh = CellCostAStar::new(&grid, &costs).unwrap();
+            if let (Some(start), Some(goal)) = (free_cell(&grid, a), free_cell(&grid, b)) {
+                let got = reused.plan_with_cost(start, goal).unwrap();
+                prop_assert_eq!(&got, &fresh.plan_with_cost(start, goal).unwrap());
+                let want = oracle(&grid, &costs, start, goal);
+                prop_assert_eq!(got.is_some(), want.is_some());
+                if let (Some(p), Some(want)) = (got, want) {
+                    prop_assert!((p.cost - want).abs() <= 1e-9 * want.max(1.0));
+                }
+            }
+            memory = reused.into_memory();
+        }
+        // A grid of another size starts afresh.
+        let other = random_grid(w + 1, h, density, seed);
+        let other_costs = vec![1.0; other.len()];
+        let mut planner = CellCostAStar::with_memory(&other, &other_costs, memory).unwrap();
+        let mut fresh = CellCostAStar::new(&other, &other_costs).unwrap();
+        if let (Some(start), Some(goal)) = (free_cell(&other, 1), free_cell(&other, 99)) {
+            prop_assert_eq!(planner.plan(start, goal).unwrap(), fresh.plan(start, goal).unwrap());
+        }
+    }
 }
 
 #[test]
