@@ -8,7 +8,7 @@ use slam_core::{BitGrid, Cell};
 
 use crate::nav::NavError;
 use crate::nav::config::{NavigatorConfig, PlannerKind};
-use crate::nav::path::{Plan, dense_path};
+use crate::nav::path::{Plan, PlannerMemory, dense_path};
 
 /// A periodic replan may not lead back within this distance (metres) of where an earlier path
 /// to the same goal was blocked: about a box's half width plus the hard inflation.
@@ -58,6 +58,8 @@ pub(crate) struct DetourPolicy {
     /// box are hit by fewer beams), and without this the robot turned back and forth between
     /// the way past it and the way round.
     blocked_at: Vec<Vector2<f64>>,
+    /// The planner's memory on the map's own planning grid.
+    memory: PlannerMemory,
 }
 
 impl DetourPolicy {
@@ -71,6 +73,7 @@ impl DetourPolicy {
             unchanged_for: 0,
             waited_out_for: None,
             blocked_at: Vec::new(),
+            memory: PlannerMemory::default(),
         }
     }
 
@@ -153,7 +156,7 @@ impl DetourPolicy {
         if live_length.is_some_and(|l| l <= (goal - position).norm() + extra) {
             return Ok(None);
         }
-        let Some(map_path) = dense_path(map_only, planner, position, goal)? else {
+        let Some(map_path) = dense_path(map_only, planner, &self.memory, position, goal)? else {
             return Ok(None);
         };
         let map_length = map_path.length * resolution;

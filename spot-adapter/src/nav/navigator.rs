@@ -12,7 +12,7 @@ use crate::nav::controller::Controller;
 use crate::nav::detour::{DetourPolicy, Wait};
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::path::Plan;
+use crate::nav::path::{Plan, PlannerMemory};
 use crate::nav::stuck::{StuckMonitor, StuckState};
 use crate::nav::unseen::unseen_blockers;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
@@ -83,6 +83,8 @@ pub struct Navigator<R: Registrator> {
     /// The planning grid of the map alone, without the live layer's changes: how far the way
     /// would be if what is new moved away.
     static_planning: PlanningGrid,
+    /// The planner's memory on `planning`, kept from plan to plan.
+    memory: PlannerMemory,
     /// The path being followed and its waypoints.
     plan: Plan,
     /// The goal the path leads to.
@@ -134,6 +136,7 @@ impl<R: Registrator> Navigator<R> {
             static_planning,
             config,
             limits: robot.limits.clone(),
+            memory: PlannerMemory::default(),
             plan: Plan::default(),
             planned_for: None,
             cycles_since_plan: 0,
@@ -336,6 +339,7 @@ impl<R: Registrator> Navigator<R> {
         Plan::search(
             &self.planning,
             c.planner,
+            &self.memory,
             c.shortcut_clearance,
             position,
             goal,

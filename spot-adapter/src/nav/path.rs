@@ -3,11 +3,25 @@
 
 use gridmap::PlanningGrid;
 use nalgebra::Vector2;
-use pathfind::{AStar, CellCostAStar, JumpPointSearch, filter_path};
+use std::cell::RefCell;
+
+use pathfind::{AStar, CellCostAStar, CellCostMemory, JumpPointSearch, filter_path};
 use slam_core::{BitGrid, Cell, GridPath, Planner};
 
 use crate::nav::NavError;
 use crate::nav::config::PlannerKind;
+
+/// What the cost-aware planner keeps from one plan to the next on a grid (its component labels
+/// and search records, [`CellCostMemory`]): a replan on an unchanged map builds neither again,
+/// and on a changed one only the labels. A cache: a clone starts empty.
+#[derive(Debug, Default)]
+pub(crate) struct PlannerMemory(RefCell<Option<CellCostMemory>>);
+
+impl Clone for PlannerMemory {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
 
 /// A path to the goal and the waypoints along it, kept together from the plan to the goal: the
 /// path's cells are what the blocked-path test and the detour policy read, the waypoints what
@@ -45,11 +59,12 @@ impl Plan {
     pub(crate) fn search(
         planning: &PlanningGrid,
         planner: PlannerKind,
+        memory: &PlannerMemory,
         shortcut_clearance: f64,
         position: Vector2<f64>,
         goal: Vector2<f64>,
     ) -> Result<Option<Self>, NavError> {
-        let Some(path) = dense_path(planning, planner, position, goal)? else {
+        let Some(path) = dense_path(planning, planner, memory, position, goal)? else {
             return Ok(None);
         };
         let waypoints = waypoints_along(planning, shortcut_clearance, &path, goal);
@@ -128,10 +143,12 @@ impl Plan {
 }
 
 /// The path on `planning` from `position` to `goal` by `planner` with every cell, its length
-/// that of those cells, or `None` when none joins them (see [`Plan::search`]).
+/// that of those cells, or `None` when none joins them (see [`Plan::search`]); the cost-aware
+/// planner reuses and keeps `memory`.
 pub(crate) fn dense_path(
     planning: &PlanningGrid,
     planner: PlannerKind,
+    memory: &PlannerMemory,
     position: Vector2<f64>,
     goal: Vector2<f64>,
 ) -> Result<Option<GridPath>, NavError> {
@@ -143,9 +160,17 @@ pub(crate) fn dense_path(
         return Ok(None);
     };
     let path: Option<GridPath> = match planner {
-        PlannerKind::CellCostAStar => CellCostAStar::new(grid, planning.step_costs())
-            .map_err(NavError::PlanningCosts)?
-            .plan(start, goal_cell),
+        PlannerKind::CellCostAStar => {
+            let costs = planning.step_costs();
+            let mut search = match memory.0.borrow_mut().take() {
+                Some(kept) => CellCostAStar::with_memory(grid, costs, kept),
+                None => CellCostAStar::new(grid, costs),
+            }
+            .map_err(NavError::PlanningCosts)?;
+            let found = search.plan(start, goal_cell);
+            *memory.0.borrow_mut() = Some(search.into_memory());
+            found
+        }
         PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
         PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
     }
