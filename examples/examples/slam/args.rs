@@ -1,35 +1,15 @@
 //! The command line: `Args`, its value types, and the recording's source settings from it.
 
-use std::convert::Infallible;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Parser, ValueEnum};
-use gridmap::{UnknownCells, inflate};
-use nalgebra::{Translation3, Vector2};
-use posegraph::g2o::{G2oGraph, write_g2o};
-use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
-use slam_core::{
-    EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
-    quaternion_from_xyzw,
-};
-use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
+use nalgebra::Translation3;
+use slam_core::{Pose3, quaternion_from_xyzw};
 use spot_adapter::record::{
-    BagConfig, DroppedPoints, ImuSource, OdometrySource, PointCloud2Config, ReadAhead,
-    ReturnFilter, SampleSource, SourceConfig, TimeUnit, open_recording,
+    BagConfig, ImuSource, OdometrySource, PointCloud2Config, ReturnFilter, SourceConfig, TimeUnit,
 };
-use spot_adapter::robot::Sample;
-use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_nav_examples::health::skip_reasons;
-use spot_nav_examples::summary::{
-    Accuracy, Input, Loops, Points, SlamSummary, Times, write_summary,
-};
-use spot_nav_examples::{
-    GroundTruthFile, MappedScans, Mapping, Motion, Registration, Sensor, evaluate, map_samples,
-    out, parse_numbers, print_tracking_health, value_name,
-};
+use spot_nav_examples::{Motion, Registration, Sensor, parse_numbers};
 
 /// A per-point time unit, as `--time-unit` gives it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

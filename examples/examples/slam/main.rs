@@ -15,35 +15,19 @@ mod args;
 mod report;
 
 use std::convert::Infallible;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
-use clap::{Parser, ValueEnum};
-use gridmap::{UnknownCells, inflate};
-use nalgebra::{Translation3, Vector2};
-use posegraph::g2o::{G2oGraph, write_g2o};
-use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
-use slam_core::{
-    EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
-    quaternion_from_xyzw,
-};
-use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
+use anyhow::Result;
+use clap::Parser;
+use slam_core::io::StampedPose;
+use slam_core::{EdgeInformation, GraphSlamConfig, Pose3};
 use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
-use spot_adapter::record::{
-    BagConfig, DroppedPoints, ImuSource, OdometrySource, PointCloud2Config, ReadAhead,
-    ReturnFilter, SampleSource, SourceConfig, TimeUnit, open_recording,
-};
+use spot_adapter::record::{DroppedPoints, ReadAhead, SampleSource, open_recording};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
-use spot_nav_examples::health::skip_reasons;
-use spot_nav_examples::summary::{
-    Accuracy, Input, Loops, Points, SlamSummary, Times, write_summary,
-};
-use spot_nav_examples::{
-    GroundTruthFile, MappedScans, Mapping, Motion, Registration, Sensor, evaluate, map_samples,
-    out, parse_numbers, print_tracking_health, value_name,
-};
+use spot_nav_examples::summary::Input;
+use spot_nav_examples::{GroundTruthFile, Registration, map_samples, out};
 
 use args::{Args, OdometryInformation, source_config};
 use report::finish;
@@ -51,6 +35,7 @@ use report::finish;
 fn main() -> ExitCode {
     spot_nav_examples::run(|| slam(&Args::parse()))
 }
+
 /// Scans read ahead of the engine (each a few hundred kB to a few MB).
 const READ_AHEAD: usize = 4;
 

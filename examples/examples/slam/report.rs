@@ -1,41 +1,25 @@
 //! The run's figures: evaluated, printed, and written with the map and grid to `--out`.
 
-use std::convert::Infallible;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use std::path::Path;
 
 use anyhow::{Context, Result};
-use clap::{Parser, ValueEnum};
 use gridmap::{UnknownCells, inflate};
-use nalgebra::{Translation3, Vector2};
+use nalgebra::Vector2;
 use posegraph::g2o::{G2oGraph, write_g2o};
-use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
-use slam_core::{
-    EdgeInformation, GraphSlam, GraphSlamConfig, MapRegistrator, Optimizer, Pose3,
-    quaternion_from_xyzw,
-};
+use slam_core::io::{PcdEncoding, PlyEncoding, write_pcd, write_ply, write_tum};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
-use spot_adapter::record::{
-    BagConfig, DroppedPoints, ImuSource, OdometrySource, PointCloud2Config, ReadAhead,
-    ReturnFilter, SampleSource, SourceConfig, TimeUnit, open_recording,
-};
-use spot_adapter::robot::Sample;
-use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
+use spot_adapter::record::DroppedPoints;
 use spot_nav_examples::health::skip_reasons;
-use spot_nav_examples::summary::{
-    Accuracy, Input, Loops, Points, SlamSummary, Times, write_summary,
-};
-use spot_nav_examples::{
-    GroundTruthFile, MappedScans, Mapping, Motion, Registration, Sensor, evaluate, map_samples,
-    out, parse_numbers, print_tracking_health, value_name,
-};
+use spot_nav_examples::summary::{Accuracy, Loops, Points, SlamSummary, Times, write_summary};
+use spot_nav_examples::{MappedScans, Mapping, evaluate, out, print_tracking_health, value_name};
 
 use crate::args::Args;
 use crate::{RunContext, Truth};
 
 /// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
 const INFLATION: f64 = 0.30;
+
 /// Evaluates the run against the ground truth (when known), prints its figures and writes the
 /// outputs.
 pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
