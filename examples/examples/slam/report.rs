@@ -1,0 +1,234 @@
+//! The run's figures: evaluated, printed, and written with the map and grid to `--out`.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use gridmap::{UnknownCells, inflate};
+use nalgebra::Vector2;
+use posegraph::g2o::{G2oGraph, write_g2o};
+use slam_core::io::{PcdEncoding, PlyEncoding, write_pcd, write_ply, write_tum};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
+use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
+use spot_adapter::record::DroppedPoints;
+use spot_nav_examples::health::skip_reasons;
+use spot_nav_examples::summary::{Accuracy, Loops, Points, SlamSummary, Times, write_summary};
+use spot_nav_examples::{MappedScans, Mapping, evaluate, out, print_tracking_health, value_name};
+
+use crate::args::Args;
+use crate::{RunContext, Truth};
+
+/// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
+const INFLATION: f64 = 0.30;
+
+/// Evaluates the run against the ground truth (when known), prints its figures and writes the
+/// outputs.
+pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    run: &MappedScans,
+    body_t_lidar: &Pose3,
+    points: Option<DroppedPoints>,
+    args: &Args,
+    context: &RunContext<'_>,
+) -> Result<()> {
+    let truth = match context.truth {
+        Truth::None => None,
+        Truth::Stamped(poses) => Some(poses.to_vec()),
+        Truth::File(file) => Some(file.stamped(&run.stamps)?),
+    };
+    let (evaluation, estimate) =
+        evaluate(slam, body_t_lidar, truth.as_deref()).with_context(|| {
+            format!(
+                "evaluating {} scan poses against the ground truth ({})",
+                slam.scan_trajectory().len(),
+                context.input.ground_truth.as_deref().unwrap_or("none")
+            )
+        })?;
+    let mapping = Mapping {
+        estimate,
+        evaluation,
+        seconds: run.seconds,
+    };
+    let summary = report(slam, &mapping, points, args, context)?;
+    if let Some(dir) = &args.out {
+        write_outputs(slam, &mapping, dir, args.lidar_height, &summary)?;
+    }
+    if let Some(path) = &args.summary {
+        write_summary(path, &summary)?;
+        out!("wrote       {}", path.display())?;
+    }
+    Ok(())
+}
+
+/// Prints the run's figures; returns them as `summary.json` holds them.
+pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    mapping: &Mapping,
+    points: Option<DroppedPoints>,
+    args: &Args,
+    context: &RunContext<'_>,
+) -> Result<SlamSummary> {
+    let report = slam.report();
+    let skipped: usize = skip_reasons(report).iter().map(|&(_, n)| n).sum();
+    out!(
+        "scans       {} ({} keyframes, {skipped} skipped)",
+        report.scans,
+        report.keyframes
+    )?;
+    let loops = Loops::new(report);
+    let rejected = if loops.rejected.is_empty() {
+        "none".to_string()
+    } else {
+        loops
+            .rejected
+            .iter()
+            .map(|(reason, n)| format!("{n} {reason}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    out!(
+        "loops       {} closed of {} tried ({} by appearance; {} refused beyond the drift, {} weighted out by the back end; rejected: {rejected})",
+        loops.closed,
+        loops.tried,
+        loops.by_appearance,
+        loops.refused_beyond_drift,
+        loops.weighted_out
+    )?;
+    let health = print_tracking_health(report)?;
+    let time = Times::new(report, mapping.seconds);
+    out!(
+        "time        {:.2} ms mean, {:.2} ms p99, {:.2} ms max (scan {}) per scan (odometry path); loop steps max {:.1} ms; {:.1} s in all",
+        time.scan_ms_mean,
+        time.scan_ms_p99,
+        time.scan_ms_max,
+        time.slowest_scan,
+        time.loop_ms_max,
+        time.seconds
+    )?;
+    let points = points.map(|p| Points {
+        no_return: p.no_return,
+        non_finite: p.non_finite,
+    });
+    if let Some(p) = &points {
+        out!(
+            "points      {} no-return and {} non-finite points removed",
+            p.no_return,
+            p.non_finite
+        )?;
+    }
+    let accuracy = mapping.evaluation.as_ref().map(Accuracy::new);
+    if let Some(a) = &accuracy {
+        print_accuracy(a)?;
+    }
+    Ok(SlamSummary {
+        input: context.input.clone(),
+        registration: value_name(&args.registration),
+        scans: report.scans,
+        keyframes: report.keyframes,
+        loops,
+        tracking: health,
+        time,
+        points,
+        accuracy,
+    })
+}
+
+/// The accuracy lines: ATE and drifts, KITTI's RPE, each step's rotation error.
+pub(crate) fn print_accuracy(a: &Accuracy) -> Result<()> {
+    let drift = a.end_point_drift_percent.map_or_else(
+        || "the truth did not move".to_owned(),
+        |d| format!("{d:.3} % of {:.1} m", a.path_length_m),
+    );
+    let segments = a
+        .segment_drift_percent
+        .map_or_else(String::new, |s| format!(", segments (10-50 m) {s:.3} %"));
+    out!(
+        "accuracy    ATE {:.3} m (RMSE after SE(3) alignment, {} poses), end point {:.3} m ({drift}), height drift {:+.3} m, loop end-point error {:.3} m{segments}",
+        a.ate_m,
+        a.ate_pairs,
+        a.end_point_error_m,
+        a.height_drift_m,
+        a.loop_end_point_error_m
+    )?;
+    match (a.rpe_percent, a.rpe_rotation_deg_per_100m) {
+        (Some(t), Some(r)) => {
+            let lengths = match (
+                a.rpe_segment_lengths_m.first(),
+                a.rpe_segment_lengths_m.last(),
+            ) {
+                (Some(first), Some(last)) if first < last => format!("{first}-{last} m"),
+                (Some(first), _) => format!("{first} m"),
+                _ => String::new(),
+            };
+            let which = if a.rpe_kitti_lengths {
+                format!("KITTI's segments of {lengths}")
+            } else {
+                format!(
+                    "the path, {:.1} m, is shorter than KITTI's 100 m segments: over {lengths} instead",
+                    a.path_length_m
+                )
+            };
+            out!(
+                "rpe         {t:.3} % per 100 m, {r:.3} deg per 100 m ({which}; {} segments)",
+                a.rpe_segments
+            )?;
+        }
+        _ => out!(
+            "rpe         none: the path ({:.3} m) is too short for any segment",
+            a.path_length_m
+        )?,
+    }
+    out!(
+        "steps       {} of {} steps with more than 2 deg of rotation error against the truth, {} with more than 5 deg (largest {:.2} deg)",
+        a.steps_over_2_deg,
+        a.steps,
+        a.steps_over_5_deg,
+        a.step_rotation_error_max_deg
+    )
+}
+
+/// The map, trajectory, graph, grid and summary in `dir` (made here, after the run).
+pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    mapping: &Mapping,
+    dir: &Path,
+    lidar_height: f64,
+    summary: &SlamSummary,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_summary(&dir.join("summary.json"), summary)?;
+    let map = slam.map(0.05)?;
+    write_ply(dir.join("map.ply"), &map, PlyEncoding::BinaryLittleEndian)?;
+    write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
+    write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
+    write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
+    let scans: Vec<_> = slam.keyframe_scans().collect();
+    match NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default()) {
+        Ok(navigation) => {
+            let grid = navigation.occupancy();
+            let planning = grid.to_planning_grid(UnknownCells::Free);
+            let inflated = inflate(&planning, INFLATION)?;
+            let path: Vec<_> = mapping
+                .estimate
+                .iter()
+                .filter_map(|p| {
+                    let t = p.pose.translation.vector;
+                    planning.cell_at(Vector2::new(t.x, t.y))
+                })
+                .collect();
+            gridmap::write_png(dir.join("grid.png"), grid, Some(&inflated), &path, &[])?;
+            gridmap::write_ros_map(grid, dir.join("map.yaml"))?;
+            out!(
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, grid.png, map.yaml + map.pgm, summary.json",
+                dir.display()
+            )?;
+        }
+        Err(e) => {
+            eprintln!("note: no grid ({e:#}); is --lidar-height {lidar_height} m right?");
+            out!(
+                "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, summary.json",
+                dir.display()
+            )?;
+        }
+    }
+    Ok(())
+}
