@@ -5,7 +5,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{Cell, GridGeometry, PointCloud, Pose3};
 
 use crate::config::OccupancyGridConfig;
-use crate::error::{GridMapError, check};
+use crate::error::{GridMapError, check, check_not_negative};
 use crate::occupancy::{CellState, OccupancyGrid};
 
 /// Builds [`OccupancyGrid`]s from map clouds. The thesis tested each cell with a k-d tree search
@@ -29,18 +29,11 @@ impl OccupancyGridBuilder {
             c.resolution,
             "finite and positive",
         )?;
-        for (setting, v) in [
+        check_not_negative(&[
             ("OccupancyGridConfig::slice_below", c.slice_below),
             ("OccupancyGridConfig::slice_above", c.slice_above),
             ("OccupancyGridConfig::margin", c.margin),
-        ] {
-            check(
-                v.is_finite() && v >= 0.0,
-                setting,
-                v,
-                "finite and not negative",
-            )?;
-        }
+        ])?;
         check(
             c.min_points > 0,
             "OccupancyGridConfig::min_points",

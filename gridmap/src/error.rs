@@ -120,3 +120,17 @@ pub(crate) fn check(
 ) -> Result<(), GridMapError> {
     Ok(InvalidSetting::check(ok, setting, value, expected)?)
 }
+
+/// [`GridMapError::InvalidConfig`] for the first of `settings` (name, value) that is not finite
+/// and non-negative.
+pub(crate) fn check_not_negative(settings: &[(&'static str, f64)]) -> Result<(), GridMapError> {
+    for &(setting, v) in settings {
+        check(
+            v.is_finite() && v >= 0.0,
+            setting,
+            v,
+            "finite and not negative",
+        )?;
+    }
+    Ok(())
+}
