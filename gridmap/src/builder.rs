@@ -5,7 +5,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{Cell, GridGeometry, PointCloud, Pose3};
 
 use crate::config::OccupancyGridConfig;
-use crate::error::{GridMapError, check, check_not_negative};
+use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::traverse;
 
@@ -54,15 +54,7 @@ impl OccupancyGridBuilder {
         if cloud.is_empty() {
             return Err(GridMapError::EmptyCloud);
         }
-        let bad = cloud
-            .points()
-            .iter()
-            .filter(|p| !p.iter().all(|v| v.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(GridMapError::NonFinitePoints { count: bad });
-        }
-        Ok(())
+        check_finite_points(cloud)
     }
 
     fn slice_bounds(&self, lidar_height: f64) -> Result<(f64, f64), GridMapError> {

@@ -134,3 +134,16 @@ pub(crate) fn check_not_negative(settings: &[(&'static str, f64)]) -> Result<(),
     }
     Ok(())
 }
+
+/// [`GridMapError::NonFinitePoints`] when any point of `cloud` has a coordinate that is not finite.
+pub(crate) fn check_finite_points(cloud: &slam_core::PointCloud) -> Result<(), GridMapError> {
+    let bad = cloud
+        .points()
+        .iter()
+        .filter(|p| !p.iter().all(|v| v.is_finite()))
+        .count();
+    if bad > 0 {
+        return Err(GridMapError::NonFinitePoints { count: bad });
+    }
+    Ok(())
+}

@@ -10,7 +10,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{BitGrid, Cell, InvalidSetting, PointCloud, Pose2, Pose3};
 
 use crate::band::{Height, ObstacleBandConfig, band_at, classify};
-use crate::error::{GridMapError, check, check_not_negative};
+use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
 use crate::floor::FloorMap;
 use crate::fusion::{LocalCell, LocalGrid};
 use crate::occupancy::{CellState, OccupancyGrid};
@@ -433,14 +433,7 @@ impl LiveLayer {
             }
             .into());
         }
-        let bad = scan
-            .points()
-            .iter()
-            .filter(|p| !p.iter().all(|v| v.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(GridMapError::NonFinitePoints { count: bad });
-        }
+        check_finite_points(scan)?;
         let g = *self.combined.geometry();
         let res = g.resolution;
         let n = self.n;
