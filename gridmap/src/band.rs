@@ -5,7 +5,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{Cell, PointCloud, Pose3};
 
 use crate::builder::{OccupancyGridBuilder, extent};
-use crate::error::{GridMapError, check};
+use crate::error::{GridMapError, check, check_not_negative};
 use crate::floor::FloorMap;
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::{below_top, clip_to_box, traverse};
@@ -40,12 +40,7 @@ impl ObstacleBandConfig {
     /// # Errors
     /// [`GridMapError::InvalidConfig`] unless `0 <= above_floor < up_to`, both finite.
     pub fn validate(&self) -> Result<(), GridMapError> {
-        check(
-            self.above_floor.is_finite() && self.above_floor >= 0.0,
-            "ObstacleBandConfig::above_floor",
-            self.above_floor,
-            "finite and not negative",
-        )?;
+        check_not_negative(&[("ObstacleBandConfig::above_floor", self.above_floor)])?;
         check(
             self.up_to.is_finite() && self.up_to > self.above_floor,
             "ObstacleBandConfig::up_to",

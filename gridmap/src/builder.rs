@@ -5,8 +5,9 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{Cell, GridGeometry, PointCloud, Pose3};
 
 use crate::config::OccupancyGridConfig;
-use crate::error::{GridMapError, check};
+use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
 use crate::occupancy::{CellState, OccupancyGrid};
+use crate::rays::traverse;
 
 /// Builds [`OccupancyGrid`]s from map clouds. The thesis tested each cell with a k-d tree search
 /// (O(cells log N)); binning each slice point into its cell is O(N) and gives the same cells.
@@ -29,18 +30,11 @@ impl OccupancyGridBuilder {
             c.resolution,
             "finite and positive",
         )?;
-        for (setting, v) in [
+        check_not_negative(&[
             ("OccupancyGridConfig::slice_below", c.slice_below),
             ("OccupancyGridConfig::slice_above", c.slice_above),
             ("OccupancyGridConfig::margin", c.margin),
-        ] {
-            check(
-                v.is_finite() && v >= 0.0,
-                setting,
-                v,
-                "finite and not negative",
-            )?;
-        }
+        ])?;
         check(
             c.min_points > 0,
             "OccupancyGridConfig::min_points",
@@ -60,15 +54,7 @@ impl OccupancyGridBuilder {
         if cloud.is_empty() {
             return Err(GridMapError::EmptyCloud);
         }
-        let bad = cloud
-            .points()
-            .iter()
-            .filter(|p| !p.iter().all(|v| v.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(GridMapError::NonFinitePoints { count: bad });
-        }
-        Ok(())
+        check_finite_points(cloud)
     }
 
     fn slice_bounds(&self, lidar_height: f64) -> Result<(f64, f64), GridMapError> {
@@ -239,53 +225,20 @@ pub(crate) fn clear_ray(
     to: Vector2<f64>,
 ) -> Result<(), GridMapError> {
     let g = *grid.geometry();
-    let a = (from - g.origin) / g.resolution;
-    let b = (to - g.origin) / g.resolution;
-    let (mut x, mut y) = (a.x.floor() as i64, a.y.floor() as i64);
-    let (ex, ey) = (b.x.floor() as i64, b.y.floor() as i64);
-    let d = b - a;
-    let step_x: i64 = if d.x > 0.0 { 1 } else { -1 };
-    let step_y: i64 = if d.y > 0.0 { 1 } else { -1 };
-    let next_boundary = |p: f64, s: i64| if s > 0 { p.floor() + 1.0 } else { p.floor() };
-    let mut t_max_x = if d.x == 0.0 {
-        f64::INFINITY
-    } else {
-        (next_boundary(a.x, step_x) - a.x) / d.x
-    };
-    let mut t_max_y = if d.y == 0.0 {
-        f64::INFINITY
-    } else {
-        (next_boundary(a.y, step_y) - a.y) / d.y
-    };
-    let t_dx = if d.x == 0.0 {
-        f64::INFINITY
-    } else {
-        1.0 / d.x.abs()
-    };
-    let t_dy = if d.y == 0.0 {
-        f64::INFINITY
-    } else {
-        1.0 / d.y.abs()
-    };
-    let max_steps = (ex - x).abs() + (ey - y).abs() + 1;
     let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
-    for _ in 0..max_steps {
-        if x == ex && y == ey {
-            break;
-        }
-        if x >= 0 && y >= 0 && x < w && y < h {
-            let c = Cell::new(x as u32, y as u32);
-            if grid.state(c) != CellState::Occupied {
-                grid.set(c, CellState::Free)?;
+    let mut result = Ok(());
+    traverse(
+        (from - g.origin) / g.resolution,
+        (to - g.origin) / g.resolution,
+        false,
+        |x, y| {
+            if result.is_ok() && x >= 0 && y >= 0 && x < w && y < h {
+                let c = Cell::new(x as u32, y as u32);
+                if grid.state(c) != CellState::Occupied {
+                    result = grid.set(c, CellState::Free);
+                }
             }
-        }
-        if t_max_x < t_max_y {
-            x += step_x;
-            t_max_x += t_dx;
-        } else {
-            y += step_y;
-            t_max_y += t_dy;
-        }
-    }
-    Ok(())
+        },
+    );
+    result
 }

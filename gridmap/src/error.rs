@@ -120,3 +120,30 @@ pub(crate) fn check(
 ) -> Result<(), GridMapError> {
     Ok(InvalidSetting::check(ok, setting, value, expected)?)
 }
+
+/// [`GridMapError::InvalidConfig`] for the first of `settings` (name, value) that is not finite
+/// and non-negative.
+pub(crate) fn check_not_negative(settings: &[(&'static str, f64)]) -> Result<(), GridMapError> {
+    for &(setting, v) in settings {
+        check(
+            v.is_finite() && v >= 0.0,
+            setting,
+            v,
+            "finite and not negative",
+        )?;
+    }
+    Ok(())
+}
+
+/// [`GridMapError::NonFinitePoints`] when any point of `cloud` has a coordinate that is not finite.
+pub(crate) fn check_finite_points(cloud: &slam_core::PointCloud) -> Result<(), GridMapError> {
+    let bad = cloud
+        .points()
+        .iter()
+        .filter(|p| !p.iter().all(|v| v.is_finite()))
+        .count();
+    if bad > 0 {
+        return Err(GridMapError::NonFinitePoints { count: bad });
+    }
+    Ok(())
+}

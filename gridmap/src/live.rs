@@ -10,7 +10,7 @@ use nalgebra::{Point3, Vector2};
 use slam_core::{BitGrid, Cell, InvalidSetting, PointCloud, Pose2, Pose3};
 
 use crate::band::{Height, ObstacleBandConfig, band_at, classify};
-use crate::error::{GridMapError, check};
+use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
 use crate::floor::FloorMap;
 use crate::fusion::{LocalCell, LocalGrid};
 use crate::occupancy::{CellState, OccupancyGrid};
@@ -62,12 +62,7 @@ impl LiveLayerConfig {
     /// 1000 m, an invalid band, `min_points == 0` or above 65,535, or a decay or minimum range
     /// that is not finite and non-negative.
     pub fn validate(&self) -> Result<(), GridMapError> {
-        check(
-            self.clear_below.is_finite() && self.clear_below >= 0.0,
-            "LiveLayerConfig::clear_below",
-            self.clear_below,
-            "finite and not negative",
-        )?;
+        check_not_negative(&[("LiveLayerConfig::clear_below", self.clear_below)])?;
         check(
             self.window.is_finite() && self.window > 0.0 && self.window <= 1000.0,
             "LiveLayerConfig::window",
@@ -81,18 +76,10 @@ impl LiveLayerConfig {
             f64::from(self.min_points),
             "from 1 to 65535",
         )?;
-        for (setting, v) in [
+        check_not_negative(&[
             ("LiveLayerConfig::decay", self.decay),
             ("LiveLayerConfig::min_range", self.min_range),
-        ] {
-            check(
-                v.is_finite() && v >= 0.0,
-                setting,
-                v,
-                "finite and not negative",
-            )?;
-        }
-        Ok(())
+        ])
     }
 }
 
@@ -446,14 +433,7 @@ impl LiveLayer {
             }
             .into());
         }
-        let bad = scan
-            .points()
-            .iter()
-            .filter(|p| !p.iter().all(|v| v.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(GridMapError::NonFinitePoints { count: bad });
-        }
+        check_finite_points(scan)?;
         let g = *self.combined.geometry();
         let res = g.resolution;
         let n = self.n;

@@ -5,7 +5,7 @@
 use slam_core::{BitGrid, Cell};
 
 use crate::distance::{DistanceField, squared_distance_cells};
-use crate::error::{GridMapError, check};
+use crate::error::{GridMapError, check, check_not_negative};
 use crate::occupancy::{OccupancyGrid, UnknownCells};
 
 /// The clearance cost: entering a cell `d` metres from the nearest obstacle costs the step's
@@ -49,12 +49,7 @@ impl ClearanceCostConfig {
             self.weight,
             "finite, from 0 to 1000",
         )?;
-        check(
-            self.full_within.is_finite() && self.full_within >= 0.0,
-            "ClearanceCostConfig::full_within",
-            self.full_within,
-            "finite and not negative",
-        )?;
+        check_not_negative(&[("ClearanceCostConfig::full_within", self.full_within)])?;
         check(
             self.zero_beyond.is_finite()
                 && self.zero_beyond > self.full_within

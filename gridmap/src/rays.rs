@@ -1,4 +1,4 @@
-//! Ray geometry shared by the floor-band map builder and the live layer: where a beam lies below
+//! Ray geometry shared by the map builders and the live layer: where a beam lies below
 //! the top of the obstacle band, and which cells its ground track crosses.
 
 use nalgebra::{Point3, Vector2};

@@ -1,5 +1,5 @@
 //! The cell-by-cell best-first search behind [`Dijkstra`](crate::Dijkstra) and
-//! [`AStar`](crate::AStar).
+//! [`AStar`](crate::AStar), with the state both keep between queries.
 
 use slam_core::{BitGrid, Cell, GridPath, PlanError, validate_endpoints};
 
@@ -10,48 +10,75 @@ use crate::movement::DIRECTIONS;
 use crate::open_list::CellRing;
 use crate::search_space::SearchSpace;
 
-/// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
-/// `g + heuristic(cell)`; `None` when the goal is unreachable.
-pub(crate) fn best_first(
-    grid: &BitGrid,
-    components: &Components,
-    space: &mut SearchSpace<CellRing>,
-    closed: &mut ClosedSet,
-    start: Cell,
-    goal: Cell,
-    heuristic: impl Fn(Cell) -> Cost,
-) -> Result<Option<GridPath>, PlanError> {
-    validate_endpoints(grid, start, goal)?;
-    if !components.connected(start, goal) {
-        return Ok(None);
-    }
-    closed.reset();
-    let (s, t) = (space.index(start), space.index(goal));
-    space.start(s, heuristic(start));
-    // Index offset of the neighbour in each direction (row-major, rows `width` apart), modulo 2^32.
-    let offset = DIRECTIONS.map(|(dx, dy)| {
-        dy.cast_unsigned()
-            .wrapping_mul(grid.width())
-            .wrapping_add(dx.cast_unsigned())
-    });
-    let mut expanded = 0;
-    while let Some((i, g, _)) = space.pop() {
-        expanded += 1;
-        if i == t {
-            return Ok(Some(space.path(s, t, expanded)));
-        }
-        let c = space.cell(i);
-        closed.insert(c);
-        let mut steps = closed.legal_open_steps(grid, c);
-        while steps != 0 {
-            let d = steps.trailing_zeros() as usize;
-            steps &= steps - 1;
-            let (dx, dy) = DIRECTIONS[d];
-            let n = || Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
-            let j = i.wrapping_add(offset[d]);
-            space.relax(j, g + STEP[d], || heuristic(n()), i, d as u8);
+/// A best-first search on one grid: its connected components, labelled once, and search state
+/// reused by every query. The planners differ only in the heuristic they pass to
+/// [`BestFirst::search`].
+pub(crate) struct BestFirst<'g> {
+    grid: &'g BitGrid,
+    components: Components,
+    space: SearchSpace<CellRing>,
+    closed: ClosedSet,
+}
+
+impl<'g> BestFirst<'g> {
+    /// A search for `grid` (labels its connected components once).
+    pub(crate) fn new(grid: &'g BitGrid) -> Self {
+        Self {
+            grid,
+            components: Components::new(grid),
+            space: SearchSpace::new(grid.width(), grid.height()),
+            closed: ClosedSet::new(grid),
         }
     }
-    // The open list ran dry: unreachable (the component check above normally answers first).
-    Ok(None)
+
+    /// Search from `start` to `goal` expanding the 8 neighbours of each cell, with priority
+    /// `g + heuristic(cell)`; `None` when the goal is unreachable.
+    pub(crate) fn search(
+        &mut self,
+        start: Cell,
+        goal: Cell,
+        heuristic: impl Fn(Cell) -> Cost,
+    ) -> Result<Option<GridPath>, PlanError> {
+        let Self {
+            grid,
+            components,
+            space,
+            closed,
+        } = self;
+        let grid = *grid;
+        validate_endpoints(grid, start, goal)?;
+        if !components.connected(start, goal) {
+            return Ok(None);
+        }
+        closed.reset();
+        let (s, t) = (space.index(start), space.index(goal));
+        space.start(s, heuristic(start));
+        // Index offset of the neighbour in each direction (row-major, rows `width` apart), modulo
+        // 2^32.
+        let offset = DIRECTIONS.map(|(dx, dy)| {
+            dy.cast_unsigned()
+                .wrapping_mul(grid.width())
+                .wrapping_add(dx.cast_unsigned())
+        });
+        let mut expanded = 0;
+        while let Some((i, g, _)) = space.pop() {
+            expanded += 1;
+            if i == t {
+                return Ok(Some(space.path(s, t, expanded)));
+            }
+            let c = space.cell(i);
+            closed.insert(c);
+            let mut steps = closed.legal_open_steps(grid, c);
+            while steps != 0 {
+                let d = steps.trailing_zeros() as usize;
+                steps &= steps - 1;
+                let (dx, dy) = DIRECTIONS[d];
+                let n = || Cell::new(c.x.wrapping_add_signed(dx), c.y.wrapping_add_signed(dy));
+                let j = i.wrapping_add(offset[d]);
+                space.relax(j, g + STEP[d], || heuristic(n()), i, d as u8);
+            }
+        }
+        // The open list ran dry: unreachable (the component check above normally answers first).
+        Ok(None)
+    }
 }

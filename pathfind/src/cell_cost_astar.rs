@@ -10,6 +10,7 @@ use crate::cost_ring::CostRing;
 use crate::error::PathfindError;
 use crate::movement::{DIRECTIONS, SQRT_2, path_cost};
 use crate::open_list::{KeyHeap, Open, OpenList};
+use crate::search_space::next_generation;
 
 /// Fractional bits of the fixed-point costs at most (as [`crate::cost`]: 2^-29 cells).
 const MAX_FRACTION_BITS: u32 = 29;
@@ -439,13 +440,9 @@ impl<'g> CellCostAStar<'g> {
         self.open.clear();
         self.same_f.clear();
         self.current_f = 0;
-        if self.generation >= MAX_GENERATION {
-            for n in &mut self.nodes {
-                n.stamp = 0;
-            }
-            self.generation = 0;
-        }
-        self.generation += 1;
+        next_generation(&mut self.generation, MAX_GENERATION, &mut self.nodes, |n| {
+            n.stamp = 0;
+        });
     }
 
     /// The path to `goal` by following parents back to `start`, with its cost summed in `f64`.

@@ -117,6 +117,18 @@ fn row_free3(grid: &BitGrid, x: u32, y: i64) -> u32 {
     (!blocked & 7) as u32
 }
 
+/// [`row_free3`] of the rows above, at and below cell `c`: its 3 x 3 neighbourhood.
+#[allow(clippy::inline_always)]
+#[inline(always)]
+fn rows_free3(grid: &BitGrid, c: Cell) -> (u32, u32, u32) {
+    let y = i64::from(c.y);
+    (
+        row_free3(grid, c.x, y + 1),
+        row_free3(grid, c.x, y),
+        row_free3(grid, c.x, y - 1),
+    )
+}
+
 /// The legal steps (bits as in [`legal_steps`]) from the free bits of the rows above, at and
 /// below the cell (bit 0 = west, as [`row_free3`] gives them).
 #[allow(clippy::inline_always)]
@@ -156,12 +168,7 @@ fn neighbours_from_rows(up: u32, mid: u32, down: u32) -> u8 {
 #[inline(always)]
 #[must_use]
 pub fn legal_steps(grid: &BitGrid, c: Cell) -> u8 {
-    let y = i64::from(c.y);
-    let (up, mid, down) = (
-        row_free3(grid, c.x, y + 1),
-        row_free3(grid, c.x, y),
-        row_free3(grid, c.x, y - 1),
-    );
+    let (up, mid, down) = rows_free3(grid, c);
     legal_from_rows(up, mid, down)
 }
 
@@ -171,12 +178,7 @@ pub fn legal_steps(grid: &BitGrid, c: Cell) -> u8 {
 #[allow(clippy::inline_always)]
 #[inline(always)]
 pub(crate) fn free_neighbours(grid: &BitGrid, c: Cell) -> u8 {
-    let y = i64::from(c.y);
-    let (up, mid, down) = (
-        row_free3(grid, c.x, y + 1),
-        row_free3(grid, c.x, y),
-        row_free3(grid, c.x, y - 1),
-    );
+    let (up, mid, down) = rows_free3(grid, c);
     neighbours_from_rows(up, mid, down)
 }
 

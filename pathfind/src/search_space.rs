@@ -34,6 +34,22 @@ const DIRECTION_MASK: u32 = 0xF;
 /// Generations run from 1 to this value, then the stamps are cleared once.
 const MAX_GENERATION: u32 = u32::MAX >> STAMP_SHIFT;
 
+/// Move `generation`, the stamp that marks a search record as written by the current query, on
+/// to a new query. Generations run from 1 to `max`; past it every record's stamp is cleared once
+/// by `clear_stamp` (so that no old stamp can match) and the count starts again.
+pub(crate) fn next_generation<N>(
+    generation: &mut u32,
+    max: u32,
+    nodes: &mut [N],
+    clear_stamp: impl Fn(&mut N),
+) {
+    if *generation >= max {
+        nodes.iter_mut().for_each(clear_stamp);
+        *generation = 0;
+    }
+    *generation += 1;
+}
+
 /// Search state for one grid size, with open list `Q`.
 pub(crate) struct SearchSpace<Q = KeyHeap> {
     width: u32,
@@ -95,14 +111,10 @@ impl<Q: OpenList> SearchSpace<Q> {
         self.open.clear();
         self.same_f.clear();
         self.current_f = 0;
-        if self.generation >= MAX_GENERATION {
-            // After 134 million queries: clear the stamps once.
-            for n in &mut self.nodes {
-                n.stamp = 0;
-            }
-            self.generation = 0;
-        }
-        self.generation += 1;
+        // After 134 million queries the stamps are cleared once.
+        next_generation(&mut self.generation, MAX_GENERATION, &mut self.nodes, |n| {
+            n.stamp = 0;
+        });
     }
 
     /// Offer `g` as the cost of reaching cell `i` from `parent`, arriving in `direction`; queue it
