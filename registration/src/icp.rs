@@ -24,6 +24,8 @@ pub(crate) struct Pair {
 
 /// How a backend turns correspondences into an update (applied on the left).
 pub(crate) trait IcpStep {
+    /// Whether the target carries PCA normals (the step pairs points with planes).
+    const TARGET_NORMALS: bool;
     /// The residual of a pair (metres).
     fn residual(pair: &Pair) -> f64;
     /// The update `delta` with `pose <- exp(delta) pose`.

@@ -53,6 +53,7 @@
 
 mod config;
 mod icp;
+mod icp_target;
 mod kernel;
 mod lidar_layout;
 mod loam;
