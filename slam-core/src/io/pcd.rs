@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::lzf::lzf_decompress;
-use super::point_record::{ascii_record, binary_record};
+use super::point_record::{write_ascii_records, write_binary_records};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -511,18 +511,11 @@ pub fn write_pcd_to(
     match encoding {
         PcdEncoding::Binary => {
             writeln!(w, "DATA binary")?;
-            let mut rec = Vec::with_capacity(22);
-            for i in 0..cloud.len() {
-                rec.clear();
-                binary_record(cloud, i, &mut rec);
-                w.write_all(&rec)?;
-            }
+            write_binary_records(cloud, &mut w)?;
         }
         PcdEncoding::Ascii => {
             writeln!(w, "DATA ascii")?;
-            for i in 0..cloud.len() {
-                ascii_record(cloud, i, &mut w)?;
-            }
+            write_ascii_records(cloud, &mut w)?;
         }
     }
     w.flush()?;

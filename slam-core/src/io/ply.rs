@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::point_record::{ascii_record, binary_record};
+use super::point_record::{write_ascii_records, write_binary_records};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -429,16 +429,9 @@ pub fn write_ply_to(
         writeln!(w, "property float time")?;
     }
     writeln!(w, "end_header")?;
-    let mut rec = Vec::with_capacity(22);
-    for i in 0..cloud.len() {
-        match encoding {
-            PlyEncoding::BinaryLittleEndian => {
-                rec.clear();
-                binary_record(cloud, i, &mut rec);
-                w.write_all(&rec)?;
-            }
-            PlyEncoding::Ascii => ascii_record(cloud, i, &mut w)?,
-        }
+    match encoding {
+        PlyEncoding::BinaryLittleEndian => write_binary_records(cloud, &mut w)?,
+        PlyEncoding::Ascii => write_ascii_records(cloud, &mut w)?,
     }
     w.flush()?;
     Ok(())
