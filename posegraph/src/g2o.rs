@@ -10,6 +10,7 @@ use nalgebra::{Matrix3, Matrix6, Translation3, Vector2};
 use slam_core::{GraphPose, Pose2, Pose3, PoseGraph, quaternion_from_xyzw, quaternion_to_xyzw};
 
 use crate::error::{GraphFileError, UnknownTags};
+use crate::graph_text_lines::{line_err, tagged_lines};
 use crate::information_repair::{InformationRepair, RepairedEdge};
 use crate::se2_text::{Se2Format, se2_text};
 
@@ -20,13 +21,6 @@ pub enum G2oGraph {
     Se2(PoseGraph<Pose2>),
     /// `VERTEX_SE3:QUAT` / `EDGE_SE3:QUAT`.
     Se3(PoseGraph<Pose3>),
-}
-
-fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
-    GraphFileError::Line {
-        line,
-        message: message.into(),
-    }
 }
 
 fn numbers(
@@ -84,15 +78,7 @@ pub fn parse_g2o_with(
     let mut g3: Option<PoseGraph<Pose3>> = None;
     let mut fixes: Vec<(usize, u64)> = Vec::new();
     let mut unknown = UnknownTags::default();
-    for (k, raw) in text.lines().enumerate() {
-        let line = k + 1;
-        let words: Vec<&str> = raw.split_whitespace().collect();
-        let Some((&tag, rest)) = words.split_first() else {
-            continue;
-        };
-        if tag.starts_with('#') {
-            continue;
-        }
+    for (line, tag, rest) in tagged_lines(text) {
         let graph_err = |source| GraphFileError::Graph { line, source };
         match tag {
             "VERTEX_SE3:QUAT" => {

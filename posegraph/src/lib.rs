@@ -49,6 +49,7 @@ pub mod g2o;
 mod gauss_newton;
 mod gnc;
 mod gnc_loss;
+mod graph_text_lines;
 pub mod information_repair;
 mod levenberg_marquardt;
 mod linearize;

@@ -7,14 +7,8 @@ use nalgebra::{Matrix3, Vector2};
 use slam_core::{Pose2, PoseGraph};
 
 use crate::error::{GraphFileError, UnknownTags};
+use crate::graph_text_lines::{line_err, tagged_lines};
 use crate::se2_text::{Se2Format, se2_text};
-
-fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
-    GraphFileError::Line {
-        line,
-        message: message.into(),
-    }
-}
 
 /// Parse TORO text into an SE(2) graph (no node is fixed: fix one before optimising).
 ///
@@ -23,15 +17,7 @@ fn line_err(line: usize, message: impl Into<String>) -> GraphFileError {
 pub fn parse_toro(text: &str) -> Result<PoseGraph<Pose2>, GraphFileError> {
     let mut g = PoseGraph::new();
     let mut unknown = UnknownTags::default();
-    for (k, raw) in text.lines().enumerate() {
-        let line = k + 1;
-        let words: Vec<&str> = raw.split_whitespace().collect();
-        let Some((&tag, rest)) = words.split_first() else {
-            continue;
-        };
-        if tag.starts_with('#') {
-            continue;
-        }
+    for (line, tag, rest) in tagged_lines(text) {
         // `ids` vertex ids (whole numbers, parsed as integers so that ids above 2^53 stay
         // exact), then `values` finite numbers.
         let fields = |ids: usize, values: usize| -> Result<(Vec<u64>, Vec<f64>), GraphFileError> {

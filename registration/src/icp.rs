@@ -3,10 +3,9 @@
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
 use rayon::prelude::*;
-use slam_core::{
-    Alignment, Degeneracy, Pose3, RegistrationError, pose3_is_finite, se3_exp, so3_hat,
-};
+use slam_core::{Alignment, Degeneracy, Pose3, RegistrationError, se3_exp, so3_hat};
 
+use crate::alignment_inputs::checked_target_index;
 use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
@@ -24,6 +23,8 @@ pub(crate) struct Pair {
 
 /// How a backend turns correspondences into an update (applied on the left).
 pub(crate) trait IcpStep {
+    /// Whether the target carries PCA normals (the step pairs points with planes).
+    const TARGET_NORMALS: bool;
     /// The residual of a pair (metres).
     fn residual(pair: &Pair) -> f64;
     /// The update `delta` with `pose <- exp(delta) pose`.
@@ -162,11 +163,7 @@ pub(crate) fn align<S: IcpStep>(
     target: &PreparedTarget,
     initial: &Pose3,
 ) -> Result<Alignment, RegistrationError> {
-    config.validate()?;
-    if !pose3_is_finite(initial) {
-        return Err(RegistrationError::NonFiniteInitialGuess);
-    }
-    let index = target.index()?;
+    let index = checked_target_index(config, target, initial)?;
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
     // On a worker of the thread pool: each iteration's search then forks onto the other

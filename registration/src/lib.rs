@@ -51,8 +51,10 @@
 //! spinning LiDAR's ring structure (a ring field, or clouds in the sensor frame with a known
 //! layout); for other clouds use the ICP backends.
 
+mod alignment_inputs;
 mod config;
 mod icp;
+mod icp_target;
 mod kernel;
 mod lidar_layout;
 mod loam;

@@ -4,9 +4,10 @@
 
 use slam_core::{
     Alignment, Degeneracy, InvalidSetting, MapRegistrator, PointCloud, Pose3, Reach,
-    RegistrationError, Registrator, pose3_is_finite, se3_exp,
+    RegistrationError, Registrator, se3_exp,
 };
 
+use crate::alignment_inputs::check_alignment_inputs;
 use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
 use crate::icp::min_eigenvalue_ratio;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
@@ -287,10 +288,7 @@ fn align_loam(
     target: &LoamTarget,
     initial: &Pose3,
 ) -> Result<Alignment, RegistrationError> {
-    config.validate()?;
-    if !pose3_is_finite(initial) {
-        return Err(RegistrationError::NonFiniteInitialGuess);
-    }
+    check_alignment_inputs(config.validate(), initial)?;
     let mut matcher = Matcher::new(config, target, source);
     let mut pose = *initial;
     let mut k = config.initial_tukey_threshold.max(config.tukey_threshold);

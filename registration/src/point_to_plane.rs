@@ -8,7 +8,8 @@ use slam_core::{
 
 use crate::config::IcpConfig;
 use crate::icp::{IcpStep, Pair, align};
-use crate::target::{PreparedTarget, finite_points, merge_sources, prepare_source_points};
+use crate::icp_target;
+use crate::target::{PreparedTarget, prepare_source_points};
 
 /// Point-to-plane ICP: residual `n . (T p - q)` against the target point's normal (PCA over its
 /// nearest neighbours), minimised by Gauss-Newton steps on SE(3) with robust weights.
@@ -45,6 +46,8 @@ fn row(pair: &Pair) -> Vector6<f64> {
 }
 
 impl IcpStep for GaussNewtonPlane {
+    const TARGET_NORMALS: bool = true;
+
     fn residual(pair: &Pair) -> f64 {
         pair.n.map_or(f64::INFINITY, |n| n.dot(&(pair.p - pair.q)))
     }
@@ -76,16 +79,7 @@ impl Registrator for PointToPlaneIcp {
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
-        self.config.validate()?;
-        let target = PreparedTarget::new(
-            finite_points(cloud, self.config.target_voxel),
-            Some((self.config.normal_neighbours, self.config.min_planarity)),
-            self.config.min_correspondences,
-        )?;
-        if self.config.normals_up_front {
-            target.index()?.compute_all_normals();
-        }
-        Ok(target)
+        icp_target::prepare_target::<GaussNewtonPlane>(&self.config, cloud)
     }
 
     fn align(
@@ -129,12 +123,12 @@ impl MapRegistrator for PointToPlaneIcp {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
-        self.prepare_target(&merge_sources(parts))
+        icp_target::target_from_sources::<GaussNewtonPlane>(&self.config, parts)
     }
 
     /// [`IcpConfig::source_voxel`] when above zero: the source is the scan's voxel centroids.
     fn source_voxel(&self) -> Option<f32> {
-        (self.config.source_voxel > 0.0).then_some(self.config.source_voxel)
+        icp_target::source_voxel(&self.config)
     }
 
     /// With a [`IcpConfig::target_voxel`] above zero (and a valid configuration), a map kept
@@ -142,15 +136,7 @@ impl MapRegistrator for PointToPlaneIcp {
     /// k-d tree is rebuilt over the voxel centroids on the first alignment after a change.
     /// It holds the points [`MapRegistrator::target_from_sources`] would (up to rounding).
     fn empty_map(&self) -> Option<Self::Target> {
-        let c = &self.config;
-        (c.target_voxel > 0.0 && c.validate().is_ok()).then(|| {
-            PreparedTarget::window(
-                c.target_voxel,
-                Some((c.normal_neighbours, c.min_planarity)),
-                c.normals_up_front,
-                c.min_correspondences,
-            )
-        })
+        icp_target::empty_map::<GaussNewtonPlane>(&self.config)
     }
 
     fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {

@@ -9,7 +9,8 @@ use slam_core::{
 
 use crate::config::IcpConfig;
 use crate::icp::{IcpStep, Pair, align, point_jacobian};
-use crate::target::{PreparedTarget, finite_points, merge_sources, prepare_source_points};
+use crate::icp_target;
+use crate::target::{PreparedTarget, prepare_source_points};
 
 /// Point-to-point ICP: each iteration pairs every source point with its nearest target point and
 /// takes the weighted least-squares rigid transform between the pairs in closed form.
@@ -22,6 +23,8 @@ pub struct PointToPointIcp {
 struct Svd;
 
 impl IcpStep for Svd {
+    const TARGET_NORMALS: bool = false;
+
     fn residual(pair: &Pair) -> f64 {
         (pair.p - pair.q).norm()
     }
@@ -57,12 +60,7 @@ impl Registrator for PointToPointIcp {
     }
 
     fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
-        self.config.validate()?;
-        PreparedTarget::new(
-            finite_points(cloud, self.config.target_voxel),
-            None,
-            self.config.min_correspondences,
-        )
+        icp_target::prepare_target::<Svd>(&self.config, cloud)
     }
 
     fn align(
@@ -102,20 +100,18 @@ impl MapRegistrator for PointToPointIcp {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
-        self.prepare_target(&merge_sources(parts))
+        icp_target::target_from_sources::<Svd>(&self.config, parts)
     }
 
     /// [`IcpConfig::source_voxel`] when above zero: the source is the scan's voxel centroids.
     fn source_voxel(&self) -> Option<f32> {
-        (self.config.source_voxel > 0.0).then_some(self.config.source_voxel)
+        icp_target::source_voxel(&self.config)
     }
 
     /// As [`PointToPlaneIcp`](crate::PointToPlaneIcp)'s: with a
     /// [`IcpConfig::target_voxel`] above zero, a map of per-voxel sums updated in place.
     fn empty_map(&self) -> Option<Self::Target> {
-        let c = &self.config;
-        (c.target_voxel > 0.0 && c.validate().is_ok())
-            .then(|| PreparedTarget::window(c.target_voxel, None, false, c.min_correspondences))
+        icp_target::empty_map::<Svd>(&self.config)
     }
 
     fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {

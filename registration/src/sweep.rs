@@ -15,9 +15,10 @@ use nalgebra::{Point3, SMatrix, SVector, Vector6};
 use rayon::prelude::*;
 use slam_core::{
     Alignment, Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment,
-    pose3_is_finite, se3_adjoint, se3_exp,
+    se3_adjoint, se3_exp,
 };
 
+use crate::alignment_inputs::checked_target_index;
 use crate::config::IcpConfig;
 use crate::icp::{Pair, inliers_and_rmse, min_eigenvalue_ratio, thin_source};
 use crate::matcher::Matcher;
@@ -76,11 +77,7 @@ pub(crate) fn align_sweep(
     target: &PreparedTarget,
     initial: &Pose3,
 ) -> Result<SweepAlignment, RegistrationError> {
-    config.validate()?;
-    if !pose3_is_finite(initial) {
-        return Err(RegistrationError::NonFiniteInitialGuess);
-    }
-    let index = target.index()?;
+    let index = checked_target_index(config, target, initial)?;
     let (points, times) = sweep_points(config, sweep)?;
     let (points, times) = match (
         thin_source(&points, config.max_source_points),

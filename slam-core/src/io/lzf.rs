@@ -1,7 +1,7 @@
 //! LZF decompression of PCL's `binary_compressed` PCD data (Marc Lehmann's format: literal
 //! runs and back references), bounded so that a forged length cannot allocate without limit.
 
-use super::pcd::byte_err;
+use super::reading::byte_err;
 use crate::error::FormatError;
 
 /// Most bytes one byte of LZF data can expand to: a 3-byte back reference copies 264 bytes.

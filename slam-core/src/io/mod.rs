@@ -25,6 +25,7 @@ mod lzf;
 mod pcd;
 mod ply;
 mod point_record;
+mod reading;
 mod scalar;
 mod tum;
 

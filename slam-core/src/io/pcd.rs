@@ -6,7 +6,8 @@ use std::io::Write;
 use std::path::Path;
 
 use super::lzf::lzf_decompress;
-use super::point_record::{ascii_record, binary_record};
+use super::point_record::{write_ascii_records, write_binary_records};
+use super::reading::{byte_err, line_err, next_header_line, require_xyz};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -44,20 +45,6 @@ struct Header {
     data_offset: usize,
     /// Line number of the first data line (for ascii errors).
     data_line: usize,
-}
-
-fn line_err(line: usize, message: impl Into<String>) -> FormatError {
-    FormatError::Line {
-        line,
-        message: message.into(),
-    }
-}
-
-pub(super) fn byte_err(offset: usize, message: impl Into<String>) -> FormatError {
-    FormatError::Byte {
-        offset,
-        message: message.into(),
-    }
 }
 
 fn scalar_of(ty: &str, size: usize, line: usize) -> Result<Scalar, FormatError> {
@@ -164,14 +151,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
     let mut line_no = 0;
     while pos < bytes.len() {
         line_no += 1;
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |e| pos + e);
-        let text = std::str::from_utf8(&bytes[pos..end])
-            .map_err(|_| line_err(line_no, "header line is not UTF-8"))?
-            .trim();
-        pos = (end + 1).min(bytes.len());
+        let text = next_header_line(bytes, &mut pos, line_no)?;
         if text.is_empty() || text.starts_with('#') {
             continue;
         }
@@ -262,11 +242,7 @@ fn layout(fields: &[Field]) -> Result<Layout, FormatError> {
             .ok_or(FormatError::RecordTooLarge)?;
         value_index += f.count;
     }
-    for ch in [Channel::X, Channel::Y, Channel::Z] {
-        if !slots.iter().any(|s| s.channel == ch) {
-            return Err(FormatError::MissingField { field: ch.name() });
-        }
-    }
+    require_xyz(|ch| slots.iter().any(|s| s.channel == ch))?;
     Ok(Layout {
         record_size: offset,
         slots,
@@ -511,18 +487,11 @@ pub fn write_pcd_to(
     match encoding {
         PcdEncoding::Binary => {
             writeln!(w, "DATA binary")?;
-            let mut rec = Vec::with_capacity(22);
-            for i in 0..cloud.len() {
-                rec.clear();
-                binary_record(cloud, i, &mut rec);
-                w.write_all(&rec)?;
-            }
+            write_binary_records(cloud, &mut w)?;
         }
         PcdEncoding::Ascii => {
             writeln!(w, "DATA ascii")?;
-            for i in 0..cloud.len() {
-                ascii_record(cloud, i, &mut w)?;
-            }
+            write_ascii_records(cloud, &mut w)?;
         }
     }
     w.flush()?;

@@ -5,7 +5,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::point_record::{ascii_record, binary_record};
+use super::point_record::{write_ascii_records, write_binary_records};
+use super::reading::{byte_err, line_err, next_header_line, require_xyz};
 use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
@@ -39,20 +40,6 @@ struct Element {
     properties: Vec<Property>,
 }
 
-fn line_err(line: usize, message: impl Into<String>) -> FormatError {
-    FormatError::Line {
-        line,
-        message: message.into(),
-    }
-}
-
-fn byte_err(offset: usize, message: impl Into<String>) -> FormatError {
-    FormatError::Byte {
-        offset,
-        message: message.into(),
-    }
-}
-
 fn scalar_of(name: &str, line: usize) -> Result<Scalar, FormatError> {
     Ok(match name {
         "char" | "int8" => Scalar::I8,
@@ -84,14 +71,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header, FormatError> {
             return Err(line_err(line_no, "no end_header line"));
         }
         line_no += 1;
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |e| pos + e);
-        let text = std::str::from_utf8(&bytes[pos..end])
-            .map_err(|_| line_err(line_no, "header line is not UTF-8"))?
-            .trim();
-        pos = (end + 1).min(bytes.len());
+        let text = next_header_line(bytes, &mut pos, line_no)?;
         let words: Vec<&str> = text.split_whitespace().collect();
         match words.as_slice() {
             ["ply"] if line_no == 1 => {}
@@ -186,11 +166,7 @@ fn vertex_slots(el: &Element) -> Result<Vec<VertexSlot>, FormatError> {
             });
         }
     }
-    for ch in [Channel::X, Channel::Y, Channel::Z] {
-        if !slots.iter().any(|s| s.channel == ch) {
-            return Err(FormatError::MissingField { field: ch.name() });
-        }
-    }
+    require_xyz(|ch| slots.iter().any(|s| s.channel == ch))?;
     Ok(slots)
 }
 
@@ -429,16 +405,9 @@ pub fn write_ply_to(
         writeln!(w, "property float time")?;
     }
     writeln!(w, "end_header")?;
-    let mut rec = Vec::with_capacity(22);
-    for i in 0..cloud.len() {
-        match encoding {
-            PlyEncoding::BinaryLittleEndian => {
-                rec.clear();
-                binary_record(cloud, i, &mut rec);
-                w.write_all(&rec)?;
-            }
-            PlyEncoding::Ascii => ascii_record(cloud, i, &mut w)?,
-        }
+    match encoding {
+        PlyEncoding::BinaryLittleEndian => write_binary_records(cloud, &mut w)?,
+        PlyEncoding::Ascii => write_ascii_records(cloud, &mut w)?,
     }
     w.flush()?;
     Ok(())
