@@ -2,7 +2,7 @@
 
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
-use crate::best_first::BestFirst;
+use crate::best_first::{BestFirst, BestFirstMemory};
 use crate::cost::octile;
 
 /// A* with the octile-distance heuristic (admissible and consistent for this movement model, so
@@ -18,6 +18,22 @@ impl<'g> AStar<'g> {
         Self {
             search: BestFirst::new(grid),
         }
+    }
+
+    /// A planner for `grid` that reuses an earlier planner's memory ([`Self::into_memory`]): its
+    /// component labels on the grid they were made for (compared cell by cell), its search
+    /// records on a grid of the same size. The paths are those of a new planner.
+    #[must_use]
+    pub fn with_memory(grid: &'g BitGrid, memory: BestFirstMemory) -> Self {
+        Self {
+            search: BestFirst::with_memory(grid, memory),
+        }
+    }
+
+    /// What a later planner on the same grid can reuse ([`Self::with_memory`]).
+    #[must_use]
+    pub fn into_memory(self) -> BestFirstMemory {
+        self.search.into_memory()
     }
 }
 

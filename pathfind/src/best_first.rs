@@ -20,6 +20,24 @@ pub(crate) struct BestFirst<'g> {
     closed: ClosedSet,
 }
 
+/// What a [`BestFirst`] search keeps for the next one on the same grid (see
+/// [`AStar::with_memory`](crate::AStar::with_memory)).
+pub struct BestFirstMemory {
+    labelled: BitGrid,
+    components: Components,
+    space: SearchSpace<CellRing>,
+    closed: ClosedSet,
+}
+
+impl std::fmt::Debug for BestFirstMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BestFirstMemory")
+            .field("width", &self.labelled.width())
+            .field("height", &self.labelled.height())
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'g> BestFirst<'g> {
     /// A search for `grid` (labels its connected components once).
     pub(crate) fn new(grid: &'g BitGrid) -> Self {
@@ -28,6 +46,37 @@ impl<'g> BestFirst<'g> {
             components: Components::new(grid),
             space: SearchSpace::new(grid.width(), grid.height()),
             closed: ClosedSet::new(grid),
+        }
+    }
+
+    /// A search for `grid` reusing `memory`: its labels on the grid they were made for
+    /// (compared cell by cell), its search records on a grid of the same size.
+    pub(crate) fn with_memory(grid: &'g BitGrid, memory: BestFirstMemory) -> Self {
+        let same_size =
+            (memory.labelled.width(), memory.labelled.height()) == (grid.width(), grid.height());
+        if !same_size {
+            return Self::new(grid);
+        }
+        let components = if memory.labelled == *grid {
+            memory.components
+        } else {
+            Components::new(grid)
+        };
+        Self {
+            grid,
+            components,
+            space: memory.space,
+            closed: memory.closed,
+        }
+    }
+
+    /// What the next search on the same grid can reuse.
+    pub(crate) fn into_memory(self) -> BestFirstMemory {
+        BestFirstMemory {
+            labelled: self.grid.clone(),
+            components: self.components,
+            space: self.space,
+            closed: self.closed,
         }
     }
 

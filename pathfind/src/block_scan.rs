@@ -152,6 +152,30 @@ impl<'g> BlockJumper<'g> {
         }
     }
 
+    /// The jumper for `grid` reusing `transposed` when `of` is the same grid (compared cell by
+    /// cell).
+    pub(crate) fn reusing(grid: &'g BitGrid, of: &BitGrid, transposed: BitGrid) -> Self {
+        if of != grid {
+            return Self::new(grid);
+        }
+        let wall = vec![u64::MAX; grid.stride_words().max(transposed.stride_words())];
+        Self {
+            grid,
+            transposed,
+            wall,
+        }
+    }
+
+    /// The grid it scans.
+    pub(crate) fn grid(&self) -> &'g BitGrid {
+        self.grid
+    }
+
+    /// The transposed grid, for [`Self::reusing`].
+    pub(crate) fn into_transposed(self) -> BitGrid {
+        self.transposed
+    }
+
     /// Bytes of the transposed grid.
     pub(crate) fn bytes(&self) -> usize {
         self.transposed.words().len() * 8

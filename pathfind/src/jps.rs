@@ -3,8 +3,10 @@
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 use crate::block_scan::BlockJumper;
+use crate::components::Components;
 use crate::jump_search::{JumpSearch, Jumper};
 use crate::movement::{DIRECTIONS, can_step, free};
+use crate::search_space::SearchSpace;
 
 /// Jump Point Search: A* over jump points found online, with no per-grid tables.
 ///
@@ -50,6 +52,77 @@ impl<'g> JumpPointSearch<'g> {
         match &self.scans {
             Scans::Words(b) => b.bytes(),
             Scans::Cells(_) => 0,
+        }
+    }
+}
+
+/// What a [`JumpPointSearch`] keeps for the next planner on the same grid
+/// ([`JumpPointSearch::into_memory`], [`JumpPointSearch::with_memory`]): the component labels,
+/// the search records and, with word scans, the transposed grid.
+pub struct JumpPointSearchMemory {
+    labelled: BitGrid,
+    components: Components,
+    space: SearchSpace,
+    transposed: Option<BitGrid>,
+}
+
+impl std::fmt::Debug for JumpPointSearchMemory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JumpPointSearchMemory")
+            .field("width", &self.labelled.width())
+            .field("height", &self.labelled.height())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'g> JumpPointSearch<'g> {
+    /// A planner for `grid` with word scans that reuses an earlier planner's memory
+    /// ([`Self::into_memory`]): on the grid it was made for (compared cell by cell) its labels and
+    /// transposed grid, on a grid of the same size its search records. The paths are those of
+    /// a new planner.
+    ///
+    /// ```
+    /// use pathfind::JumpPointSearch;
+    /// use slam_core::{BitGrid, Cell, Planner};
+    ///
+    /// let mut grid = BitGrid::new(30, 30)?;
+    /// let mut planner = JumpPointSearch::new(&grid);
+    /// assert!(planner.plan(Cell::new(0, 0), Cell::new(29, 29))?.is_some());
+    /// let memory = planner.into_memory();
+    /// for y in 0..30 {
+    ///     grid.set(Cell::new(15, y), true)?;
+    /// }
+    /// let mut planner = JumpPointSearch::with_memory(&grid, memory);
+    /// assert_eq!(planner.plan(Cell::new(0, 0), Cell::new(29, 29))?, None);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    #[must_use]
+    pub fn with_memory(grid: &'g BitGrid, memory: JumpPointSearchMemory) -> Self {
+        let search =
+            JumpSearch::with_parts(grid, &memory.labelled, memory.components, memory.space);
+        let scans = match memory.transposed {
+            Some(t) => BlockJumper::reusing(grid, &memory.labelled, t),
+            None => BlockJumper::new(grid),
+        };
+        Self {
+            search,
+            scans: Scans::Words(scans),
+        }
+    }
+
+    /// What a later planner on the same grid can reuse ([`Self::with_memory`]).
+    #[must_use]
+    pub fn into_memory(self) -> JumpPointSearchMemory {
+        let (labelled, transposed) = match self.scans {
+            Scans::Words(b) => (b.grid().clone(), Some(b.into_transposed())),
+            Scans::Cells(c) => (c.0.clone(), None),
+        };
+        let (components, space) = self.search.into_parts();
+        JumpPointSearchMemory {
+            labelled,
+            components,
+            space,
+            transposed,
         }
     }
 }

@@ -113,6 +113,33 @@ impl<'g> JumpSearch<'g> {
         }
     }
 
+    /// The search state for `grid` reusing `components` when `labelled` is the same grid
+    /// (compared cell by cell) and `space` when it has the same size.
+    pub(crate) fn with_parts(
+        grid: &'g BitGrid,
+        labelled: &BitGrid,
+        components: Components,
+        space: SearchSpace,
+    ) -> Self {
+        if (labelled.width(), labelled.height()) != (grid.width(), grid.height()) {
+            return Self::new(grid);
+        }
+        Self {
+            grid,
+            components: if labelled == grid {
+                components
+            } else {
+                Components::new(grid)
+            },
+            space,
+        }
+    }
+
+    /// The labels and the search records, for [`Self::with_parts`].
+    pub(crate) fn into_parts(self) -> (Components, SearchSpace) {
+        (self.components, self.space)
+    }
+
     /// A shortest path from `start` to `goal` with successors from `jumper` (see
     /// [`jump_search`]).
     pub(crate) fn plan(

@@ -68,11 +68,12 @@ mod path_filter;
 mod search_space;
 
 pub use astar::AStar;
+pub use best_first::BestFirstMemory;
 pub use cell_cost_astar::{CellCostAStar, CellCostMemory, CostedPath};
 pub use components::Components;
 pub use dijkstra::Dijkstra;
 pub use error::PathfindError;
-pub use jps::JumpPointSearch;
+pub use jps::{JumpPointSearch, JumpPointSearchMemory};
 pub use jps_plus::JumpPointSearchPlus;
 pub use jump_tables::MAX_JUMP_TABLE_CELLS;
 pub use line_of_sight::{line_of_sight, supercover_cells};

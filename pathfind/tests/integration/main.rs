@@ -5,4 +5,5 @@
 mod bounded_memory;
 mod cell_costs;
 mod movingai_golden;
+mod planner_memory;
 mod planners;
