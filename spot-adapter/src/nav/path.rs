@@ -5,17 +5,30 @@ use gridmap::PlanningGrid;
 use nalgebra::Vector2;
 use std::cell::RefCell;
 
-use pathfind::{AStar, CellCostAStar, CellCostMemory, JumpPointSearch, filter_path};
+use pathfind::{
+    AStar, BestFirstMemory, CellCostAStar, CellCostMemory, JumpPointSearch, JumpPointSearchMemory,
+    filter_path,
+};
 use slam_core::{BitGrid, Cell, GridPath, Planner};
 
 use crate::nav::NavError;
 use crate::nav::config::PlannerKind;
 
-/// What the cost-aware planner keeps from one plan to the next on a grid (its component labels
-/// and search records, [`CellCostMemory`]): a replan on an unchanged map builds neither again,
-/// and on a changed one only the labels. A cache: a clone starts empty.
+/// What the planner keeps from one plan to the next on a grid (its component labels, search
+/// records and, for JPS, the transposed grid): a replan on an unchanged map builds none of them
+/// again, and on a changed one only what depends on the cells. A cache: a clone starts empty.
 #[derive(Debug, Default)]
-pub(crate) struct PlannerMemory(RefCell<Option<CellCostMemory>>);
+pub(crate) struct PlannerMemory(RefCell<Kept>);
+
+/// The memory of the last planner that ran.
+#[derive(Debug, Default)]
+enum Kept {
+    #[default]
+    Nothing,
+    CellCost(CellCostMemory),
+    AStar(BestFirstMemory),
+    Jps(JumpPointSearchMemory),
+}
 
 impl Clone for PlannerMemory {
     fn clone(&self) -> Self {
@@ -162,17 +175,33 @@ pub(crate) fn dense_path(
     let path: Option<GridPath> = match planner {
         PlannerKind::CellCostAStar => {
             let costs = planning.step_costs();
-            let mut search = match memory.0.borrow_mut().take() {
-                Some(kept) => CellCostAStar::with_memory(grid, costs, kept),
-                None => CellCostAStar::new(grid, costs),
+            let mut search = match memory.0.take() {
+                Kept::CellCost(kept) => CellCostAStar::with_memory(grid, costs, kept),
+                _ => CellCostAStar::new(grid, costs),
             }
             .map_err(NavError::PlanningCosts)?;
             let found = search.plan(start, goal_cell);
-            *memory.0.borrow_mut() = Some(search.into_memory());
+            memory.0.replace(Kept::CellCost(search.into_memory()));
             found
         }
-        PlannerKind::JumpPointSearch => JumpPointSearch::new(grid).plan(start, goal_cell),
-        PlannerKind::AStar => AStar::new(grid).plan(start, goal_cell),
+        PlannerKind::JumpPointSearch => {
+            let mut search = match memory.0.take() {
+                Kept::Jps(kept) => JumpPointSearch::with_memory(grid, kept),
+                _ => JumpPointSearch::new(grid),
+            };
+            let found = search.plan(start, goal_cell);
+            memory.0.replace(Kept::Jps(search.into_memory()));
+            found
+        }
+        PlannerKind::AStar => {
+            let mut search = match memory.0.take() {
+                Kept::AStar(kept) => AStar::with_memory(grid, kept),
+                _ => AStar::new(grid),
+            };
+            let found = search.plan(start, goal_cell);
+            memory.0.replace(Kept::AStar(search.into_memory()));
+            found
+        }
     }
     .map_err(NavError::Planner)?;
     // The length of the cells walked, not the planner's cost (which counts the clearance cost).
