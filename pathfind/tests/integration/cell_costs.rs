@@ -8,17 +8,9 @@ use std::collections::BinaryHeap;
 use pathfind::movement::{can_step, validate_dense_path};
 use pathfind::{AStar, CellCostAStar, Dijkstra, PathfindError};
 use proptest::prelude::*;
-use slam_core::{BitGrid, Cell, PlanError, Planner};
 
-fn xorshift(seed: u64) -> impl FnMut() -> u64 {
-    let mut s = seed | 1;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        s
-    }
-}
+use crate::support::{free_cell, xorshift};
+use slam_core::{BitGrid, Cell, PlanError, Planner};
 
 fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
     let mut r = xorshift(seed);
@@ -100,19 +92,6 @@ fn cost_along(grid: &BitGrid, costs: &[f32], cells: &[Cell]) -> f64 {
             len * f64::from(costs[p[1].y as usize * w + p[1].x as usize])
         })
         .sum()
-}
-
-fn free_cell(grid: &BitGrid, pick: u64) -> Option<Cell> {
-    let n = u64::from(grid.width()) * u64::from(grid.height());
-    (0..n)
-        .map(|k| (pick + k * 7919) % n)
-        .map(|i| {
-            Cell::new(
-                (i % u64::from(grid.width())) as u32,
-                (i / u64::from(grid.width())) as u32,
-            )
-        })
-        .find(|&c| !grid.is_blocked(c))
 }
 
 proptest! {

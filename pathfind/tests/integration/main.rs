@@ -7,3 +7,4 @@ mod cell_costs;
 mod movingai_golden;
 mod planner_memory;
 mod planners;
+mod support;

@@ -5,26 +5,9 @@
 
 use pathfind::{AStar, Dijkstra, JumpPointSearch};
 use proptest::prelude::*;
+
+use crate::support::{free_cell, xorshift};
 use slam_core::{BitGrid, Cell, Planner};
-
-fn xorshift(seed: u64) -> impl FnMut() -> u64 {
-    let mut s = seed | 1;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        s
-    }
-}
-
-/// The `pick`-th free cell in row-major order (wrapping), if any.
-fn free_cell(grid: &BitGrid, pick: u64) -> Option<Cell> {
-    let free: Vec<Cell> = (0..grid.height())
-        .flat_map(|y| (0..grid.width()).map(move |x| Cell::new(x, y)))
-        .filter(|&c| !grid.is_blocked(c))
-        .collect();
-    (!free.is_empty()).then(|| free[(pick % free.len() as u64) as usize])
-}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(150))]

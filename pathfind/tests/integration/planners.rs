@@ -7,6 +7,8 @@ use pathfind::{
     supercover_cells,
 };
 use proptest::prelude::*;
+
+use crate::support::free_cell;
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
 
 /// A random grid: `density` percent blocked, from a seeded xorshift.
@@ -19,19 +21,6 @@ fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
         (s % 100) < u64::from(density)
     })
     .unwrap()
-}
-
-fn free_cell(grid: &BitGrid, pick: u64) -> Option<Cell> {
-    let n = u64::from(grid.width()) * u64::from(grid.height());
-    (0..n)
-        .map(|k| (pick + k * 7919) % n)
-        .map(|i| {
-            Cell::new(
-                (i % u64::from(grid.width())) as u32,
-                (i / u64::from(grid.width())) as u32,
-            )
-        })
-        .find(|&c| !grid.is_blocked(c))
 }
 
 fn check(
