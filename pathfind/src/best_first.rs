@@ -20,8 +20,9 @@ pub(crate) struct BestFirst<'g> {
     closed: ClosedSet,
 }
 
-/// What a [`BestFirst`] search keeps for the next one on the same grid (see
-/// [`AStar::with_memory`](crate::AStar::with_memory)).
+/// What an [`AStar`](crate::AStar) keeps for the next planner on the same grid (see
+/// [`AStar::with_memory`](crate::AStar::with_memory)): the component labels and the search
+/// records.
 pub struct BestFirstMemory {
     labelled: BitGrid,
     components: Components,
