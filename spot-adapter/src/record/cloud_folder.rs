@@ -23,6 +23,7 @@ use slam_core::Pose3;
 use slam_core::io::read_tum;
 
 use crate::record::RecordError;
+use crate::record::folder_files::sorted_files;
 use crate::record::frame_tree::PoseSeries;
 use crate::record::no_return::{DroppedPoints, ReturnFilter};
 use crate::record::time_unit::TimeUnitInference;
@@ -81,13 +82,7 @@ impl CloudFolder {
     /// another count of lines; [`RecordError::Format`] for a malformed TUM file.
     pub fn open(dir: impl AsRef<Path>, config: &CloudFolderConfig) -> Result<Self, RecordError> {
         let dir = dir.as_ref().to_path_buf();
-        let mut scans: Vec<PathBuf> = fs::read_dir(&dir)
-            .map_err(|e| RecordError::io(&dir, e))?
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| is_cloud_file(p))
-            .collect();
-        scans.sort();
+        let mut scans = sorted_files(&dir, is_cloud_file)?;
         if scans.is_empty() {
             return Err(RecordError::NoScans { path: dir });
         }

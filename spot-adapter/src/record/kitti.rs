@@ -12,7 +12,6 @@
 //! either the identity for every scan (the engine then predicts no motion) or, on request, the
 //! ground truth itself (for checking the mapping half alone).
 
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use slam_core::Pose3;
@@ -20,6 +19,7 @@ use slam_core::io::{parse_kitti_bin, parse_kitti_poses};
 
 use super::bounded_file::{MAX_RECORDING_FILE_BYTES, read_bounded, read_bounded_text};
 use crate::record::RecordError;
+use crate::record::folder_files::sorted_files;
 use crate::robot::Sample;
 
 /// Where a KITTI sequence's odometry comes from.
@@ -73,13 +73,7 @@ impl KittiSequence {
     pub fn open(dir: impl AsRef<Path>, odometry: KittiOdometry) -> Result<Self, RecordError> {
         let dir = dir.as_ref();
         let velodyne = dir.join("velodyne");
-        let mut scans: Vec<PathBuf> = fs::read_dir(&velodyne)
-            .map_err(|e| RecordError::io(&velodyne, e))?
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|x| x == "bin"))
-            .collect();
-        scans.sort();
+        let scans = sorted_files(&velodyne, |p| p.extension().is_some_and(|x| x == "bin"))?;
         let poses_path = dir.join("poses.txt");
         let poses = if poses_path.exists() {
             let p = parse_kitti_poses(&read_text(&poses_path)?)?;

@@ -65,6 +65,7 @@ mod bag_topics;
 mod bounded_file;
 mod cloud_folder;
 mod error;
+mod folder_files;
 mod frame_tree;
 mod imu;
 mod kitti;
