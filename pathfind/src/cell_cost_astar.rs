@@ -165,9 +165,6 @@ impl Units {
 pub struct CellCostAStar<'g> {
     grid: &'g BitGrid,
     costs: &'g [f32],
-    /// The grid `components` labels (a copy, so that a planner built again from this one's
-    /// memory can tell whether the grid changed).
-    labelled: BitGrid,
     components: Components,
     closed: ClosedSet,
     nodes: Vec<Node>,
@@ -243,7 +240,9 @@ impl<'g> CellCostAStar<'g> {
     #[must_use]
     pub fn into_memory(self) -> CellCostMemory {
         CellCostMemory {
-            labelled: self.labelled,
+            // A copy, so that a planner built from this memory can tell whether its grid is
+            // the one the labels are of.
+            labelled: self.grid.clone(),
             components: self.components,
             closed: self.closed,
             nodes: self.nodes,
@@ -283,36 +282,33 @@ impl<'g> CellCostAStar<'g> {
         let same_size = |m: &CellCostMemory| {
             (m.labelled.width(), m.labelled.height()) == (grid.width(), grid.height())
         };
-        let memory = match memory.filter(same_size) {
-            Some(m) if m.labelled == *grid => m,
-            Some(m) => CellCostMemory {
-                labelled: grid.clone(),
-                components: Components::new(grid),
-                ..m
-            },
-            None => CellCostMemory {
-                labelled: grid.clone(),
-                components: Components::new(grid),
-                closed: ClosedSet::new(grid),
-                nodes: vec![
-                    Node {
-                        g: 0,
-                        parent: 0,
-                        stamp: 0,
-                    };
-                    grid.len()
-                ],
-                generation: 0,
-            },
+        let (components, closed, nodes, generation) = if let Some(m) = memory.filter(same_size) {
+            let components = if m.labelled == *grid {
+                m.components
+            } else {
+                Components::new(grid)
+            };
+            (components, m.closed, m.nodes, m.generation)
+        } else {
+            let fresh = Node {
+                g: 0,
+                parent: 0,
+                stamp: 0,
+            };
+            (
+                Components::new(grid),
+                ClosedSet::new(grid),
+                vec![fresh; grid.len()],
+                0,
+            )
         };
         Ok(Self {
             grid,
             costs,
-            labelled: memory.labelled,
-            components: memory.components,
-            closed: memory.closed,
-            nodes: memory.nodes,
-            generation: memory.generation,
+            components,
+            closed,
+            nodes,
+            generation,
             open,
             same_f: Vec::new(),
             current_f: 0,
