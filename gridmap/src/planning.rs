@@ -404,7 +404,8 @@ impl PlanningGrid {
     /// grid on which straight segments between a path's waypoints keep room to spare. The mask
     /// of the last clearance asked for is kept and kept up to date by [`Self::refresh`], so a
     /// navigator that asks every plan builds it once per map; another clearance is computed
-    /// afresh. A clearance beyond the reach blocks every cell (clearances are capped there).
+    /// afresh. A clearance beyond the reach blocks every cell (clearances are capped there); one
+    /// that is not above zero (or NaN) adds no cell to the blocked ones.
     ///
     /// ```
     /// use gridmap::{OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid, PlanningGridConfig};

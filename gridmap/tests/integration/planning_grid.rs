@@ -123,6 +123,12 @@ proptest! {
         prop_assert_eq!(&*layer.roomy(min_clearance), &want);
         prop_assert_eq!(&*rebuilt.roomy(min_clearance), &want);
         prop_assert_eq!(&*layer.roomy(0.7), &*rebuilt.roomy(0.7));
+        // Careless clearances: none, negative, NaN add nothing; beyond the reach, everything.
+        for nothing in [0.0, -1.0, f64::NAN] {
+            prop_assert_eq!(&*layer.roomy(nothing), rebuilt.blocked());
+        }
+        let everything = layer.roomy(1e9);
+        prop_assert!((0..h).all(|y| (0..w).all(|x| everything.is_blocked(Cell::new(x, y)))));
     }
 }
 
