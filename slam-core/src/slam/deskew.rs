@@ -169,5 +169,15 @@ mod tests {
             }
             assert!((q - exact).norm() < 2e-5, "point {i}: {q} vs {exact}");
         }
+        // Careless twists: a spin too fast for the steps (1,000 rad/s) is deskewed point by
+        // point, exactly; a NaN twist leaves no point in place, without a panic.
+        let spin = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, 1000.0);
+        let fixed = deskew(&cloud, &spin).unwrap();
+        for ((p, q), &t) in points.iter().zip(fixed.points()).zip(&times).skip(18) {
+            let exact = (se3_exp(&(spin * f64::from(t))) * p.cast::<f64>()).cast::<f32>();
+            assert!((q - exact).norm() < 1e-4, "{q} vs {exact}");
+        }
+        let lost = deskew(&cloud, &Vector6::repeat(f64::NAN)).unwrap();
+        assert!(lost.points().iter().all(|p| !p.x.is_finite()));
     }
 }
