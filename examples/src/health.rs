@@ -62,6 +62,9 @@ pub struct HealthSummary {
     pub odometry_faults: usize,
     /// LiDAR-only scans whose turn since the last one the gyro predicted.
     pub gyro_predictions: usize,
+    /// LiDAR-only scans predicted without a gyro, by how much of the last step's turn the
+    /// prediction repeated (`held`, `half`, `all`).
+    pub turn_shares: BTreeMap<String, usize>,
     /// Optimiser runs that failed (the graph was kept as it was).
     pub optimizer_failures: usize,
     /// Local maps the odometry's backend could not build (those scans fell back with
@@ -102,6 +105,11 @@ impl HealthSummary {
             lost: fallback_share > LOST_SHARE || tracking.losses > 0,
             odometry_faults: report.odometry_faults,
             gyro_predictions: report.gyro_predictions,
+            turn_shares: ["held", "half", "all"]
+                .into_iter()
+                .zip(report.turn_shares)
+                .map(|(share, n)| (share.to_owned(), n))
+                .collect(),
             optimizer_failures: report.optimizer_failures,
             local_map_failures: report.local_map_failures,
             skipped,
@@ -145,8 +153,9 @@ fn listed(map: &BTreeMap<String, usize>) -> String {
 /// [`StdoutClosed`](crate::StdoutClosed) when stdout was closed.
 pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
     let health = HealthSummary::new(report);
+    let [held, half, all] = report.turn_shares;
     out!(
-        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} turns predicted by the gyro; {} optimiser failures; {} local maps not built",
+        "tracking    {} of {} scans fell back ({:.1} %: {}), {} recovered on a second try, lost {} times; {} odometry faults; {} turns predicted by the gyro; last turn repeated {}/{}/{} times (held/half/all); {} optimiser failures; {} local maps not built",
         health.fallbacks,
         health.scans,
         100.0 * health.fallback_share,
@@ -155,6 +164,9 @@ pub fn print_tracking_health(report: &SlamReport) -> Result<HealthSummary> {
         health.losses,
         health.odometry_faults,
         health.gyro_predictions,
+        held,
+        half,
+        all,
         health.optimizer_failures,
         health.local_map_failures
     )?;

@@ -55,7 +55,7 @@ pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
     EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, LoopRejection, LoopRejections,
-    ScanInput, ScanOutcome, SkipReason, SlamReport, deskew,
+    ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew,
 };
 pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};

@@ -12,7 +12,7 @@ use super::keyframes::{Keyframe, ScanPose};
 use super::local_map::LocalMap;
 use super::loop_closure::LoopQueue;
 use super::node_index::NodeIndex;
-use super::prediction::Prediction;
+use super::prediction::{Prediction, TurnBasis};
 use super::report::{ScanOutcome, SkipReason, SlamReport};
 use super::scan_preparation::Prepared;
 use crate::cloud::PointCloud;
@@ -20,7 +20,7 @@ use crate::error::{InvalidSetting, OptimizeError};
 use crate::geometry::{Pose3, pose3_is_finite};
 use crate::io::StampedPose;
 use crate::pose_graph::{GraphPose, PoseGraph};
-use crate::tracking::Tracker;
+use crate::tracking::{Tracker, TurnPersistence};
 use crate::traits::optimizer::Optimizer;
 use crate::traits::place_recognizer::PlaceRecognizer;
 use crate::traits::registrator::MapRegistrator;
@@ -77,6 +77,10 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Every accepted scan.
     pub(super) scan_poses: Vec<ScanPose>,
     pub(super) last_stamp: f64,
+    /// How much of the last turn LiDAR-only predictions repeat.
+    pub(super) turns: TurnPersistence,
+    /// What the current scan's LiDAR-only prediction was extrapolated from, to score `turns`.
+    pub(super) turn_basis: Option<TurnBasis>,
     /// The gyro orientation of the last scan taken.
     pub(super) last_gyro: Option<GyroReading>,
     /// The RMS error of the last scan's registration by the tracker (its sweep's own must beat
@@ -119,6 +123,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             loops: LoopQueue::default(),
             scan_poses: Vec::new(),
             last_stamp: f64::NEG_INFINITY,
+            turns: TurnPersistence::default(),
+            turn_basis: None,
             last_gyro: None,
             last_fit: None,
             last_odometry: None,
@@ -255,6 +261,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             velocity,
             swept && lidar_only.is_some(),
         );
+        if let Some(basis) = self.turn_basis.take()
+            && tracked.information.is_some()
+        {
+            basis.score(&mut self.turns, &tracked.pose, tracked.prepared.extent);
+        }
         // 4. Keyframe decision: an odometry step was long enough already; LiDAR-only, the
         //    registered pose decides.
         if let Some(last) = lidar_only {

@@ -30,7 +30,7 @@ mod report;
 mod scan_preparation;
 mod scan_tracking;
 
-pub use config::{EdgeInformation, GraphSlamConfig};
+pub use config::{EdgeInformation, GraphSlamConfig, TurnPrediction};
 pub use deskew::deskew;
 pub use engine::{GraphSlam, ScanInput};
 pub use report::{LoopOutcome, LoopRejection, LoopRejections, ScanOutcome, SkipReason, SlamReport};

@@ -1,14 +1,17 @@
 //! Where a scan is expected before it is registered: from the robot's odometry since the last
 //! keyframe (thesis eq. 4.1-4.2), or LiDAR-only from the constant velocity of the last two scans
-//! (its rotation from the gyro when there is one); and with what velocity its sweep is deskewed.
+//! (its rotation from the gyro when there is one, else with the share of the last turn that has
+//! predicted best lately: [`TurnPersistence`]); and with what velocity its sweep is deskewed.
 
 use nalgebra::Vector6;
 
+use super::config::TurnPrediction;
 use super::engine::{GraphSlam, GyroReading, ScanInput};
 use super::keyframes::ScanPose;
 use super::report::SkipReason;
 use crate::geometry::{Pose3, se3_exp, se3_log};
 use crate::io::StampedPose;
+use crate::tracking::{TURN_SHARES, TurnPersistence};
 use crate::traits::optimizer::Optimizer;
 use crate::traits::registrator::MapRegistrator;
 
@@ -53,6 +56,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         odom_t_lidar: Option<Pose3>,
         swept: bool,
     ) -> Result<Prediction, SkipReason> {
+        self.turn_basis = None;
         let odometry_velocity = self.odometry_velocity(scan.stamp, odom_t_lidar, swept);
         let Some(last) = self.keyframes.len().checked_sub(1) else {
             if swept && odom_t_lidar.is_some() && odometry_velocity.is_none() {
@@ -68,10 +72,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if let (Some(now), Some(then)) = (odom_t_lidar, self.keyframes[last].odom_t_lidar) {
             return Ok(self.odometry_prediction(scan.stamp, now, then, last, odometry_velocity));
         }
-        let (guess, velocity) = self
+        let (guess, velocity, basis) = self
             .motion_prior(scan.stamp)
-            .unwrap_or_else(|| (self.keyframe_pose(last), None));
+            .unwrap_or_else(|| (self.keyframe_pose(last), None, None));
+        let gyro_before = self.report.gyro_predictions;
         let (guess, velocity) = self.gyro_prior(scan, guess, velocity);
+        if basis.is_some() && self.report.gyro_predictions == gyro_before {
+            self.report.turn_shares[self.turn_choice()] += 1;
+        }
+        self.turn_basis = basis;
         Ok(Prediction::LidarOnly {
             guess,
             velocity: velocity.filter(|_| swept),
@@ -120,7 +129,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             };
         }
         let prior = self.motion_prior(stamp);
-        let suspect = prior.is_some_and(|(p, _)| {
+        let suspect = prior.as_ref().is_some_and(|(p, _, _)| {
             (p.inverse() * predicted).translation.vector.norm()
                 > self.config.tracker.arbitration_distance
         });
@@ -128,12 +137,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // extrapolation's instead. The extrapolation arbitrates only a suspect step, so that
         // clean input runs exactly as without the check.
         let velocity = if suspect {
-            velocity.and(prior.and_then(|(_, v)| v))
+            velocity.and(prior.as_ref().and_then(|(_, v, _)| *v))
         } else {
             velocity
         };
         let mut guesses = vec![predicted];
-        guesses.extend(prior.filter(|_| suspect).map(|(guess, _)| guess));
+        guesses.extend(prior.filter(|_| suspect).map(|(guess, _, _)| guess));
         Prediction::Odometry { guesses, velocity }
     }
 
@@ -180,12 +189,27 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         (Pose3::from_parts(predicted.translation, rotation), velocity)
     }
 
-    /// The LiDAR pose at `stamp` extrapolated at constant velocity from the last two accepted
-    /// scans, with that velocity (LiDAR-frame twist per second); the last scan's pose held, and
+    /// The share of the last step's turn a LiDAR-only prediction repeats: all of it unless
+    /// [`TurnPrediction::Adaptive`].
+    fn turn_share(&self) -> f64 {
+        TURN_SHARES[self.turn_choice()]
+    }
+
+    /// The index in [`TURN_SHARES`] of [`Self::turn_share`].
+    fn turn_choice(&self) -> usize {
+        match self.config.turn_prediction {
+            TurnPrediction::Adaptive => self.turns.choice(),
+            TurnPrediction::ConstantVelocity => TURN_SHARES.len() - 1,
+        }
+    }
+
+    /// The LiDAR pose at `stamp` extrapolated at the velocity of the last two accepted scans
+    /// (with [`Self::turn_share`] of its turn), with that velocity (LiDAR-frame twist per second)
+    /// and what the extrapolation was made from; the last scan's pose held, and
     /// no velocity, when there is only one or the scans are more than a second apart. `None`
     /// before the first scan. Read from the scans' keyframes, so a loop closure that moved them
     /// moves the extrapolation too.
-    fn motion_prior(&self, stamp: f64) -> Option<(Pose3, Option<Vector6<f64>>)> {
+    fn motion_prior(&self, stamp: f64) -> Option<(Pose3, Option<Vector6<f64>>, Option<TurnBasis>)> {
         // Each scan's pose in the middle of its sweep: registering a deskewed sweep fixes its
         // middle whatever velocity it was deskewed with, while its start moves with that
         // velocity's error. A velocity taken from the starts would feed that error back into
@@ -205,7 +229,34 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             (dt0 > 0.0 && dt0 <= 1.0 && dt > 0.0 && dt <= 1.0)
                 .then(|| se3_log(&(m0.inverse() * m1)) / dt0)
         });
-        let pose = velocity.map_or(x1, |v| m1 * se3_exp(&(v * (stamp - t1))));
-        Some((pose, velocity))
+        let basis = velocity.map(|v| TurnBasis {
+            from: m1,
+            velocity: v,
+            dt: stamp - t1,
+        });
+        let pose = basis.as_ref().map_or(x1, |b| b.predict(self.turn_share()));
+        Some((pose, velocity, basis))
+    }
+}
+
+/// What a LiDAR-only prediction was extrapolated from: the last scan's mid-sweep pose, the
+/// velocity of the last step and the time since; scored against the registered pose
+/// ([`TurnPersistence::record`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TurnBasis {
+    from: Pose3,
+    velocity: Vector6<f64>,
+    dt: f64,
+}
+
+impl TurnBasis {
+    /// The prediction with `share` of the last step's turn.
+    fn predict(&self, share: f64) -> Pose3 {
+        TurnPersistence::predict(&self.from, &self.velocity, self.dt, share)
+    }
+
+    /// Scores the turn shares on the pose the scan registered at.
+    pub(super) fn score(&self, turns: &mut TurnPersistence, registered: &Pose3, extent: f64) {
+        turns.record(&self.from, &self.velocity, self.dt, registered, extent);
     }
 }

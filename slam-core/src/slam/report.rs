@@ -203,6 +203,10 @@ pub struct SlamReport {
     /// ([`ScanInput::gyro_orientation`](crate::ScanInput::gyro_orientation)) instead of the
     /// constant velocity.
     pub gyro_predictions: usize,
+    /// LiDAR-only scans predicted from the last step's motion (without a gyro), by the share of
+    /// its turn the prediction repeated: none (heading held), half, all (constant velocity);
+    /// see [`TurnPersistence`](crate::tracking::TurnPersistence).
+    pub turn_shares: [usize; 3],
     /// Skipped scans: a non-finite keyframe pose ([`SkipReason::NonFinitePose`]).
     pub skipped_non_finite_pose: usize,
     /// Loop candidates tried.

@@ -18,8 +18,10 @@ mod extent;
 mod health;
 mod reach;
 mod tracker;
+mod turn_persistence;
 
 pub use extent::scan_extent;
 pub use health::{FallbackCounts, FallbackReason, TrackingHealth};
 pub use reach::{AdaptiveReach, ReachConfig, point_displacement};
 pub use tracker::{TrackOutcome, Tracker, TrackerConfig};
+pub use turn_persistence::{TURN_SHARES, TurnPersistence};
