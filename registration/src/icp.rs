@@ -6,6 +6,7 @@ use rayon::prelude::*;
 use slam_core::{Alignment, Degeneracy, Pose3, RegistrationError, se3_exp, so3_hat};
 
 use crate::alignment_inputs::checked_target_index;
+use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
@@ -268,16 +269,15 @@ fn align_indexed<S: IcpStep>(
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, S::residual);
     let information = S::information(&pairs, &weights);
-    Ok(Alignment {
+    Ok(alignment_report(
         pose,
         converged,
         iterations,
         inliers,
-        inlier_ratio: inliers as f64 / source.len().max(1) as f64,
+        source.len(),
         rmse,
-        min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
-        information,
-    })
+        &information,
+    ))
 }
 
 /// Every `k`-th point of `source`, the smallest `k` that leaves at most `max` (0: no limit);
@@ -309,11 +309,4 @@ pub(crate) fn inliers_and_rmse(
         f64::INFINITY
     };
     (inliers, rmse)
-}
-
-/// Smallest eigenvalue of an information matrix over its largest (0 when it is not positive).
-pub(crate) fn min_eigenvalue_ratio(information: &Matrix6<f64>) -> f64 {
-    let eig = SymmetricEigen::new(*information).eigenvalues;
-    let (lo, hi) = (eig.min(), eig.max());
-    if hi > 0.0 { (lo / hi).max(0.0) } else { 0.0 }
 }

@@ -52,6 +52,7 @@
 //! layout); for other clouds use the ICP backends.
 
 mod alignment_inputs;
+mod alignment_report;
 mod config;
 mod icp;
 mod icp_target;
