@@ -3,7 +3,9 @@
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
 use rayon::prelude::*;
-use slam_core::{Alignment, Degeneracy, Pose3, RegistrationError, se3_exp, so3_hat};
+use slam_core::{
+    Alignment, Degeneracy, PointCloud, Pose3, RegistrationError, SweepAlignment, se3_exp, so3_hat,
+};
 
 use crate::alignment_inputs::checked_target_index;
 use crate::alignment_report::alignment_report;
@@ -22,10 +24,14 @@ pub(crate) struct Pair {
     pub(crate) n: Option<Vector3<f64>>,
 }
 
-/// How a backend turns correspondences into an update (applied on the left).
+/// What sets an ICP backend apart: what it pairs a source point with, how it turns the pairs
+/// into an update (applied on the left), and whether it registers sweeps.
 pub(crate) trait IcpStep {
     /// Whether the target carries PCA normals (the step pairs points with planes).
     const TARGET_NORMALS: bool;
+    /// How many nearest target points a source point is paired with (their mean; 1: the
+    /// nearest, as textbook ICP).
+    fn pair_points(config: &IcpConfig) -> usize;
     /// The residual of a pair (metres).
     fn residual(pair: &Pair) -> f64;
     /// The update `delta` with `pose <- exp(delta) pose`.
@@ -38,6 +44,16 @@ pub(crate) trait IcpStep {
     /// `(J^T W J, J^T W r)` when the step is a Gauss-Newton solve of them (`None` for a
     /// closed-form step).
     fn normal_equations(_pairs: &[Pair], _weights: &[f64]) -> Option<(Matrix6<f64>, Vector6<f64>)> {
+        None
+    }
+    /// The registration of a sweep together with the correction to the velocity it was
+    /// deskewed with ([`slam_core::Registrator::align_sweep`]); `None` when the backend has none.
+    fn align_sweep(
+        _config: &IcpConfig,
+        _sweep: &PointCloud,
+        _target: &PreparedTarget,
+        _initial: &Pose3,
+    ) -> Option<Result<SweepAlignment, RegistrationError>> {
         None
     }
 }
@@ -155,16 +171,16 @@ fn update<S: IcpStep>(
     ))
 }
 
-/// ICP from `initial`, pairing each source point with the mean of its `pair_points` nearest
-/// target points (1: the nearest, as textbook ICP).
+/// ICP from `initial`, pairing each source point with the mean of its
+/// [`IcpStep::pair_points`] nearest target points.
 pub(crate) fn align<S: IcpStep>(
     config: &IcpConfig,
-    pair_points: usize,
     source: &[Point3<f64>],
     target: &PreparedTarget,
     initial: &Pose3,
 ) -> Result<Alignment, RegistrationError> {
     let index = checked_target_index(config, target, initial)?;
+    let pair_points = S::pair_points(config);
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
     // On a worker of the thread pool: each iteration's search then forks onto the other

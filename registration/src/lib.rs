@@ -55,6 +55,7 @@ mod alignment_inputs;
 mod alignment_report;
 mod config;
 mod icp;
+mod icp_backend;
 mod icp_target;
 mod kernel;
 mod lidar_layout;
