@@ -73,10 +73,12 @@ pub fn pick_movingai_maps(root: &Path, var: &str, default: &[&str]) -> Vec<(Stri
 }
 
 /// The peer planner: the `pathfinding` crate's generic `astar`, the common Rust choice, with a
-/// successor closure that follows the same movement rule (8-connected, no corner cutting) and an
-/// octile heuristic. Costs are integers (`pathfinding` needs `Ord`): 1 = 1e-6 cells, so lengths
-/// are exact to about 1e-6 per step.
+/// successor closure that follows the same movement rule ([`pathfind::movement`]: 8-connected,
+/// no corner cutting) and an octile heuristic. Costs are integers (`pathfinding` needs `Ord`):
+/// 1 = 1e-6 cells, so lengths are exact to about 1e-6 per step.
 pub mod pathfinding_peer {
+    use pathfind::movement::{DIRECTIONS, can_step};
+
     use super::{BitGrid, Cell};
 
     /// Cost of a straight step.
@@ -104,33 +106,21 @@ pub mod pathfinding_peer {
     /// Shortest path length (in cells) from `start` to `goal`, or `None`.
     #[must_use]
     pub fn astar_length(grid: &BitGrid, start: Cell, goal: Cell) -> Option<f64> {
-        let free = |x: i64, y: i64| grid.is_free_signed(x, y);
         let goal_t = (goal.x, goal.y);
         let (_, cost) = pathfinding::directed::astar::astar(
             &(start.x, start.y),
             |&(x, y)| {
                 let (x, y) = (i64::from(x), i64::from(y));
                 let mut out: Vec<((u32, u32), u64)> = Vec::with_capacity(8);
-                for (dx, dy) in [
-                    (1, 0),
-                    (-1, 0),
-                    (0, 1),
-                    (0, -1),
-                    (1, 1),
-                    (1, -1),
-                    (-1, 1),
-                    (-1, -1),
-                ] {
-                    let (nx, ny) = (x + dx, y + dy);
-                    if !free(nx, ny) {
-                        continue;
-                    }
-                    if dx != 0 && dy != 0 {
-                        if free(x + dx, y) && free(x, y + dy) {
-                            out.push(((nx as u32, ny as u32), DIAGONAL));
-                        }
-                    } else {
-                        out.push(((nx as u32, ny as u32), STRAIGHT));
+                for (dx, dy) in DIRECTIONS {
+                    let (dx, dy) = (i64::from(dx), i64::from(dy));
+                    if can_step(grid, x, y, dx, dy) {
+                        let cost = if dx != 0 && dy != 0 {
+                            DIAGONAL
+                        } else {
+                            STRAIGHT
+                        };
+                        out.push((((x + dx) as u32, (y + dy) as u32), cost));
                     }
                 }
                 out

@@ -33,16 +33,7 @@ impl JumpTables {
         for d in 0..4u8 {
             let (dx, dy) = DIRECTIONS[d as usize];
             let (dx, dy) = (i64::from(dx), i64::from(dy));
-            let xs: Vec<i64> = if dx > 0 {
-                (0..i64::from(w)).rev().collect()
-            } else {
-                (0..i64::from(w)).collect()
-            };
-            let ys: Vec<i64> = if dy > 0 {
-                (0..i64::from(h)).rev().collect()
-            } else {
-                (0..i64::from(h)).collect()
-            };
+            let (xs, ys) = (against(w, dx), against(h, dy));
             for &y in &ys {
                 for &x in &xs {
                     if !free(grid, x, y) {
@@ -66,16 +57,7 @@ impl JumpTables {
             let (dx, dy) = DIRECTIONS[d as usize];
             let (dx, dy) = (i64::from(dx), i64::from(dy));
             let (hd, vd) = (u8::from(dx < 0), if dy > 0 { 2 } else { 3 });
-            let xs: Vec<i64> = if dx > 0 {
-                (0..i64::from(w)).rev().collect()
-            } else {
-                (0..i64::from(w)).collect()
-            };
-            let ys: Vec<i64> = if dy > 0 {
-                (0..i64::from(h)).rev().collect()
-            } else {
-                (0..i64::from(h)).collect()
-            };
+            let (xs, ys) = (against(w, dx), against(h, dy));
             for &y in &ys {
                 for &x in &xs {
                     if !free(grid, x, y) {
@@ -112,6 +94,17 @@ impl JumpTables {
     /// Bytes used.
     pub(crate) fn bytes(&self) -> usize {
         self.dist.len() * std::mem::size_of::<i16>()
+    }
+}
+
+/// The coordinates `0..len` in the order that reaches each one after its neighbour a step of
+/// sign `step` away (descending for a positive step): walking against the direction, the next
+/// cell's distance is known when a cell is reached.
+fn against(len: u32, step: i64) -> Vec<i64> {
+    if step > 0 {
+        (0..i64::from(len)).rev().collect()
+    } else {
+        (0..i64::from(len)).collect()
     }
 }
 

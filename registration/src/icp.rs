@@ -3,9 +3,12 @@
 
 use nalgebra::{Matrix6, Point3, SymmetricEigen, Vector3, Vector6};
 use rayon::prelude::*;
-use slam_core::{Alignment, Degeneracy, Pose3, RegistrationError, se3_exp, so3_hat};
+use slam_core::{
+    Alignment, Degeneracy, PointCloud, Pose3, RegistrationError, SweepAlignment, se3_exp, so3_hat,
+};
 
 use crate::alignment_inputs::checked_target_index;
+use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
@@ -21,10 +24,14 @@ pub(crate) struct Pair {
     pub(crate) n: Option<Vector3<f64>>,
 }
 
-/// How a backend turns correspondences into an update (applied on the left).
+/// What sets an ICP backend apart: what it pairs a source point with, how it turns the pairs
+/// into an update (applied on the left), and whether it registers sweeps.
 pub(crate) trait IcpStep {
     /// Whether the target carries PCA normals (the step pairs points with planes).
     const TARGET_NORMALS: bool;
+    /// How many nearest target points a source point is paired with (their mean; 1: the
+    /// nearest, as textbook ICP).
+    fn pair_points(config: &IcpConfig) -> usize;
     /// The residual of a pair (metres).
     fn residual(pair: &Pair) -> f64;
     /// The update `delta` with `pose <- exp(delta) pose`.
@@ -37,6 +44,16 @@ pub(crate) trait IcpStep {
     /// `(J^T W J, J^T W r)` when the step is a Gauss-Newton solve of them (`None` for a
     /// closed-form step).
     fn normal_equations(_pairs: &[Pair], _weights: &[f64]) -> Option<(Matrix6<f64>, Vector6<f64>)> {
+        None
+    }
+    /// The registration of a sweep together with the correction to the velocity it was
+    /// deskewed with ([`slam_core::Registrator::align_sweep`]); `None` when the backend has none.
+    fn align_sweep(
+        _config: &IcpConfig,
+        _sweep: &PointCloud,
+        _target: &PreparedTarget,
+        _initial: &Pose3,
+    ) -> Option<Result<SweepAlignment, RegistrationError>> {
         None
     }
 }
@@ -154,16 +171,16 @@ fn update<S: IcpStep>(
     ))
 }
 
-/// ICP from `initial`, pairing each source point with the mean of its `pair_points` nearest
-/// target points (1: the nearest, as textbook ICP).
+/// ICP from `initial`, pairing each source point with the mean of its
+/// [`IcpStep::pair_points`] nearest target points.
 pub(crate) fn align<S: IcpStep>(
     config: &IcpConfig,
-    pair_points: usize,
     source: &[Point3<f64>],
     target: &PreparedTarget,
     initial: &Pose3,
 ) -> Result<Alignment, RegistrationError> {
     let index = checked_target_index(config, target, initial)?;
+    let pair_points = S::pair_points(config);
     let thinned = thin_source(source, config.max_source_points);
     let source = thinned.as_deref().unwrap_or(source);
     // On a worker of the thread pool: each iteration's search then forks onto the other
@@ -268,16 +285,15 @@ fn align_indexed<S: IcpStep>(
     weights.extend(pairs.iter().map(|p| config.kernel.weight(S::residual(p))));
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, S::residual);
     let information = S::information(&pairs, &weights);
-    Ok(Alignment {
+    Ok(alignment_report(
         pose,
         converged,
         iterations,
         inliers,
-        inlier_ratio: inliers as f64 / source.len().max(1) as f64,
+        source.len(),
         rmse,
-        min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
-        information,
-    })
+        &information,
+    ))
 }
 
 /// Every `k`-th point of `source`, the smallest `k` that leaves at most `max` (0: no limit);
@@ -309,11 +325,4 @@ pub(crate) fn inliers_and_rmse(
         f64::INFINITY
     };
     (inliers, rmse)
-}
-
-/// Smallest eigenvalue of an information matrix over its largest (0 when it is not positive).
-pub(crate) fn min_eigenvalue_ratio(information: &Matrix6<f64>) -> f64 {
-    let eig = SymmetricEigen::new(*information).eigenvalues;
-    let (lo, hi) = (eig.min(), eig.max());
-    if hi > 0.0 { (lo / hi).max(0.0) } else { 0.0 }
 }

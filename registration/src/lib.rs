@@ -52,8 +52,10 @@
 //! layout); for other clouds use the ICP backends.
 
 mod alignment_inputs;
+mod alignment_report;
 mod config;
 mod icp;
+mod icp_backend;
 mod icp_target;
 mod kernel;
 mod lidar_layout;

@@ -8,8 +8,8 @@ use slam_core::{
 };
 
 use crate::alignment_inputs::check_alignment_inputs;
+use crate::alignment_report::alignment_report;
 use crate::config::{NON_NEGATIVE, POSITIVE, check, check_f32};
-use crate::icp::min_eigenvalue_ratio;
 use crate::loam_features::{LoamFeatureConfig, LoamFeatures, voxel_thin};
 use crate::loam_matching::{Matcher, normal_equations};
 use crate::voxel_hash_map::VoxelHashMap;
@@ -348,16 +348,15 @@ fn align_loam(
     if inliers < config.min_correspondences {
         return Err(too_few(inliers));
     }
-    Ok(Alignment {
+    Ok(alignment_report(
         pose,
         converged,
         iterations,
         inliers,
-        inlier_ratio: inliers as f64 / source.len().max(1) as f64,
-        rmse: (sq / inliers as f64).sqrt(),
-        min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
-        information,
-    })
+        source.len(),
+        (sq / inliers as f64).sqrt(),
+        &information,
+    ))
 }
 
 /// How far `b` is from `a`: translation plus rotation seen at 10 m (metres).

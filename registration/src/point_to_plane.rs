@@ -1,15 +1,12 @@
 //! Point-to-plane ICP: Gauss-Newton on SE(3) with target normals from PCA.
 
-use nalgebra::{Matrix6, Point3, Vector6};
-use slam_core::{
-    Alignment, Degeneracy, MapRegistrator, PointCloud, Pose3, Reach, RegistrationError,
-    Registrator, SweepAlignment,
-};
+use nalgebra::{Matrix6, Vector6};
+use slam_core::{Degeneracy, PointCloud, Pose3, RegistrationError, SweepAlignment};
 
 use crate::config::IcpConfig;
-use crate::icp::{IcpStep, Pair, align};
-use crate::icp_target;
-use crate::target::{PreparedTarget, prepare_source_points};
+use crate::icp::{IcpStep, Pair};
+use crate::icp_backend::icp_backend;
+use crate::target::PreparedTarget;
 
 /// Point-to-plane ICP: residual `n . (T p - q)` against the target point's normal (PCA over its
 /// nearest neighbours), minimised by Gauss-Newton steps on SE(3) with robust weights.
@@ -48,6 +45,10 @@ fn row(pair: &Pair) -> Vector6<f64> {
 impl IcpStep for GaussNewtonPlane {
     const TARGET_NORMALS: bool = true;
 
+    fn pair_points(_config: &IcpConfig) -> usize {
+        1
+    }
+
     fn residual(pair: &Pair) -> f64 {
         pair.n.map_or(f64::INFINITY, |n| n.dot(&(pair.p - pair.q)))
     }
@@ -68,82 +69,17 @@ impl IcpStep for GaussNewtonPlane {
     fn information(pairs: &[Pair], weights: &[f64]) -> Matrix6<f64> {
         normal_equations(pairs, weights).0
     }
-}
-
-impl Registrator for PointToPlaneIcp {
-    type Source = Vec<Point3<f64>>;
-    type Target = PreparedTarget;
-
-    fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
-        prepare_source_points(&self.config, cloud)
-    }
-
-    fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
-        icp_target::prepare_target::<GaussNewtonPlane>(&self.config, cloud)
-    }
-
-    fn align(
-        &self,
-        source: &Self::Source,
-        target: &Self::Target,
-        initial: &Pose3,
-    ) -> Result<Alignment, RegistrationError> {
-        align::<GaussNewtonPlane>(&self.config, 1, source, target, initial)
-    }
-
-    fn align_within(
-        &self,
-        source: &Self::Source,
-        target: &Self::Target,
-        initial: &Pose3,
-        reach: &Reach,
-    ) -> Result<Alignment, RegistrationError> {
-        align::<GaussNewtonPlane>(&self.config.within(reach)?, 1, source, target, initial)
-    }
 
     /// Point-to-plane registration of the sweep together with the correction to the velocity
     /// it was deskewed with (see the crate docs' sweep section).
     fn align_sweep(
-        &self,
+        config: &IcpConfig,
         sweep: &PointCloud,
-        target: &Self::Target,
+        target: &PreparedTarget,
         initial: &Pose3,
     ) -> Option<Result<SweepAlignment, RegistrationError>> {
-        Some(crate::sweep::align_sweep(
-            &self.config,
-            sweep,
-            target,
-            initial,
-        ))
+        Some(crate::sweep::align_sweep(config, sweep, target, initial))
     }
 }
 
-impl MapRegistrator for PointToPlaneIcp {
-    fn target_from_sources(
-        &self,
-        parts: &[(&Self::Source, Pose3)],
-    ) -> Result<Self::Target, RegistrationError> {
-        icp_target::target_from_sources::<GaussNewtonPlane>(&self.config, parts)
-    }
-
-    /// [`IcpConfig::source_voxel`] when above zero: the source is the scan's voxel centroids.
-    fn source_voxel(&self) -> Option<f32> {
-        icp_target::source_voxel(&self.config)
-    }
-
-    /// With a [`IcpConfig::target_voxel`] above zero (and a valid configuration), a map kept
-    /// as per-voxel sums: a keyframe enters and leaves at the cost of its own points, and the
-    /// k-d tree is rebuilt over the voxel centroids on the first alignment after a change.
-    /// It holds the points [`MapRegistrator::target_from_sources`] would (up to rounding).
-    fn empty_map(&self) -> Option<Self::Target> {
-        icp_target::empty_map::<GaussNewtonPlane>(&self.config)
-    }
-
-    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
-        map.add_part(key, source, pose);
-    }
-
-    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
-        map.remove_part(key);
-    }
-}
+icp_backend!(PointToPlaneIcp, GaussNewtonPlane);

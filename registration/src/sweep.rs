@@ -14,13 +14,14 @@
 use nalgebra::{Point3, SMatrix, SVector, Vector6};
 use rayon::prelude::*;
 use slam_core::{
-    Alignment, Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment,
-    se3_adjoint, se3_exp,
+    Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment, se3_adjoint,
+    se3_exp,
 };
 
 use crate::alignment_inputs::checked_target_index;
+use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
-use crate::icp::{Pair, inliers_and_rmse, min_eigenvalue_ratio, thin_source};
+use crate::icp::{Pair, inliers_and_rmse, thin_source};
 use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
 
@@ -168,16 +169,15 @@ fn align_sweep_indexed(
     let information = h.fixed_view::<6, 6>(0, 0).into_owned();
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, residual);
     Ok(SweepAlignment {
-        alignment: Alignment {
+        alignment: alignment_report(
             pose,
             converged,
             iterations,
             inliers,
-            inlier_ratio: inliers as f64 / points.len().max(1) as f64,
+            points.len(),
             rmse,
-            min_eigenvalue_ratio: min_eigenvalue_ratio(&information),
-            information,
-        },
+            &information,
+        ),
         velocity_correction: correction,
     })
 }

@@ -12,6 +12,8 @@ use nalgebra::{Point3, Vector2};
 use proptest::prelude::*;
 use slam_core::{BitGrid, Cell, GridGeometry, InvalidSetting, PointCloud, Pose2, Pose3};
 
+use crate::rng::rng;
+
 fn config(resolution: f64) -> OccupancyGridConfig {
     OccupancyGridConfig {
         resolution,
@@ -21,14 +23,8 @@ fn config(resolution: f64) -> OccupancyGridConfig {
 }
 
 fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
-    let mut s = seed | 1;
-    BitGrid::from_fn(w, h, |_, _| {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s % 100) < u64::from(density)
-    })
-    .unwrap()
+    let mut r = rng(seed);
+    BitGrid::from_fn(w, h, |_, _| (r() % 100) < u64::from(density)).unwrap()
 }
 
 /// A 6 m x 4 m room at 0.1 m cells: walls one cell thick, a pillar, floor and ceiling outside the
@@ -188,14 +184,11 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 fn ros_map_round_trip_preserves_every_cell() {
     let geometry = GridGeometry::try_new(Vector2::new(-12.35, 4.05), 0.05).unwrap();
     let mut grid = OccupancyGrid::new(77, 53, geometry, CellState::Unknown).unwrap();
-    let mut s = 12345u64;
+    let mut r = rng(12345);
     for y in 0..53 {
         for x in 0..77 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
             let state =
-                [CellState::Free, CellState::Occupied, CellState::Unknown][(s % 3) as usize];
+                [CellState::Free, CellState::Occupied, CellState::Unknown][(r() % 3) as usize];
             grid.set(Cell::new(x, y), state).unwrap();
         }
     }

@@ -8,3 +8,4 @@ mod floor_band;
 mod gridmap;
 mod live_layer;
 mod planning_grid;
+mod rng;

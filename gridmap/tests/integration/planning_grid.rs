@@ -12,16 +12,15 @@ use nalgebra::{Point3, Vector2};
 use proptest::prelude::*;
 use slam_core::{Cell, GridGeometry, InvalidSetting};
 
+use crate::rng::rng;
+
 fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
     let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.1).unwrap();
     let mut grid = OccupancyGrid::new(w, h, geometry, CellState::Free).unwrap();
-    let mut s = seed | 1;
+    let mut next = rng(seed);
     for y in 0..h {
         for x in 0..w {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            let r = (s % 1000) as u32;
+            let r = (next() % 1000) as u32;
             let state = if r < density * 10 {
                 CellState::Occupied
             } else if r < (density + unknown) * 10 {
@@ -94,11 +93,9 @@ proptest! {
         let _ = layer.roomy(min_clearance);
         let (x0, y0) = (rect.0 % w, rect.1 % h);
         let changed = CellRect { x0, y0, x1: (x0 + rect.2).min(w), y1: (y0 + rect.3).min(h) };
-        let mut s = seed.rotate_left(17) | 1;
+        let mut r = rng(seed.rotate_left(17));
         for _ in 0..flips {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
+            let s = r();
             let x = changed.x0 + (s % u64::from(changed.x1 - changed.x0)) as u32;
             let y = changed.y0 + ((s >> 20) % u64::from(changed.y1 - changed.y0)) as u32;
             let state = [CellState::Free, CellState::Occupied, CellState::Unknown][(s >> 40) as usize % 3];

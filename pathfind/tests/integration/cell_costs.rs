@@ -9,18 +9,13 @@ use pathfind::movement::{can_step, validate_dense_path};
 use pathfind::{AStar, CellCostAStar, Dijkstra, PathfindError};
 use proptest::prelude::*;
 
-use crate::support::{free_cell, xorshift};
+use crate::support::{free_cell, random_grid, rng};
 use slam_core::{BitGrid, Cell, PlanError, Planner};
-
-fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
-    let mut r = xorshift(seed);
-    BitGrid::from_fn(w, h, |_, _| (r() % 100) < u64::from(density)).unwrap()
-}
 
 /// Random multipliers: all 1, uniform in [1, 6), a few expensive cells among cheap ones, or
 /// multipliers up to 1000 (past the bucket ring's range: the heap).
 fn random_costs(n: usize, kind: u8, seed: u64) -> Vec<f32> {
-    let mut r = xorshift(seed ^ 0x9E37_79B9_7F4A_7C15);
+    let mut r = rng(seed ^ 0x9E37_79B9_7F4A_7C15);
     (0..n)
         .map(|_| match kind {
             0 => 1.0,
@@ -153,7 +148,7 @@ proptest! {
         let mut grid = random_grid(w, h, density, seed);
         let mut costs = random_costs(grid.len(), kind, seed);
         let mut memory = CellCostAStar::new(&grid, &costs).unwrap().into_memory();
-        let mut r = xorshift(seed.rotate_left(7));
+        let mut r = rng(seed.rotate_left(7));
         for (flips, a, b, cost_seed) in rounds {
             for _ in 0..flips {
                 let c = Cell::new((r() % u64::from(w)) as u32, (r() % u64::from(h)) as u32);

@@ -6,7 +6,7 @@
 use pathfind::{AStar, Dijkstra, JumpPointSearch};
 use proptest::prelude::*;
 
-use crate::support::{free_cell, xorshift};
+use crate::support::{free_cell, rng};
 use slam_core::{BitGrid, Cell, Planner};
 
 proptest! {
@@ -17,7 +17,7 @@ proptest! {
         w in 2u32..60, h in 2u32..60, density in 0u32..=45, seed in any::<u64>(),
         rounds in proptest::collection::vec((0usize..50, any::<u64>(), any::<u64>()), 1..6),
     ) {
-        let mut r = xorshift(seed);
+        let mut r = rng(seed);
         let mut grid = BitGrid::from_fn(w, h, |_, _| (r() % 100) < u64::from(density)).unwrap();
         let mut astar_memory = AStar::new(&grid).into_memory();
         let mut jps_memory = JumpPointSearch::new(&grid).into_memory();

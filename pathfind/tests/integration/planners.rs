@@ -8,20 +8,8 @@ use pathfind::{
 };
 use proptest::prelude::*;
 
-use crate::support::free_cell;
+use crate::support::{free_cell, random_grid};
 use slam_core::{BitGrid, Cell, GridPath, PlanError, Planner};
-
-/// A random grid: `density` percent blocked, from a seeded xorshift.
-fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
-    let mut s = seed | 1;
-    BitGrid::from_fn(w, h, |_, _| {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s % 100) < u64::from(density)
-    })
-    .unwrap()
-}
 
 fn check(
     grid: &BitGrid,

@@ -1,16 +1,20 @@
-//! Helpers the integration tests share: a seeded xorshift and a free-cell picker.
+//! Helpers the integration tests share: a seeded generator, random grids and a free-cell picker.
+#![allow(clippy::unwrap_used)]
 
+use rand_pcg::Pcg64Mcg;
+use rand_pcg::rand_core::{Rng, SeedableRng};
 use slam_core::{BitGrid, Cell};
 
-/// Marsaglia's xorshift64 from `seed` (0 is made odd): fast, reproducible test data.
-pub(crate) fn xorshift(seed: u64) -> impl FnMut() -> u64 {
-    let mut s = seed | 1;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        s
-    }
+/// A stream of `u64`s from `seed` (PCG-64): reproducible test data, the same on every platform.
+pub(crate) fn rng(seed: u64) -> impl FnMut() -> u64 {
+    let mut g = Pcg64Mcg::seed_from_u64(seed);
+    move || g.next_u64()
+}
+
+/// A `w` x `h` grid with each cell blocked with probability `density` percent, drawn from `seed`.
+pub(crate) fn random_grid(w: u32, h: u32, density: u32, seed: u64) -> BitGrid {
+    let mut r = rng(seed);
+    BitGrid::from_fn(w, h, |_, _| (r() % 100) < u64::from(density)).unwrap()
 }
 
 /// A free cell of `grid` chosen by `pick` (cells visited from `pick` in steps of 7,919, a prime,

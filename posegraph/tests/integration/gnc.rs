@@ -18,9 +18,9 @@ use posegraph::{
     GncConfig, GncLoss, GraduatedNonConvexity, KnownInliers, LevenbergMarquardt, SolverConfig,
     SolverPose,
 };
-use rand_pcg::Pcg64Mcg;
-use rand_pcg::rand_core::{Rng, SeedableRng};
 use slam_core::{InvalidSetting, Optimizer, Pose2, PoseGraph, RobustKernel, StopReason, se2_exp};
+
+use crate::common::{rng_u64, uniform};
 
 fn bundled(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -63,9 +63,7 @@ where
         .information;
     let mut g = clean.clone();
     let first = g.edge_count();
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let added =
-        add_wrong_loops(&mut g, reference, count, 5.0, info, &mut || rng.next_u64()).unwrap();
+    let added = add_wrong_loops(&mut g, reference, count, 5.0, info, &mut rng_u64(seed)).unwrap();
     assert_eq!(added.len(), count);
     let report = GraduatedNonConvexity::default()
         .optimize_robust(&mut g)
@@ -96,13 +94,10 @@ fn assert_targets(s: &RobustScore, what: &str) {
 /// 0.5 degree noise (the guess composed from it drifts by metres), the last 20 poses closing
 /// exactly onto the first 20 with ring.g2o's loop information (10 cm, 5 degrees).
 fn synthetic_ring(n: usize, seed: u64) -> PoseGraph<Pose2> {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut u = uniform(seed);
     let mut normal = move || {
         // Sum of 12 uniforms: a portable, roughly normal sample.
-        (0..12)
-            .map(|_| (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-            .sum::<f64>()
-            - 6.0
+        (0..12).map(|_| u()).sum::<f64>() - 6.0
     };
     let lap = n - 20;
     let truth: Vec<Pose2> = (0..n)
@@ -301,8 +296,7 @@ fn known_inliers_and_losses() {
     let info = clean.edges().last().unwrap().information;
     let mut g = clean.clone();
     let first = g.edge_count();
-    let mut rng = Pcg64Mcg::seed_from_u64(9);
-    add_wrong_loops(&mut g, &reference, 13, 5.0, info, &mut || rng.next_u64()).unwrap();
+    add_wrong_loops(&mut g, &reference, 13, 5.0, info, &mut rng_u64(9)).unwrap();
     // Explicit flags marking the odometry, and kernels marking the candidates, give the same
     // result as consecutive ids.
     let odometry: Vec<bool> = g
@@ -384,11 +378,7 @@ fn ring_g2o_with_2_to_45_wrong_loops() {
 fn with_gm_loops(clean: &PoseGraph<Pose2>, reference: &[Pose2], wrong: usize) -> PoseGraph<Pose2> {
     let info = clean.edges().last().unwrap().information;
     let mut plain = clean.clone();
-    let mut rng = Pcg64Mcg::seed_from_u64(1);
-    add_wrong_loops(&mut plain, reference, wrong, 5.0, info, &mut || {
-        rng.next_u64()
-    })
-    .unwrap();
+    add_wrong_loops(&mut plain, reference, wrong, 5.0, info, &mut rng_u64(1)).unwrap();
     let mut g = PoseGraph::new();
     for n in plain.nodes() {
         g.add_node(n.id, n.pose).unwrap();
