@@ -14,7 +14,7 @@ mod common;
 use common::example;
 
 /// Every example with the options its `--help` must name.
-const EXAMPLES: [(&str, &[&str]); 8] = [
+const EXAMPLES: [(&str, &[&str]); 9] = [
     (
         "g2o",
         &[
@@ -61,6 +61,7 @@ const EXAMPLES: [(&str, &[&str]); 8] = [
         ],
     ),
     ("movingai", &["MAP", "SCEN", "--planner", "jps-plus", "all"]),
+    ("own_backends", &["--seed", "--max-ate"]),
     (
         "register",
         &[

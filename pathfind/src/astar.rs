@@ -7,6 +7,7 @@ use crate::cost::octile;
 
 /// A* with the octile-distance heuristic (admissible and consistent for this movement model, so
 /// the first time the goal is expanded its cost is optimal). Ties in `f` go to the larger `g`.
+#[derive(Debug)]
 pub struct AStar<'g> {
     search: BestFirst<'g>,
 }

@@ -20,6 +20,16 @@ pub(crate) struct BestFirst<'g> {
     closed: ClosedSet,
 }
 
+/// The grid's size; not the labels and search records.
+impl std::fmt::Debug for BestFirst<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BestFirst")
+            .field("width", &self.grid.width())
+            .field("height", &self.grid.height())
+            .finish_non_exhaustive()
+    }
+}
+
 /// What an [`AStar`](crate::AStar) keeps for the next planner on the same grid (see
 /// [`AStar::with_memory`](crate::AStar::with_memory)): the component labels and the search
 /// records.

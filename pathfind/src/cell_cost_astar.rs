@@ -179,6 +179,17 @@ pub struct CellCostAStar<'g> {
     heuristic: bool,
 }
 
+/// The grid's size and whether the heuristic guides the search; not the costs and records.
+impl std::fmt::Debug for CellCostAStar<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CellCostAStar")
+            .field("width", &self.grid.width())
+            .field("height", &self.grid.height())
+            .field("heuristic", &self.heuristic)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'g> CellCostAStar<'g> {
     /// A planner for `grid` with `costs`, the cost multiplier of entering each cell (row-major,
     /// `width * height` values, `costs[y * width + x]` for cell (x, y); dimensionless: a step's

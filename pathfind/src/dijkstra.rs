@@ -6,6 +6,7 @@ use crate::best_first::BestFirst;
 
 /// Dijkstra's algorithm on the grid (uniform-cost search, no heuristic). Exact and simple; use
 /// [`AStar`](crate::AStar) or a jump-point planner for speed.
+#[derive(Debug)]
 pub struct Dijkstra<'g> {
     search: BestFirst<'g>,
 }

@@ -25,6 +25,20 @@ enum Scans<'g> {
     Cells(CellJumper<'g>),
 }
 
+/// The search (the grid's size) and which scans it uses; not the tables and records.
+impl std::fmt::Debug for JumpPointSearch<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let scans = match self.scans {
+            Scans::Words(_) => "words",
+            Scans::Cells(_) => "cells",
+        };
+        f.debug_struct("JumpPointSearch")
+            .field("search", &self.search)
+            .field("scans", &scans)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'g> JumpPointSearch<'g> {
     /// A planner for `grid` with word scans (labels its connected components and transposes the
     /// grid once).

@@ -18,6 +18,15 @@ pub struct JumpPointSearchPlus<'g> {
     tables: JumpTables,
 }
 
+/// The search (the grid's size); not the jump tables and records.
+impl std::fmt::Debug for JumpPointSearchPlus<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JumpPointSearchPlus")
+            .field("search", &self.search)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'g> JumpPointSearchPlus<'g> {
     /// JPS+ for `grid`: precomputes the jump distance of every cell in every direction (and
     /// labels the grid's connected components).

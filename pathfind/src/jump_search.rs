@@ -103,6 +103,16 @@ pub(crate) struct JumpSearch<'g> {
     space: SearchSpace,
 }
 
+/// The grid's size; not the labels and search records.
+impl std::fmt::Debug for JumpSearch<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JumpSearch")
+            .field("width", &self.grid.width())
+            .field("height", &self.grid.height())
+            .finish_non_exhaustive()
+    }
+}
+
 impl<'g> JumpSearch<'g> {
     /// The search state for `grid` (labels its connected components).
     pub(crate) fn new(grid: &'g BitGrid) -> Self {

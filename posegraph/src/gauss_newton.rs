@@ -9,7 +9,7 @@ use crate::solver::{SolverConfig, SolverPose};
 /// non-positive pivot is retried with a small damping. Fast near the optimum, may diverge from a
 /// poor start (use [`LevenbergMarquardt`](crate::LevenbergMarquardt) there). The sparse pattern
 /// and the symbolic Cholesky are kept between calls while the graph's structure is unchanged.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct GaussNewton {
     /// Stopping rules.
     pub config: SolverConfig,

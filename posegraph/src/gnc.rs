@@ -196,6 +196,16 @@ pub struct GraduatedNonConvexity {
     weights: Vec<f64>,
 }
 
+/// The settings and how many edge weights the last run left; not the weights themselves.
+impl std::fmt::Debug for GraduatedNonConvexity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GraduatedNonConvexity")
+            .field("config", &self.config)
+            .field("weights", &self.weights.len())
+            .finish_non_exhaustive()
+    }
+}
+
 impl GraduatedNonConvexity {
     /// Graduated non-convexity with `config`.
     ///

@@ -11,6 +11,7 @@ use crate::solver::{SolverConfig, SolverPose};
 /// where the start is poor.
 /// The sparse pattern and the symbolic Cholesky are kept between calls while the graph's structure
 /// is unchanged.
+#[derive(Debug)]
 pub struct LevenbergMarquardt {
     /// Stopping rules.
     pub config: SolverConfig,

@@ -238,6 +238,13 @@ pub(crate) mod sealed {
         se2: Cache<3>,
     }
 
+    /// Nothing of the cached normal equations (their size follows the last graph).
+    impl std::fmt::Debug for Caches {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.debug_struct("Caches").finish_non_exhaustive()
+        }
+    }
+
     /// The loop of [`optimize`] with the cache slot of the pose type.
     pub trait Sealed: slam_core::GraphPose {
         /// The position (metres; z = 0 in SE(2)).

@@ -2,7 +2,7 @@
 //! retrieval of places that look like a query scan, with the heading between them.
 
 use kiddo::{MutableKdTree, SquaredEuclidean};
-use slam_core::{InvalidSetting, PlaceMatch, PlaceRecognizer, PointCloud, RegistrationError};
+use slam_core::{InvalidSetting, PlaceMatch, PlaceRecognitionError, PlaceRecognizer, PointCloud};
 
 use crate::scan_context::{SCAN_CONTEXT_RINGS, ScanContext, ScanContextConfig, ScanContextMatch};
 
@@ -32,8 +32,8 @@ impl ScanContextIndexConfig {
     /// At least one ring-key candidate, a distance in (0, 1].
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), RegistrationError> {
+    /// [`PlaceRecognitionError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), PlaceRecognitionError> {
         if self.ring_key_candidates == 0 {
             return Err(InvalidSetting {
                 setting: "ScanContextIndexConfig::ring_key_candidates",
@@ -87,7 +87,7 @@ pub struct PlaceCandidate {
 /// }
 /// let found = index.query(&ScanContext::from_cloud(&walls(0.05), &config)?);
 /// assert_eq!(found[0].id, 7);
-/// # Ok::<(), slam_core::RegistrationError>(())
+/// # Ok::<(), slam_core::PlaceRecognitionError>(())
 /// ```
 pub struct ScanContextIndex {
     config: ScanContextIndexConfig,
@@ -112,8 +112,8 @@ impl ScanContextIndex {
     /// An empty index.
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] for invalid settings.
-    pub fn new(config: ScanContextIndexConfig) -> Result<Self, RegistrationError> {
+    /// [`PlaceRecognitionError::InvalidConfig`] for invalid settings.
+    pub fn new(config: ScanContextIndexConfig) -> Result<Self, PlaceRecognitionError> {
         config.validate()?;
         Ok(Self {
             config,
@@ -139,23 +139,20 @@ impl ScanContextIndex {
     /// become searchable.
     ///
     /// # Errors
-    /// [`RegistrationError::TooManyPoints`] beyond 2^32 descriptors (the tree's item index).
-    pub fn insert(&mut self, id: u64, context: ScanContext) -> Result<(), RegistrationError> {
+    /// [`PlaceRecognitionError::IndexFull`] beyond 2^32 descriptors (the tree's item index).
+    pub fn insert(&mut self, id: u64, context: ScanContext) -> Result<(), PlaceRecognitionError> {
         self.contexts.push((id, context));
         while self.searchable + self.config.exclude_recent < self.contexts.len() {
             let k = self.searchable;
-            let item = u32::try_from(k).map_err(|_| RegistrationError::TooManyPoints {
-                what: "place index",
-                points: k + 1,
+            let full = PlaceRecognitionError::IndexFull {
+                what: "the scan context index",
+                keyframe: k + 1,
                 max: u32::MAX as usize,
-            })?;
+            };
+            let item = u32::try_from(k).map_err(|_| full.clone())?;
             self.tree
                 .add(self.contexts[k].1.ring_key(), item)
-                .map_err(|_| RegistrationError::TooManyPoints {
-                    what: "place index",
-                    points: k + 1,
-                    max: u32::MAX as usize,
-                })?;
+                .map_err(|_| full)?;
             self.searchable += 1;
         }
         Ok(())
@@ -207,13 +204,13 @@ impl ScanContextRecognizer {
     /// around it (0: the origin only).
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] for invalid settings or an offset that is not finite
+    /// [`PlaceRecognitionError::InvalidConfig`] for invalid settings or an offset that is not finite
     /// and non-negative.
     pub fn new(
         descriptor: ScanContextConfig,
         index: ScanContextIndexConfig,
         query_offset: f64,
-    ) -> Result<Self, RegistrationError> {
+    ) -> Result<Self, PlaceRecognitionError> {
         descriptor.validate()?;
         if !(query_offset.is_finite() && query_offset >= 0.0) {
             return Err(InvalidSetting {
@@ -248,12 +245,12 @@ impl PlaceRecognizer for ScanContextRecognizer {
         &mut self,
         keyframe: usize,
         scan: &PointCloud,
-    ) -> Result<(), RegistrationError> {
+    ) -> Result<(), PlaceRecognitionError> {
         let context = ScanContext::from_cloud(scan, &self.descriptor)?;
         self.index.insert(keyframe as u64, context)
     }
 
-    fn candidates(&self, scan: &PointCloud) -> Result<Vec<PlaceMatch>, RegistrationError> {
+    fn candidates(&self, scan: &PointCloud) -> Result<Vec<PlaceMatch>, PlaceRecognitionError> {
         let here = ScanContext::from_cloud(scan, &self.descriptor)?;
         self.candidates_from(scan, &here)
     }
@@ -262,7 +259,7 @@ impl PlaceRecognizer for ScanContextRecognizer {
         &mut self,
         keyframe: usize,
         scan: &PointCloud,
-    ) -> Result<Vec<PlaceMatch>, RegistrationError> {
+    ) -> Result<Vec<PlaceMatch>, PlaceRecognitionError> {
         let here = ScanContext::from_cloud(scan, &self.descriptor)?;
         let found = self.candidates_from(scan, &here)?;
         self.index.insert(keyframe as u64, here)?;
@@ -276,7 +273,7 @@ impl ScanContextRecognizer {
         &self,
         scan: &PointCloud,
         here: &ScanContext,
-    ) -> Result<Vec<PlaceMatch>, RegistrationError> {
+    ) -> Result<Vec<PlaceMatch>, PlaceRecognitionError> {
         let d = self.query_offset;
         let offsets: &[(f64, f64)] = if d > 0.0 {
             &[(d, 0.0), (-d, 0.0), (0.0, d), (0.0, -d)]

@@ -4,7 +4,7 @@
 //! the sectors, so comparing two scans means finding the column shift that makes them agree,
 //! and that shift is the heading between them.
 
-use slam_core::{InvalidSetting, PointCloud, RegistrationError};
+use slam_core::{InvalidSetting, PlaceRecognitionError, PointCloud};
 
 /// Rings of a [`ScanContext`] (range bins): fixed, because the ring key indexes a k-d tree of
 /// this dimension. 20 as in the paper.
@@ -44,10 +44,10 @@ impl ScanContextConfig {
     /// At least 4 sectors, ranges finite with `0 <= min_range < max_range`, a finite offset.
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] naming the first bad setting.
-    pub fn validate(&self) -> Result<(), RegistrationError> {
+    /// [`PlaceRecognitionError::InvalidConfig`] naming the first bad setting.
+    pub fn validate(&self) -> Result<(), PlaceRecognitionError> {
         let invalid = |setting, value, expected| {
-            RegistrationError::from(InvalidSetting {
+            PlaceRecognitionError::from(InvalidSetting {
                 setting,
                 value,
                 expected,
@@ -125,12 +125,12 @@ impl ScanContext {
     /// out.
     ///
     /// # Errors
-    /// [`RegistrationError::InvalidConfig`] for invalid settings;
-    /// [`RegistrationError::TooFewPoints`] when no point falls within the ranges.
+    /// [`PlaceRecognitionError::InvalidConfig`] for invalid settings;
+    /// [`PlaceRecognitionError::TooFewPoints`] when no point falls within the ranges.
     pub fn from_cloud(
         cloud: &PointCloud,
         config: &ScanContextConfig,
-    ) -> Result<Self, RegistrationError> {
+    ) -> Result<Self, PlaceRecognitionError> {
         Self::seen_from(cloud, config, 0.0, 0.0)
     }
 
@@ -144,7 +144,7 @@ impl ScanContext {
         config: &ScanContextConfig,
         x: f32,
         y: f32,
-    ) -> Result<Self, RegistrationError> {
+    ) -> Result<Self, PlaceRecognitionError> {
         config.validate()?;
         let sectors = config.sectors;
         let mut bins = vec![0.0f32; SCAN_CONTEXT_RINGS * sectors];
@@ -174,8 +174,7 @@ impl ScanContext {
             used += 1;
         }
         if used == 0 {
-            return Err(RegistrationError::TooFewPoints {
-                what: "scan context",
+            return Err(PlaceRecognitionError::TooFewPoints {
                 points: 0,
                 required: 1,
             });
@@ -467,13 +466,13 @@ mod tests {
         ] {
             assert!(matches!(
                 ScanContext::from_cloud(&scan, &config),
-                Err(RegistrationError::InvalidConfig(_))
+                Err(PlaceRecognitionError::InvalidConfig(_))
             ));
         }
         let far = PointCloud::from_points(vec![Point3::new(100.0, 0.0, 0.0)]);
         assert!(matches!(
             ScanContext::from_cloud(&far, &ScanContextConfig::default()),
-            Err(RegistrationError::TooFewPoints { .. })
+            Err(PlaceRecognitionError::TooFewPoints { .. })
         ));
     }
 

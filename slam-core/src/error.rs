@@ -1,10 +1,30 @@
 //! Error enums of slam-core and of the three backend traits.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use thiserror::Error;
 
 use crate::robust_kernel::RobustKernel;
+
+/// `Error::backend(name, error)`, the constructor of an error's `Backend { backend, source }`
+/// variant, with the docs given.
+macro_rules! backend_constructor {
+    ($error:ident, $(#[doc = $doc:literal])*) => {
+        impl $error {
+            $(#[doc = $doc])*
+            pub fn backend(
+                backend: &'static str,
+                error: impl Into<Box<dyn std::error::Error + Send + Sync>>,
+            ) -> Self {
+                Self::Backend {
+                    backend,
+                    source: BackendError::new(error),
+                }
+            }
+        }
+    };
+}
 
 /// Errors building or addressing a [`BitGrid`](crate::BitGrid).
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
@@ -169,6 +189,31 @@ pub enum RegistrationError {
     /// A setting is out of its valid range.
     #[error(transparent)]
     InvalidConfig(#[from] InvalidSetting),
+    /// A third-party registrator failed for a reason of its own (its error is the
+    /// [`source`](std::error::Error::source)); see [`RegistrationError::backend`].
+    #[error("registration backend {backend} failed")]
+    Backend {
+        /// The backend's name.
+        backend: &'static str,
+        /// The backend's own error.
+        #[source]
+        source: BackendError,
+    },
+}
+
+backend_constructor! {
+    RegistrationError,
+    /// A [`RegistrationError::Backend`]: `backend`'s own `error` (any error type, or a message).
+    ///
+    /// ```
+    /// use slam_core::RegistrationError;
+    /// let io = std::io::Error::other("the GPU is gone");
+    /// let e = RegistrationError::backend("cuda-icp", io);
+    /// assert_eq!(e.to_string(), "registration backend cuda-icp failed");
+    /// // The backend's error is the source, as it was made.
+    /// let source = std::error::Error::source(&e).expect("a source");
+    /// assert!(source.downcast_ref::<std::io::Error>().is_some());
+    /// ```
 }
 
 /// What made a registration problem [`RegistrationError::Degenerate`].
@@ -299,6 +344,29 @@ pub enum OptimizeError {
         /// Why.
         cause: FactorizationFailure,
     },
+    /// A third-party optimizer failed for a reason of its own (its error is the
+    /// [`source`](std::error::Error::source)); see [`OptimizeError::backend`].
+    #[error("optimizer backend {backend} failed")]
+    Backend {
+        /// The backend's name.
+        backend: &'static str,
+        /// The backend's own error.
+        #[source]
+        source: BackendError,
+    },
+}
+
+backend_constructor! {
+    OptimizeError,
+    /// An [`OptimizeError::Backend`]: `backend`'s own `error` (any error type, or a message).
+    ///
+    /// ```
+    /// use slam_core::OptimizeError;
+    /// let e = OptimizeError::backend("ceres", "the solver ran out of time");
+    /// assert_eq!(e.to_string(), "optimizer backend ceres failed");
+    /// let source = std::error::Error::source(&e).expect("a source");
+    /// assert_eq!(source.to_string(), "the solver ran out of time");
+    /// ```
 }
 
 /// Which value of a [`PoseGraph`](crate::PoseGraph) an [`OptimizeError::NonFinite`] is about.
@@ -368,9 +436,10 @@ pub enum FactorizationFailure {
     Unrecognised,
 }
 
-/// Errors of a [`Planner`](crate::Planner): bad arguments only. An unreachable goal is not an
-/// error but the answer `Ok(None)` of [`Planner::plan`](crate::Planner::plan).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+/// Errors of a [`Planner`](crate::Planner): bad arguments, or a third-party planner's own
+/// failure ([`PlanError::Backend`]). An unreachable goal is not an error but the answer
+/// `Ok(None)` of [`Planner::plan`](crate::Planner::plan).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
 #[non_exhaustive]
 pub enum PlanError {
     /// Start or goal is off the grid.
@@ -397,6 +466,130 @@ pub enum PlanError {
         /// Row.
         y: u32,
     },
+    /// A planner failed for a reason of its own, not an argument of the query (its error is
+    /// the [`source`](std::error::Error::source)): a third-party planner's fault, or a grid
+    /// it cannot plan on. See [`PlanError::backend`].
+    #[error("planner backend {backend} failed")]
+    Backend {
+        /// The backend's name.
+        backend: &'static str,
+        /// The backend's own error.
+        #[source]
+        source: BackendError,
+    },
+}
+
+backend_constructor! {
+    PlanError,
+    /// A [`PlanError::Backend`]: `backend`'s own `error` (any error type, or a message).
+    ///
+    /// ```
+    /// use slam_core::PlanError;
+    /// let e = PlanError::backend("ompl", "the state space is not set up");
+    /// assert_eq!(e.to_string(), "planner backend ompl failed");
+    /// assert!(std::error::Error::source(&e).is_some());
+    /// ```
+}
+
+/// A third-party backend's own error, kept as the source of the `Backend` variants of
+/// [`RegistrationError`], [`OptimizeError`], [`PlanError`] and [`PlaceRecognitionError`].
+///
+/// It dereferences to the backend's error (`dyn Error + Send + Sync`), which is also what the
+/// variant's [`source`](std::error::Error::source) returns, so a caller downcasts it to the
+/// backend's type. It is shared, so the errors that hold it stay `Clone`; two are equal when they
+/// are the same error (one a clone of the other), as errors of unknown types cannot be compared.
+///
+/// ```
+/// use slam_core::BackendError;
+/// let e = BackendError::new(std::io::Error::other("device lost"));
+/// assert_eq!(e.to_string(), "device lost");
+/// assert!(e.downcast_ref::<std::io::Error>().is_some());
+/// assert_eq!(e.clone(), e);
+/// assert_ne!(BackendError::new("device lost"), e);
+/// ```
+#[derive(Clone)]
+pub struct BackendError(Arc<dyn std::error::Error + Send + Sync>);
+
+impl BackendError {
+    /// `error` (any error type, or a message) as a backend's error.
+    pub fn new(error: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> Self {
+        Self(Arc::from(error.into()))
+    }
+}
+
+// Deliberately not `std::error::Error` itself: thiserror then returns the backend's error (the
+// target of this `Deref`) as the source, so it downcasts to the backend's type.
+impl std::ops::Deref for BackendError {
+    type Target = dyn std::error::Error + Send + Sync;
+
+    fn deref(&self) -> &Self::Target {
+        &*self.0
+    }
+}
+
+impl std::fmt::Debug for BackendError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(&*self.0, f)
+    }
+}
+
+impl std::fmt::Display for BackendError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(&*self.0, f)
+    }
+}
+
+impl PartialEq for BackendError {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl Eq for BackendError {}
+
+/// Errors of a [`PlaceRecognizer`](crate::PlaceRecognizer).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum PlaceRecognitionError {
+    /// Too few points of the scan fall within the descriptor's ranges to describe it.
+    #[error(
+        "the scan has {points} points within the descriptor's ranges, at least {required} are needed"
+    )]
+    TooFewPoints {
+        /// Points in range.
+        points: usize,
+        /// Points needed.
+        required: usize,
+    },
+    /// The recognizer holds as many keyframes as it can number.
+    #[error("{what} is full: keyframe {keyframe} is beyond its {max} entries")]
+    IndexFull {
+        /// The full index.
+        what: &'static str,
+        /// 1-based number of the keyframe that did not fit.
+        keyframe: usize,
+        /// Entries it can hold.
+        max: usize,
+    },
+    /// A setting is out of its valid range.
+    #[error(transparent)]
+    InvalidConfig(#[from] InvalidSetting),
+    /// A third-party recognizer failed for a reason of its own (its error is the
+    /// [`source`](std::error::Error::source)); see [`PlaceRecognitionError::backend`].
+    #[error("place recognition backend {backend} failed")]
+    Backend {
+        /// The backend's name.
+        backend: &'static str,
+        /// The backend's own error.
+        #[source]
+        source: BackendError,
+    },
+}
+
+backend_constructor! {
+    PlaceRecognitionError,
+    /// A [`PlaceRecognitionError::Backend`]: `backend`'s own `error` (any error type, or a
+    /// message).
 }
 
 /// Errors building or combining a [`PointCloud`](crate::PointCloud).

@@ -46,8 +46,9 @@ mod voxel;
 
 pub use cloud::{Aabb, PointCloud};
 pub use error::{
-    CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
-    InvalidSetting, OptimizeError, PlanError, RegistrationError, RigidFitError,
+    BackendError, CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,
+    InvalidSetting, OptimizeError, PlaceRecognitionError, PlanError, RegistrationError,
+    RigidFitError,
 };
 pub use geometry::*;
 pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};

@@ -93,6 +93,29 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     pub(super) report: SlamReport,
 }
 
+/// The settings, the backends and how far the map has grown; not the keyframes, their clouds
+/// and the graph.
+impl<R, C, O> std::fmt::Debug for GraphSlam<R, C, O>
+where
+    R: MapRegistrator + std::fmt::Debug,
+    C: MapRegistrator + std::fmt::Debug,
+    O: Optimizer<Pose3> + std::fmt::Debug,
+{
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GraphSlam")
+            .field("config", &self.config)
+            .field("odometry", &self.odometry)
+            .field("loop_check", &self.loop_coarse)
+            .field("loop_refine", &self.loop_refine)
+            .field("optimizer", &self.optimizer)
+            .field("place_recognition", &self.places.is_some())
+            .field("scans", &self.report.scans)
+            .field("keyframes", &self.keyframes.len())
+            .field("edges", &self.graph.edges().len())
+            .finish_non_exhaustive()
+    }
+}
+
 impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, O> {
     /// An engine with its backends: `odometry` registers scans against the local map,
     /// `loop_coarse` checks loop candidates, `loop_refine` refines accepted loops (the same
@@ -161,6 +184,24 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     #[must_use]
     pub fn optimizer(&self) -> &O {
         &self.optimizer
+    }
+
+    /// The odometry's registrator (scans against the local map).
+    #[must_use]
+    pub fn registrator(&self) -> &R {
+        &self.odometry
+    }
+
+    /// The registrator that checks loop candidates (coarse).
+    #[must_use]
+    pub fn loop_check_registrator(&self) -> &C {
+        &self.loop_coarse
+    }
+
+    /// The registrator that refines accepted loops.
+    #[must_use]
+    pub fn loop_refine_registrator(&self) -> &R {
+        &self.loop_refine
     }
 
     /// Counts and timings so far.

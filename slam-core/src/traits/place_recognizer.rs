@@ -2,7 +2,7 @@
 //! Graph-SLAM engine can seek a loop where the robot has been, whatever its drift.
 
 use crate::cloud::PointCloud;
-use crate::error::RegistrationError;
+use crate::error::PlaceRecognitionError;
 
 /// A keyframe that looks like a query scan.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,15 +22,18 @@ pub trait PlaceRecognizer {
     ///
     /// # Errors
     /// The recognizer's reason for refusing the scan (too few points in range, index full).
-    fn add_keyframe(&mut self, keyframe: usize, scan: &PointCloud)
-    -> Result<(), RegistrationError>;
+    fn add_keyframe(
+        &mut self,
+        keyframe: usize,
+        scan: &PointCloud,
+    ) -> Result<(), PlaceRecognitionError>;
 
     /// Remembered keyframes that look like `scan`, best first. The recognizer leaves out the
     /// most recent keyframes (the robot's own trail, not a revisit).
     ///
     /// # Errors
     /// The recognizer's reason for refusing the scan.
-    fn candidates(&self, scan: &PointCloud) -> Result<Vec<PlaceMatch>, RegistrationError>;
+    fn candidates(&self, scan: &PointCloud) -> Result<Vec<PlaceMatch>, PlaceRecognitionError>;
 
     /// [`PlaceRecognizer::candidates`] for keyframe `keyframe`'s scan, then
     /// [`PlaceRecognizer::add_keyframe`]: what the engine calls for each new keyframe (a
@@ -42,7 +45,7 @@ pub trait PlaceRecognizer {
         &mut self,
         keyframe: usize,
         scan: &PointCloud,
-    ) -> Result<Vec<PlaceMatch>, RegistrationError> {
+    ) -> Result<Vec<PlaceMatch>, PlaceRecognitionError> {
         let found = self.candidates(scan)?;
         self.add_keyframe(keyframe, scan)?;
         Ok(found)

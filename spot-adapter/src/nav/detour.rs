@@ -7,8 +7,9 @@ use nalgebra::Vector2;
 use slam_core::{BitGrid, Cell};
 
 use crate::nav::NavError;
-use crate::nav::config::{NavigatorConfig, PlannerKind};
-use crate::nav::path::{Plan, PlannerMemory, dense_path};
+use crate::nav::config::NavigatorConfig;
+use crate::nav::path::{Plan, dense_path};
+use crate::nav::planner::NavPlanner;
 
 /// A periodic replan may not lead back within this distance (metres) of where an earlier path
 /// to the same goal was blocked: about a box's half width plus the hard inflation.
@@ -58,8 +59,6 @@ pub(crate) struct DetourPolicy {
     /// box are hit by fewer beams), and without this the robot turned back and forth between
     /// the way past it and the way round.
     blocked_at: Vec<Vector2<f64>>,
-    /// The planner's memory on the map's own planning grid.
-    memory: PlannerMemory,
 }
 
 impl DetourPolicy {
@@ -73,7 +72,6 @@ impl DetourPolicy {
             unchanged_for: 0,
             waited_out_for: None,
             blocked_at: Vec::new(),
-            memory: PlannerMemory::default(),
         }
     }
 
@@ -117,14 +115,14 @@ impl DetourPolicy {
 
     /// What blocks the way from `position` to `target` given `plan`, the path on the `live`
     /// planning grid (see [`DetourPolicy::worth_waiting`]); `map_only` is the planning grid of
-    /// the map alone, `planner` the one to search it with. With no way round at all, something
-    /// new blocking the way is waited for again (a person met twice): only once the patience
-    /// runs out is the answer `NoPath`.
-    pub(crate) fn waiting_for(
+    /// the map alone, `planner` the one to search it with and its memory there. With no way
+    /// round at all, something new blocking the way is waited for again (a person met twice):
+    /// only once the patience runs out is the answer `NoPath`.
+    pub(crate) fn waiting_for<P: NavPlanner>(
         &self,
         live: &PlanningGrid,
         map_only: &PlanningGrid,
-        planner: PlannerKind,
+        planner: (&mut P, &mut P::Memory),
         position: Vector2<f64>,
         target: Vector2<f64>,
         plan: Option<&Plan>,
@@ -141,11 +139,11 @@ impl DetourPolicy {
     /// when there is none) is more than `extra` longer than the path on the map alone,
     /// which exists: something new stands on the map's path. With it the blocked cells of the
     /// map's path. `None` when there is nothing to wait for.
-    fn worth_waiting(
+    fn worth_waiting<P: NavPlanner>(
         &self,
         live: &PlanningGrid,
         map_only: &PlanningGrid,
-        planner: PlannerKind,
+        (planner, memory): (&mut P, &mut P::Memory),
         position: Vector2<f64>,
         goal: Vector2<f64>,
         live_length: Option<f64>,
@@ -156,7 +154,7 @@ impl DetourPolicy {
         if live_length.is_some_and(|l| l <= (goal - position).norm() + extra) {
             return Ok(None);
         }
-        let Some(map_path) = dense_path(map_only, planner, &self.memory, position, goal)? else {
+        let Some(map_path) = dense_path(map_only, planner, memory, position, goal)? else {
             return Ok(None);
         };
         let map_length = map_path.length * resolution;

@@ -9,6 +9,7 @@ use slam_core::{Pose3, Registrator};
 
 use crate::nav::DriveError;
 use crate::nav::navigator::{Goal, NavigationStep, Navigator};
+use crate::nav::planner::NavPlanner;
 use crate::robot::{MobilityCommand, Robot, Sample};
 
 /// How a drive ended.
@@ -75,9 +76,9 @@ pub struct DriveCycle<'a> {
 /// [`DriveError::Robot`] when the robot fails to deliver a sample or take a command, and
 /// [`DriveError::Navigation`] when the navigator fails (a non-finite goal); the robot was
 /// sent a stop first (if that fails too, the first error is the one returned).
-pub fn drive<R: Robot, G: Registrator>(
+pub fn drive<R: Robot, G: Registrator, P: NavPlanner>(
     robot: &mut R,
-    navigator: &mut Navigator<G>,
+    navigator: &mut Navigator<G, P>,
     goal: impl Into<Goal>,
     max_cycles: usize,
     mut observe: impl FnMut(&DriveCycle<'_>),

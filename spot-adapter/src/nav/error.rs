@@ -24,13 +24,34 @@ pub enum NavError {
     /// The navigator's map cannot be prepared for registration.
     #[error("the map cannot be prepared for localisation")]
     LocalisationMap(#[source] slam_core::RegistrationError),
-    /// A planner refused its arguments (a start or goal off the grid or blocked).
-    #[error("the planner refused its arguments")]
+    /// The planner failed: it refused its arguments, or failed for a reason of its own
+    /// ([`PlanError::Backend`](slam_core::PlanError::Backend), e.g. the cost-aware planner
+    /// refusing the planning grid's step costs).
+    #[error("the planner failed")]
     Planner(#[source] slam_core::PlanError),
-    /// The cost-aware planner refused the planning grid's per-cell step costs (a count that is
-    /// not one per cell, a multiplier below 1 or not finite, or costs too large).
-    #[error("the planner refused the planning grid's step costs")]
-    PlanningCosts(#[source] pathfind::PathfindError),
+    /// The planner's path cannot be walked: a cell blocked or off the grid, a step between cells
+    /// that are not neighbours, or a diagonal step cutting a blocked corner (a plugged-in
+    /// planner's fault; ours never return one).
+    #[error("the planner's path cannot be walked: {violation:?}")]
+    InvalidPath {
+        /// The first fault found along the path (every cell listed).
+        violation: pathfind::movement::PathViolation,
+    },
+    /// The planner's path does not run from the start to the goal it was given.
+    #[error(
+        "the planner's path runs from ({}, {}) to ({}, {}), not from ({}, {}) to ({}, {})",
+        first.x, first.y, last.x, last.y, start.x, start.y, goal.x, goal.y
+    )]
+    PathEndpoints {
+        /// The start given.
+        start: slam_core::Cell,
+        /// The goal given.
+        goal: slam_core::Cell,
+        /// The path's first cell.
+        first: slam_core::Cell,
+        /// The path's last cell.
+        last: slam_core::Cell,
+    },
 }
 
 /// Why [`drive`](super::drive) stopped early; the robot was sent a stop first.

@@ -268,6 +268,11 @@ impl<R: Registrator> Localiser<R> {
         })
     }
 
+    /// The registrator it localises with.
+    pub(crate) fn registrator(&self) -> &R {
+        &self.registrator
+    }
+
     pub(crate) fn pose(&self) -> Pose3 {
         self.map_t_body
     }

@@ -14,6 +14,7 @@ mod localiser;
 mod navigation_map;
 mod navigator;
 mod path;
+mod planner;
 mod stuck;
 mod unseen;
 
@@ -23,4 +24,5 @@ pub use error::{DriveError, NavError};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
 pub use navigation_map::NavigationMap;
 pub use navigator::{Goal, NavigationStep, Navigator};
+pub use planner::{NavPlanner, PlannerMemory};
 pub use stuck::StuckConfig;

@@ -7,12 +7,13 @@ use nalgebra::Vector2;
 use slam_core::{BitGrid, Cell, PointCloud, Pose3, Registrator, wrap_angle};
 
 use crate::nav::NavError;
-use crate::nav::config::NavigatorConfig;
+use crate::nav::config::{NavigatorConfig, PlannerKind};
 use crate::nav::controller::Controller;
 use crate::nav::detour::{DetourPolicy, Wait};
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::path::{Plan, PlannerMemory};
+use crate::nav::path::Plan;
+use crate::nav::planner::{NavPlanner, PlannerMemory};
 use crate::nav::stuck::{StuckMonitor, StuckState};
 use crate::nav::unseen::unseen_blockers;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
@@ -73,7 +74,11 @@ pub enum NavigationStep {
 /// A robot that makes no progress marks what lies ahead of it as blocked, backs off and
 /// replans, and is reported [`NavigationStep::Blocked`] after a few attempts. A goal that cannot
 /// be reached is answered with [`NavigationStep::NoPath`]; nothing loops forever.
-pub struct Navigator<R: Registrator> {
+///
+/// It localises with any [`Registrator`] `R` and plans with any [`NavPlanner`] `P`: by default
+/// one of ours, chosen by [`NavigatorConfig::planner`]; your own through
+/// [`Navigator::with_planner`].
+pub struct Navigator<R: Registrator, P: NavPlanner = PlannerKind> {
     config: NavigatorConfig,
     limits: MotionLimits,
     localiser: Localiser<R>,
@@ -83,8 +88,11 @@ pub struct Navigator<R: Registrator> {
     /// The planning grid of the map alone, without the live layer's changes: how far the way
     /// would be if what is new moved away.
     static_planning: PlanningGrid,
-    /// The planner's memory on `planning`, kept from plan to plan.
-    memory: PlannerMemory,
+    /// The planner ...
+    planner: P,
+    /// ... and its memory on `planning` and on `static_planning`, kept from plan to plan.
+    memory: P::Memory,
+    static_memory: P::Memory,
     /// The path being followed and its waypoints.
     plan: Plan,
     /// The goal the path leads to.
@@ -126,6 +134,7 @@ impl<R: Registrator> Navigator<R> {
         let planning = PlanningGrid::new(live.combined(), config.planning.clone())
             .map_err(NavError::NavigationGrid)?;
         let static_planning = planning.clone();
+        let planner = config.planner;
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone())?,
             stuck: StuckMonitor::new(config.stuck.clone()),
@@ -136,7 +145,9 @@ impl<R: Registrator> Navigator<R> {
             static_planning,
             config,
             limits: robot.limits.clone(),
+            planner,
             memory: PlannerMemory::default(),
+            static_memory: PlannerMemory::default(),
             plan: Plan::default(),
             planned_for: None,
             cycles_since_plan: 0,
@@ -145,14 +156,76 @@ impl<R: Registrator> Navigator<R> {
         })
     }
 
+    /// This navigator planning with `planner` instead of [`NavigatorConfig::planner`] (which
+    /// it then ignores): any [`NavPlanner`], e.g. your own planner built on each planning grid.
+    /// Call it before the first [`Navigator::step`] (a path already planned is kept until the
+    /// next replan).
+    ///
+    /// ```no_run
+    /// # use gridmap::PlanningGrid;
+    /// # use slam_core::{Cell, GridPath, PlanError, Planner, PointCloud, Pose3};
+    /// # use spot_adapter::nav::{NavPlanner, NavigationMap, Navigator, NavigatorConfig};
+    /// # use spot_adapter::robot::RobotDescription;
+    /// /// Dijkstra's algorithm (pathfind's), built on each grid it is given.
+    /// #[derive(Debug)]
+    /// struct MyDijkstra;
+    ///
+    /// impl NavPlanner for MyDijkstra {
+    ///     type Memory = ();
+    ///
+    ///     fn plan(
+    ///         &mut self,
+    ///         grid: &PlanningGrid,
+    ///         _: &mut (),
+    ///         start: Cell,
+    ///         goal: Cell,
+    ///     ) -> Result<Option<GridPath>, PlanError> {
+    ///         pathfind::Dijkstra::new(grid.blocked()).plan(start, goal)
+    ///     }
+    /// }
+    ///
+    /// # fn run(map: &PointCloud, navigation: &NavigationMap, start: Pose3, robot: &RobotDescription)
+    /// # -> Result<(), spot_adapter::nav::NavError> {
+    /// let localiser = spot_adapter::pipelines::point_to_plane_localiser();
+    /// let config = NavigatorConfig::default();
+    /// let navigator = Navigator::new(localiser, map, navigation, start, robot, config)?
+    ///     .with_planner(MyDijkstra);
+    /// assert_eq!(navigator.replans(), 0);
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn with_planner<Q: NavPlanner>(self, planner: Q) -> Navigator<R, Q> {
+        Navigator {
+            config: self.config,
+            limits: self.limits,
+            localiser: self.localiser,
+            map: self.map,
+            live: self.live,
+            planning: self.planning,
+            static_planning: self.static_planning,
+            planner,
+            memory: Q::Memory::default(),
+            static_memory: Q::Memory::default(),
+            plan: self.plan,
+            planned_for: self.planned_for,
+            cycles_since_plan: self.cycles_since_plan,
+            detour: self.detour,
+            replans: self.replans,
+            recoveries: self.recoveries,
+            stuck: self.stuck,
+        }
+    }
+}
+
+impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
     /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame: a position,
     /// or a [`Goal`] with a final heading).
     ///
     /// # Errors
     /// [`NavError::NonFiniteGoal`] for a goal that is not a finite point or heading
-    /// (checked before anything else); [`NavError::Planner`] when the planner refuses its
-    /// arguments, [`NavError::PlanningCosts`] when the cost-aware planner refuses the grid's
-    /// step costs, and [`NavError::NavigationGrid`] when the live layer refuses the scan
+    /// (checked before anything else); [`NavError::Planner`] when the planner fails,
+    /// [`NavError::InvalidPath`] or [`NavError::PathEndpoints`] when its path cannot be walked
+    /// from here to the goal, and [`NavError::NavigationGrid`] when the live layer refuses the scan
     /// (out-of-order stamps), which the navigator's own checks rule out in normal use.
     pub fn step(
         &mut self,
@@ -334,13 +407,16 @@ impl<R: Registrator> Navigator<R> {
     }
 
     /// A plan from `position` to `goal` on the live planning grid (see [`Plan::search`]).
-    fn search(&self, position: Vector2<f64>, goal: Vector2<f64>) -> Result<Option<Plan>, NavError> {
-        let c = &self.config;
+    fn search(
+        &mut self,
+        position: Vector2<f64>,
+        goal: Vector2<f64>,
+    ) -> Result<Option<Plan>, NavError> {
         Plan::search(
             &self.planning,
-            c.planner,
-            &self.memory,
-            c.shortcut_clearance,
+            &mut self.planner,
+            &mut self.memory,
+            self.config.shortcut_clearance,
             position,
             goal,
         )
@@ -349,7 +425,7 @@ impl<R: Registrator> Navigator<R> {
     /// What there is to wait for on the way to `target`, given the live `plan` (see
     /// [`DetourPolicy::waiting_for`]).
     fn waiting_for(
-        &self,
+        &mut self,
         position: Vector2<f64>,
         target: Vector2<f64>,
         plan: Option<&Plan>,
@@ -357,7 +433,7 @@ impl<R: Registrator> Navigator<R> {
         self.detour.waiting_for(
             &self.planning,
             &self.static_planning,
-            self.config.planner,
+            (&mut self.planner, &mut self.static_memory),
             position,
             target,
             plan,
@@ -485,5 +561,64 @@ impl<R: Registrator> Navigator<R> {
     #[must_use]
     pub fn localisation_failures(&self) -> usize {
         self.localiser.health().failures
+    }
+
+    /// The planner it plans with.
+    #[must_use]
+    pub fn planner(&self) -> &P {
+        &self.planner
+    }
+
+    /// The planner it plans with, to change between goals (its memory on the grids stays).
+    #[must_use]
+    pub fn planner_mut(&mut self) -> &mut P {
+        &mut self.planner
+    }
+
+    /// The registrator it localises with.
+    #[must_use]
+    pub fn registrator(&self) -> &R {
+        self.localiser.registrator()
+    }
+
+    /// Its settings.
+    #[must_use]
+    pub fn config(&self) -> &NavigatorConfig {
+        &self.config
+    }
+
+    /// The map it was given (occupancy and floor), without what the scans changed since (see
+    /// [`Navigator::live`]).
+    #[must_use]
+    pub fn navigation_map(&self) -> &NavigationMap {
+        &self.map
+    }
+
+    /// The planning grid it plans on: the live occupancy hard-inflated, with each cell's
+    /// clearance and step cost ([`Navigator::grid`] is its blocked cells).
+    #[must_use]
+    pub fn planning_grid(&self) -> &PlanningGrid {
+        &self.planning
+    }
+}
+
+/// The settings, the backends, the estimate and the plan's progress; not the grids and the map.
+impl<R, P> std::fmt::Debug for Navigator<R, P>
+where
+    R: Registrator + std::fmt::Debug,
+    P: NavPlanner + std::fmt::Debug,
+{
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Navigator")
+            .field("config", &self.config)
+            .field("registrator", self.localiser.registrator())
+            .field("planner", &self.planner)
+            .field("pose", &self.pose())
+            .field("localisation", &self.localisation())
+            .field("goal", &self.planned_for)
+            .field("waypoints", &self.waypoints())
+            .field("replans", &self.replans)
+            .field("recoveries", &self.recoveries)
+            .finish_non_exhaustive()
     }
 }

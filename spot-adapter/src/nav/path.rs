@@ -3,38 +3,13 @@
 
 use gridmap::PlanningGrid;
 use nalgebra::Vector2;
-use std::cell::RefCell;
 
-use pathfind::{
-    AStar, BestFirstMemory, CellCostAStar, CellCostMemory, JumpPointSearch, JumpPointSearchMemory,
-    filter_path,
-};
-use slam_core::{BitGrid, Cell, GridPath, Planner};
+use pathfind::filter_path;
+use pathfind::movement::validate_dense_path;
+use slam_core::{BitGrid, Cell, GridPath};
 
 use crate::nav::NavError;
-use crate::nav::config::PlannerKind;
-
-/// What the planner keeps from one plan to the next on a grid (its component labels, search
-/// records and, for JPS, the transposed grid): a replan on an unchanged map builds none of them
-/// again, and on a changed one only what depends on the cells. A cache: a clone starts empty.
-#[derive(Debug, Default)]
-pub(crate) struct PlannerMemory(RefCell<Kept>);
-
-/// The memory of the last planner that ran.
-#[derive(Debug, Default)]
-enum Kept {
-    #[default]
-    Nothing,
-    CellCost(CellCostMemory),
-    AStar(BestFirstMemory),
-    Jps(JumpPointSearchMemory),
-}
-
-impl Clone for PlannerMemory {
-    fn clone(&self) -> Self {
-        Self::default()
-    }
-}
+use crate::nav::planner::NavPlanner;
 
 /// A path to the goal and the waypoints along it, kept together from the plan to the goal: the
 /// path's cells are what the blocked-path test and the detour policy read, the waypoints what
@@ -69,10 +44,10 @@ impl Plan {
     /// keeping `shortcut_clearance` (metres) where they can, or `None` when no path joins them
     /// (either end off the map, the goal blocked, or no path). A start inside the inflated
     /// obstacles (the robot brushed a wall) plans from the nearest free cell.
-    pub(crate) fn search(
+    pub(crate) fn search<P: NavPlanner>(
         planning: &PlanningGrid,
-        planner: PlannerKind,
-        memory: &PlannerMemory,
+        planner: &mut P,
+        memory: &mut P::Memory,
         shortcut_clearance: f64,
         position: Vector2<f64>,
         goal: Vector2<f64>,
@@ -156,12 +131,16 @@ impl Plan {
 }
 
 /// The path on `planning` from `position` to `goal` by `planner` with every cell, its length
-/// that of those cells, or `None` when none joins them (see [`Plan::search`]); the cost-aware
-/// planner reuses and keeps `memory`.
-pub(crate) fn dense_path(
+/// that of those cells, or `None` when none joins them (see [`Plan::search`]); the planner
+/// reuses and keeps `memory`.
+///
+/// # Errors
+/// [`NavError::Planner`] with the planner's error; [`NavError::InvalidPath`] when its path does
+/// not join the endpoints through free cells.
+pub(crate) fn dense_path<P: NavPlanner>(
     planning: &PlanningGrid,
-    planner: PlannerKind,
-    memory: &PlannerMemory,
+    planner: &mut P,
+    memory: &mut P::Memory,
     position: Vector2<f64>,
     goal: Vector2<f64>,
 ) -> Result<Option<GridPath>, NavError> {
@@ -172,46 +151,31 @@ pub(crate) fn dense_path(
     let Some(start) = grid.cell_at(position).and_then(|c| nearest_free(grid, c)) else {
         return Ok(None);
     };
-    let path: Option<GridPath> = match planner {
-        PlannerKind::CellCostAStar => {
-            let costs = planning.step_costs();
-            let mut search = match memory.0.take() {
-                Kept::CellCost(kept) => CellCostAStar::with_memory(grid, costs, kept),
-                _ => CellCostAStar::new(grid, costs),
-            }
-            .map_err(NavError::PlanningCosts)?;
-            let found = search.plan(start, goal_cell);
-            memory.0.replace(Kept::CellCost(search.into_memory()));
-            found
-        }
-        PlannerKind::JumpPointSearch => {
-            let mut search = match memory.0.take() {
-                Kept::Jps(kept) => JumpPointSearch::with_memory(grid, kept),
-                _ => JumpPointSearch::new(grid),
-            };
-            let found = search.plan(start, goal_cell);
-            memory.0.replace(Kept::Jps(search.into_memory()));
-            found
-        }
-        PlannerKind::AStar => {
-            let mut search = match memory.0.take() {
-                Kept::AStar(kept) => AStar::with_memory(grid, kept),
-                _ => AStar::new(grid),
-            };
-            let found = search.plan(start, goal_cell);
-            memory.0.replace(Kept::AStar(search.into_memory()));
-            found
-        }
+    let Some(path) = planner
+        .plan(planning, memory, start, goal_cell)
+        .map_err(NavError::Planner)?
+    else {
+        return Ok(None);
+    };
+    let cells = path.expand();
+    // Any planner may be plugged in: what it returns is checked before the robot follows it.
+    if let Err(violation) = validate_dense_path(grid, &cells) {
+        return Err(NavError::InvalidPath { violation });
     }
-    .map_err(NavError::Planner)?;
+    let ends = (cells.first().copied(), cells.last().copied());
+    if ends != (Some(start), Some(goal_cell)) {
+        return Err(NavError::PathEndpoints {
+            start,
+            goal: goal_cell,
+            first: ends.0.unwrap_or(start),
+            last: ends.1.unwrap_or(goal_cell),
+        });
+    }
     // The length of the cells walked, not the planner's cost (which counts the clearance cost).
-    Ok(path.map(|p| {
-        let cells = p.expand();
-        GridPath {
-            length: cells_length(&cells),
-            expanded: p.expanded,
-            cells,
-        }
+    Ok(Some(GridPath {
+        length: cells_length(&cells),
+        expanded: path.expanded,
+        cells,
     }))
 }
 
@@ -281,6 +245,117 @@ fn nearest_free(grid: &BitGrid, cell: Cell) -> Option<Cell> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nav::{PlannerKind, PlannerMemory};
+    use gridmap::{CellState, OccupancyGrid, PlanningGridConfig};
+    use slam_core::{GridGeometry, PlanError};
+
+    /// A planner that answers every query with the same cells (or error).
+    struct Fixed(Result<Vec<Cell>, &'static str>);
+
+    impl NavPlanner for Fixed {
+        type Memory = ();
+
+        fn plan(
+            &mut self,
+            _: &PlanningGrid,
+            (): &mut (),
+            _: Cell,
+            _: Cell,
+        ) -> Result<Option<GridPath>, PlanError> {
+            let cells = self.0.clone().map_err(|e| PlanError::backend("fixed", e))?;
+            Ok(Some(GridPath {
+                cells,
+                length: 0.0,
+                expanded: 0,
+            }))
+        }
+    }
+
+    /// 40 x 20 free cells of 0.1 m, with an obstacle at `wall` if given.
+    fn planning(wall: Option<Cell>) -> PlanningGrid {
+        let cells = GridGeometry {
+            resolution: 0.1,
+            ..GridGeometry::default()
+        };
+        let mut occupancy = OccupancyGrid::new(40, 20, cells, CellState::Free).unwrap();
+        if let Some(c) = wall {
+            occupancy.set(c, CellState::Occupied).unwrap();
+        }
+        PlanningGrid::new(&occupancy, PlanningGridConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn a_plugged_in_planners_path_is_checked_before_it_is_followed() {
+        // From cell (5, 10) to cell (35, 10).
+        let (from, to) = (Vector2::new(0.55, 1.05), Vector2::new(3.55, 1.05));
+        let (start, goal) = (Cell::new(5, 10), Cell::new(35, 10));
+        let free = planning(None);
+        // Turning points joined by straight runs: expanded to every cell, its length walked.
+        let path = dense_path(&free, &mut Fixed(Ok(vec![start, goal])), &mut (), from, to)
+            .unwrap()
+            .unwrap();
+        assert_eq!(path.cells.len(), 31);
+        assert!((path.length - 30.0).abs() < 1e-12);
+        // Short of the goal.
+        let short = dense_path(
+            &free,
+            &mut Fixed(Ok(vec![start, Cell::new(20, 10)])),
+            &mut (),
+            from,
+            to,
+        );
+        assert!(
+            matches!(short, Err(NavError::PathEndpoints { last, .. }) if last == Cell::new(20, 10)),
+            "{short:?}"
+        );
+        // Through an obstacle: the straight run crosses its inflation.
+        let walled = planning(Some(Cell::new(20, 10)));
+        let through = dense_path(
+            &walled,
+            &mut Fixed(Ok(vec![start, goal])),
+            &mut (),
+            from,
+            to,
+        );
+        assert!(
+            matches!(through, Err(NavError::InvalidPath { .. })),
+            "{through:?}"
+        );
+        // No cells at all.
+        let empty = dense_path(&free, &mut Fixed(Ok(Vec::new())), &mut (), from, to);
+        assert!(
+            matches!(empty, Err(NavError::InvalidPath { .. })),
+            "{empty:?}"
+        );
+        // The planner's own failure, its error kept as the source.
+        let failed = dense_path(&free, &mut Fixed(Err("out of fuel")), &mut (), from, to);
+        let Err(NavError::Planner(
+            e @ PlanError::Backend {
+                backend: "fixed", ..
+            },
+        )) = failed
+        else {
+            panic!("{failed:?}");
+        };
+        let source = std::error::Error::source(&e).unwrap();
+        assert_eq!(source.to_string(), "out of fuel");
+        // Ours go round the obstacle, each keeping its memory.
+        for mut kind in [
+            PlannerKind::CellCostAStar,
+            PlannerKind::JumpPointSearch,
+            PlannerKind::AStar,
+        ] {
+            let mut memory = PlannerMemory::default();
+            for _ in 0..2 {
+                let path = dense_path(&walled, &mut kind, &mut memory, from, to)
+                    .unwrap()
+                    .unwrap();
+                assert_eq!(path.cells.first(), Some(&start));
+                assert_eq!(path.cells.last(), Some(&goal));
+                assert!(path.length > 30.0, "{kind:?}: {}", path.length);
+            }
+        }
+    }
 
     #[test]
     fn a_blocked_start_moves_to_the_closest_free_cell_of_the_first_ring_that_has_one() {

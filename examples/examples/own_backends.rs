@@ -1,0 +1,444 @@
+//! Your own backends plugged into spot-nav, on a simulated Spot: a registrator, an optimizer and a
+//! planner written here, outside the library, used by the Graph-SLAM engine and the navigator.
+//!
+//! - `CountingIcp` (a `MapRegistrator`): our point-to-plane ICP with every call forwarded, the
+//!   alignments counted. It registers the odometry and refines the loops.
+//! - `CountingLevenbergMarquardt` (an `Optimizer`): our Levenberg-Marquardt, its runs counted.
+//! - `GridDijkstra` (a `slam_core::Planner`): Dijkstra's algorithm on the planning grid, written
+//!   here, and `OwnPlanner` (a `NavPlanner`) that builds it on each grid the navigator plans on.
+//!   It refuses grids over its cell budget with its own error, carried by `PlanError::Backend`.
+//!
+//! 1. Mapping: Spot walks one lap of the building's corridor loop; the engine maps it with the
+//!    backends above. Prints the ATE against the simulator's ground truth.
+//! 2. Navigation: from where the lap ended, the navigator walks Spot to the entry of the room
+//!    farthest away, planning with `OwnPlanner`. Prints how far the true body ended from it.
+//!
+//! Exits with status 1 when the ATE exceeds `--max-ate`, a backend was never called, or the
+//! goal was not reached within 0.10 m.
+//!
+//! `cargo run --release -p spot-nav-examples --example own_backends -- [--seed N] [--max-ate M]`
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use anyhow::{Context, Result, bail};
+use clap::Parser;
+use gridmap::PlanningGrid;
+use nalgebra::Point3;
+use pathfind::movement::DIRECTIONS;
+use posegraph::LevenbergMarquardt;
+use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
+use slam_core::{
+    Alignment, BitGrid, Cell, GraphSlam, GridPath, MapRegistrator, OptimizationReport,
+    OptimizeError, Optimizer, PlanError, Planner, PointCloud, Pose3, PoseGraph, Reach,
+    RegistrationError, Registrator, SweepAlignment, validate_endpoints,
+};
+use spot_adapter::eval::TrajectoryEvaluation;
+use spot_adapter::nav::{
+    DriveOutcome, NavPlanner, NavigationMap, NavigationMapConfig, Navigator, NavigatorConfig, drive,
+};
+use spot_adapter::pipelines::{point_to_plane_localiser, point_to_plane_tracker, slam_config};
+use spot_adapter::robot::Robot;
+use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
+use spot_nav_examples::out;
+
+/// A goal counts as reached within this distance of the true body (metres).
+const REACHED_WITHIN: f64 = 0.10;
+
+/// Scans the walk may take (5 minutes at 5 Hz).
+const MAX_CYCLES: usize = 1500;
+
+/// Map a simulated building with your own registrator and optimizer, then walk to a room with
+/// your own planner.
+#[derive(Parser, Debug)]
+#[command(version)]
+struct Args {
+    /// The building and the run (the simulator's seed).
+    #[arg(long, default_value_t = 3)]
+    seed: u64,
+    /// Fail above this absolute trajectory error of the mapping lap (metres, RMS).
+    #[arg(long, default_value_t = 0.05)]
+    max_ate: f64,
+}
+
+// ---------------------------------------------------------------------------------------------
+// A registrator: ours, wrapped. Every method is forwarded, the defaulted ones too: a wrapper
+// that left out `empty_map`/`add_to_map`/`remove_from_map` would still compile, and the engine
+// would rebuild its local map whole for every keyframe instead of sliding it in place.
+
+/// Point-to-plane ICP with its alignments counted.
+#[derive(Debug, Default)]
+struct CountingIcp {
+    icp: PointToPlaneIcp,
+    alignments: AtomicUsize,
+}
+
+impl CountingIcp {
+    fn new(icp: PointToPlaneIcp) -> Self {
+        Self {
+            icp,
+            alignments: AtomicUsize::new(0),
+        }
+    }
+
+    fn alignments(&self) -> usize {
+        self.alignments.load(Ordering::Relaxed)
+    }
+
+    fn count(&self) {
+        self.alignments.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+impl Registrator for CountingIcp {
+    type Source = <PointToPlaneIcp as Registrator>::Source;
+    type Target = <PointToPlaneIcp as Registrator>::Target;
+
+    fn prepare_source(&self, cloud: &PointCloud) -> Result<Self::Source, RegistrationError> {
+        self.icp.prepare_source(cloud)
+    }
+
+    fn prepare_target(&self, cloud: &PointCloud) -> Result<Self::Target, RegistrationError> {
+        self.icp.prepare_target(cloud)
+    }
+
+    fn align(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Result<Alignment, RegistrationError> {
+        self.count();
+        self.icp.align(source, target, initial)
+    }
+
+    fn align_within(
+        &self,
+        source: &Self::Source,
+        target: &Self::Target,
+        initial: &Pose3,
+        reach: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        self.count();
+        self.icp.align_within(source, target, initial, reach)
+    }
+
+    fn align_sweep(
+        &self,
+        sweep: &PointCloud,
+        target: &Self::Target,
+        initial: &Pose3,
+    ) -> Option<Result<SweepAlignment, RegistrationError>> {
+        self.count();
+        self.icp.align_sweep(sweep, target, initial)
+    }
+}
+
+impl MapRegistrator for CountingIcp {
+    fn target_from_sources(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError> {
+        self.icp.target_from_sources(parts)
+    }
+
+    fn keyframe_source(&self, source: Self::Source) -> Self::Source {
+        self.icp.keyframe_source(source)
+    }
+
+    fn source_voxel(&self) -> Option<f32> {
+        self.icp.source_voxel()
+    }
+
+    fn empty_map(&self) -> Option<Self::Target> {
+        self.icp.empty_map()
+    }
+
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
+        self.icp.add_to_map(map, key, source, pose);
+    }
+
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
+        self.icp.remove_from_map(map, key);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// An optimizer: ours, wrapped.
+
+/// Levenberg-Marquardt with its runs counted.
+#[derive(Debug, Default)]
+struct CountingLevenbergMarquardt {
+    solver: LevenbergMarquardt,
+    runs: usize,
+}
+
+impl Optimizer<Pose3> for CountingLevenbergMarquardt {
+    fn optimize(
+        &mut self,
+        graph: &mut PoseGraph<Pose3>,
+    ) -> Result<OptimizationReport, OptimizeError> {
+        self.runs += 1;
+        self.solver.optimize(graph)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A planner of your own: Dijkstra's algorithm, 8-connected, diagonal steps sqrt(2) that cut no
+// corner (pathfind's movement model, which the navigator checks every path it gets against).
+
+/// A grid larger than the planner's cell budget: its own error, which the navigator passes on
+/// as the source of [`PlanError::Backend`].
+#[derive(Debug)]
+struct GridTooLarge {
+    cells: usize,
+    budget: usize,
+}
+
+impl std::fmt::Display for GridTooLarge {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} cells exceed the budget of {}",
+            self.cells, self.budget
+        )
+    }
+}
+
+impl std::error::Error for GridTooLarge {}
+
+/// Dijkstra's algorithm on one grid (a [`Planner`] is built for one grid).
+struct GridDijkstra<'g> {
+    grid: &'g BitGrid,
+    budget: usize,
+}
+
+impl Planner for GridDijkstra<'_> {
+    fn plan(&mut self, start: Cell, goal: Cell) -> Result<Option<GridPath>, PlanError> {
+        validate_endpoints(self.grid, start, goal)?;
+        let (width, height) = (self.grid.width() as usize, self.grid.height() as usize);
+        let cells = width * height;
+        if cells > self.budget {
+            let budget = self.budget;
+            return Err(PlanError::backend(
+                "grid-dijkstra",
+                GridTooLarge { cells, budget },
+            ));
+        }
+        let index = |c: Cell| c.y as usize * width + c.x as usize;
+        let mut cost = vec![f64::INFINITY; cells];
+        let mut parent = vec![usize::MAX; cells];
+        // Costs are finite and not negative: their bits order as the numbers do.
+        let mut open = BinaryHeap::new();
+        cost[index(start)] = 0.0;
+        open.push(Reverse((0.0f64.to_bits(), index(start))));
+        let mut expanded = 0;
+        while let Some(Reverse((bits, at))) = open.pop() {
+            if f64::from_bits(bits) > cost[at] {
+                continue; // an outdated entry
+            }
+            expanded += 1;
+            if at == index(goal) {
+                break;
+            }
+            let (x, y) = ((at % width) as i64, (at / width) as i64);
+            for (dx, dy) in DIRECTIONS.map(|(dx, dy)| (i64::from(dx), i64::from(dy))) {
+                let free = |x, y| self.grid.is_free_signed(x, y);
+                let diagonal = dx != 0 && dy != 0;
+                if !free(x + dx, y + dy) || (diagonal && !(free(x + dx, y) && free(x, y + dy))) {
+                    continue;
+                }
+                let next = (y + dy) as usize * width + (x + dx) as usize;
+                let step = if diagonal {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
+                let through = cost[at] + step;
+                if through < cost[next] {
+                    cost[next] = through;
+                    parent[next] = at;
+                    open.push(Reverse((through.to_bits(), next)));
+                }
+            }
+        }
+        if cost[index(goal)].is_infinite() {
+            return Ok(None);
+        }
+        let mut path = vec![goal];
+        let mut at = index(goal);
+        while at != index(start) {
+            at = parent[at];
+            path.push(Cell::new((at % width) as u32, (at / width) as u32));
+        }
+        path.reverse();
+        Ok(Some(GridPath {
+            cells: path,
+            length: cost[index(goal)],
+            expanded,
+        }))
+    }
+}
+
+/// The navigator's planner: [`GridDijkstra`] built on each grid it is handed, its queries
+/// counted. It keeps nothing from one query to the next (`Memory = ()`).
+#[derive(Debug)]
+struct OwnPlanner {
+    /// Grids of more cells are refused.
+    budget: usize,
+    queries: usize,
+    /// Paths found.
+    found: usize,
+}
+
+impl NavPlanner for OwnPlanner {
+    type Memory = ();
+
+    fn plan(
+        &mut self,
+        grid: &PlanningGrid,
+        _memory: &mut (),
+        start: Cell,
+        goal: Cell,
+    ) -> Result<Option<GridPath>, PlanError> {
+        self.queries += 1;
+        let mut dijkstra = GridDijkstra {
+            grid: grid.blocked(),
+            budget: self.budget,
+        };
+        let path = dijkstra.plan(start, goal)?;
+        self.found += usize::from(path.is_some());
+        Ok(path)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+fn main() -> ExitCode {
+    spot_nav_examples::run(|| own_backends(&Args::parse()))
+}
+
+/// The engine with the backends of this file.
+type OwnSlam = GraphSlam<CountingIcp, PointToPointIcp, CountingLevenbergMarquardt>;
+
+fn own_backends(args: &Args) -> Result<()> {
+    let config = SimulationConfig::with_seed(args.seed);
+    let sim = SimulatedSpot::corridor_loop(&config)?;
+    let building = sim.building().clone();
+    let body_t_lidar = sim.body_t_lidar();
+    let truth = sim.ground_truth();
+
+    // 1. Mapping with your registrator and optimizer.
+    let mut slam = own_slam()?;
+    for sample in sim {
+        // A skipped scan is counted in the report.
+        let _outcome = slam.process(&sample.scan_input());
+    }
+    let (evaluation, _) =
+        TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)?;
+    let ate = evaluation.ate.rmse;
+    let report = slam.report();
+    let loops_closed = report.loops_closed;
+    out!(
+        "mapping     {} scans, {} keyframes, {loops_closed} loops closed; ATE {ate:.3} m",
+        report.scans,
+        report.keyframes,
+    )?;
+    let (odometry, refinements, runs) = (
+        slam.registrator().alignments(),
+        slam.loop_refine_registrator().alignments(),
+        slam.optimizer().runs,
+    );
+    out!(
+        "backends    registrator {odometry} odometry and {refinements} loop alignments; optimizer {runs} runs"
+    )?;
+
+    // 2. Navigation with your planner. The map frame is the odometry frame of the lap, which
+    // starts at the first body pose; the LiDAR sits its mounting above the body.
+    let world_t_map = truth.first().context("empty lap")?.pose;
+    let map_t_lidar = slam.current_lidar_pose().context("no scan was mapped")?;
+    let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
+    let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
+    let navigation =
+        NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default())?;
+    let lap_end = truth.last().context("empty lap")?.pose;
+    let start = lap_end.translation.vector.xy();
+    let goal_world = building
+        .rooms()
+        .iter()
+        .map(spot_adapter::sim::Room::entry_point)
+        .max_by(|a, b| (a - start).norm().total_cmp(&(b - start).norm()))
+        .context("the building has no room")?;
+    let goal = (world_t_map.inverse() * Point3::new(goal_world.x, goal_world.y, 0.0))
+        .coords
+        .xy();
+    let mut spot = CommandedSpot::new(building, start, lap_end.rotation.euler_angles().2, &config)?;
+    let planner = OwnPlanner {
+        budget: 4_000_000,
+        queries: 0,
+        found: 0,
+    };
+    let mut navigator = Navigator::new(
+        point_to_plane_localiser(),
+        &slam.map(0.05)?,
+        &navigation,
+        map_t_lidar * body_t_lidar.inverse(),
+        spot.description(),
+        NavigatorConfig::default(),
+    )?
+    .with_planner(planner);
+    let walk = drive(&mut spot, &mut navigator, goal, MAX_CYCLES, |_| {})?;
+    let error = (spot.position() - goal_world).norm();
+    let OwnPlanner { queries, found, .. } = *navigator.planner();
+    out!(
+        "navigation  {:?} after {} cycles, {:.3} m from the goal; the planner answered {queries} queries, {found} with a path",
+        walk.outcome,
+        walk.cycles,
+        error
+    )?;
+
+    if ate > args.max_ate {
+        bail!("ATE {ate:.3} m exceeds --max-ate {:.3} m", args.max_ate);
+    }
+    if odometry == 0 || (refinements == 0 && loops_closed > 0) || runs == 0 {
+        bail!("a backend of the engine was never called");
+    }
+    if found == 0 {
+        bail!("the planner found no path");
+    }
+    if walk.outcome != DriveOutcome::Arrived || error > REACHED_WITHIN {
+        bail!(
+            "the goal was not reached: {:?}, {error:.3} m from it",
+            walk.outcome
+        );
+    }
+    Ok(())
+}
+
+/// The engine with your registrator (odometry and loop refinement, as the pipelines' point-to-plane
+/// settings) and optimizer; our point-to-point ICP checks loop candidates.
+fn own_slam() -> Result<OwnSlam> {
+    let loop_check = PointToPointIcp {
+        config: IcpConfig {
+            max_correspondence_distance: 1.0,
+            pair_target_points: 1,
+            ..IcpConfig::default()
+        },
+    };
+    let refine = PointToPlaneIcp {
+        config: IcpConfig {
+            kernel: IcpKernel::Tukey { k: 0.10 },
+            max_correspondence_distance: 1.0,
+            ..IcpConfig::default()
+        },
+    };
+    Ok(GraphSlam::try_new(
+        slam_config(),
+        CountingIcp::new(point_to_plane_tracker()),
+        loop_check,
+        CountingIcp::new(refine),
+        CountingLevenbergMarquardt::default(),
+    )?)
+}
