@@ -221,3 +221,26 @@ fn a_robot_that_never_moves_is_stopped_within_5_s() {
         "{commands} commands in {seconds:.1} s"
     );
 }
+
+#[test]
+fn refused_commands_stop_the_example_at_once() {
+    let fake = fake_spot!("example-refused", &["--refuse-motion"]);
+    let (requests, stderr) = refused(&fake, "STATUS_BEHAVIOR_FAULT", Duration::from_secs(30));
+    assert!(stderr.contains("refused"), "{stderr}");
+    let first = position(
+        &requests,
+        |r| is_command(r, "se2_velocity_request"),
+        "velocity command",
+    );
+    let motion = requests
+        .iter()
+        .filter(|r| is_command(r, "se2_velocity_request"))
+        .count();
+    assert_eq!(motion, 1, "a refused command is not retried");
+    assert!(
+        requests[..first]
+            .iter()
+            .any(|r| is_command(r, "stand_request"))
+    );
+    assert_stopped_and_lease_returned(&requests);
+}

@@ -11,7 +11,9 @@ PowerCommand powers them on in POWER_ON_SECONDS, a stand or sit takes POSTURE_SE
 off sits and cuts power at once; motion with the motors off is refused STATUS_NOT_POWERED_ON.
 The robot state lists one hardware E-stop, released (`--estop asserted`, or `--estop none`: no
 endpoint), and the faults `--behavior-fault` (CAUSE_FALL, clearable) and `--system-fault NAME`
-ask for. `--frozen` takes every command and never moves.
+ask for. `--frozen` takes every command and never moves; `--refuse-motion` refuses every
+velocity and trajectory command (STATUS_BEHAVIOR_FAULT); `--stale-cloud` serves the same scan
+(one acquisition time) again and again.
 
 Start-up prints one line `READY <port>` on stdout once the server listens; `<dir>/ca.pem` then
 holds the CA. Control lines (answered `OK <line>`): take-lease, stall-time-sync, malformed-cloud,
@@ -139,6 +141,7 @@ class Robot:
         self.powering_on_until = None  # host time the motors will be on
         self.standing = self.motors_on
         self.posture_commands = {}  # command id -> (kind, host time it completes)
+        self.started = self.now()
 
     def now(self):
         """Robot clock, seconds."""
@@ -541,7 +544,8 @@ class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
             else:
                 points = known_points()
                 data = b"".join(struct.pack("<3f", *p) for p in points)
-                scan_time = math.floor(self.r.now() * 10.0) / 10.0
+                scan_time = math.floor((self.r.started if self.r.args.stale_cloud
+                                        else self.r.now()) * 10.0) / 10.0
                 count = len(points)
             cloud.source.acquisition_time.CopyFrom(self.r.stamp(scan_time))
             cloud.num_points = count + (1 if self.r.malformed_cloud else 0)
@@ -719,6 +723,9 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
             if self.r.args.behavior_fault:
                 return Status.STATUS_BEHAVIOR_FAULT
         mobility = command.synchronized_command.mobility_command
+        if self.r.args.refuse_motion and mobility.WhichOneof("command") in (
+                "se2_velocity_request", "se2_trajectory_request"):
+            return Status.STATUS_BEHAVIOR_FAULT
         if mobility.params.type_url:
             params = spot_command_pb2.MobilityParams()
             if not mobility.params.Unpack(params):
@@ -796,6 +803,8 @@ def main():
     parser.add_argument("--behavior-fault", action="store_true", help="report a fall fault")
     parser.add_argument("--system-fault", default="", help="report a system fault of this name")
     parser.add_argument("--frozen", action="store_true", help="take commands, never move")
+    parser.add_argument("--refuse-motion", action="store_true", help="refuse every motion")
+    parser.add_argument("--stale-cloud", action="store_true", help="one scan, served forever")
     args = parser.parse_args()
     robot = Robot(args)
     key_pem, cert_pem = make_certificates(args.dir)

@@ -5,6 +5,7 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 use spot_adapter::grpc::{MotorPower, SpotError};
+use spot_adapter::robot::Robot;
 
 use crate::fake_spot;
 use crate::{connect, support};
@@ -105,4 +106,20 @@ fn the_robot_state_names_missing_estops_and_faults() {
             && message.contains("left_hip_motor_overheat"),
         "{message}"
     );
+}
+
+#[test]
+fn a_cloud_already_delivered_is_not_delivered_again() {
+    let fake = fake_spot!("stale-cloud", &["--stale-cloud"]);
+    let mut spot = connect(&fake);
+    let first = spot.next_sample().unwrap();
+    let started = Instant::now();
+    let error = spot.next_sample().unwrap_err();
+    assert!(
+        matches!(error, SpotError::NoNewScan { .. }),
+        "{error} after the scan of {}",
+        first.stamp
+    );
+    // The client's call timeout in the tests is 3 s.
+    assert!(started.elapsed() < Duration::from_secs(5));
 }
