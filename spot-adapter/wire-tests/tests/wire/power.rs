@@ -123,3 +123,24 @@ fn a_cloud_already_delivered_is_not_delivered_again() {
     // The client's call timeout in the tests is 3 s.
     assert!(started.elapsed() < Duration::from_secs(5));
 }
+
+#[test]
+fn a_panic_while_holding_the_client_sends_a_stop_and_returns_the_lease() {
+    let fake = fake_spot!("panic");
+    let result = std::panic::catch_unwind(|| {
+        let _spot = connect(&fake);
+        panic!("a bug in the caller");
+    });
+    assert!(result.is_err());
+    let requests = fake.requests();
+    let returned = requests
+        .iter()
+        .position(|r| r["method"] == "ReturnLease")
+        .expect("the lease is returned");
+    assert!(
+        requests[..returned]
+            .iter()
+            .any(|r| r["method"] == "RobotCommand" && r["decoded"]["kind"] == "full_body_command"),
+        "a stop before the lease is returned"
+    );
+}
