@@ -31,8 +31,10 @@ const SCAN_POLL: Duration = Duration::from_millis(20);
 const MOTION_TRANSLATION: f64 = 0.01;
 const MOTION_ROTATION: f64 = 0.01;
 
-/// A command faster than this (m/s, rad/s) asks the robot to move.
-const MOVING_SPEED: f64 = 1e-3;
+/// A command at least this fast (m/s, rad/s) asks the robot to move: over the 3 s stall
+/// timeout it moves the odometry well past the motion thresholds above, so a crawl on the
+/// final approach is not mistaken for a robot that does not respond.
+const MOVING_SPEED: f64 = 0.05;
 
 /// Since when the robot has been commanded to move, and where its odometry was then.
 #[derive(Clone, Copy, Debug)]
