@@ -17,6 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "bosdyn/api/point_cloud.proto",
         "bosdyn/api/local_grid.proto",
         "bosdyn/api/robot_command.proto",
+        "bosdyn/api/power.proto",
         "bosdyn/api/spot/robot_command.proto",
     ];
     println!("cargo::rerun-if-changed=proto");

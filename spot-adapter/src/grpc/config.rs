@@ -103,6 +103,17 @@ pub struct SpotConfig {
     pub velocity_hold: Duration,
     /// Time past a trajectory's last point before its command ends: 1 s.
     pub trajectory_slack: Duration,
+    /// The longest wait for the motors to power on or off: 20 s (the SDK's `power_on`).
+    pub power_timeout: Duration,
+    /// The longest wait for the robot to stand or sit: 10 s (the SDK's `blocking_stand`).
+    pub posture_timeout: Duration,
+    /// How long the odometry may stay unchanged while the robot is commanded to move before
+    /// the client reports [`SpotError::NotMoving`](crate::grpc::SpotError::NotMoving): 3 s.
+    pub stall_timeout: Duration,
+    /// The fixed period of motion commands: 0.1 s (10 Hz); a command asked for sooner waits.
+    pub command_period: Duration,
+    /// How often the robot state's E-stops and faults are checked while running: 0.5 s.
+    pub health_interval: Duration,
     /// Geometry and speed limits (commands are clamped to the limits and the limits are sent
     /// to the robot as `MobilityParams.vel_limit`).
     pub description: RobotDescription,
@@ -126,6 +137,11 @@ impl SpotConfig {
             point_cloud_source: "velodyne-point-cloud".to_owned(),
             velocity_hold: Duration::from_millis(600),
             trajectory_slack: Duration::from_secs(1),
+            power_timeout: Duration::from_secs(20),
+            posture_timeout: Duration::from_secs(10),
+            stall_timeout: Duration::from_secs(3),
+            command_period: Duration::from_millis(100),
+            health_interval: Duration::from_millis(500),
             description: RobotDescription::default(),
         }
     }

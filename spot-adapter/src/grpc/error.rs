@@ -155,6 +155,59 @@ pub enum SpotError {
         /// Seconds waited.
         seconds: f64,
     },
+    /// A step of bringing the robot up or down (power on, stand, sit, power off) did not
+    /// finish within its timeout.
+    #[error("{step}: not done within {seconds} s (the robot's last reply: {last_reply})")]
+    StepTimedOut {
+        /// The step: `power on`, `stand`, `sit`, `power off`.
+        step: &'static str,
+        /// The step's timeout, seconds.
+        seconds: f64,
+        /// What the robot last said about it.
+        last_reply: String,
+    },
+    /// The robot refused or abandoned a step of bringing it up or down.
+    #[error("{step}: the robot answered {reply}")]
+    StepFailed {
+        /// The step: `power on`, `stand`, `sit`, `power off`.
+        step: &'static str,
+        /// The robot's reply (a status as named on the wire, blocking faults).
+        reply: String,
+    },
+    /// An E-stop is asserted: the robot cannot move until it is released.
+    #[error("E-stop asserted: {names:?}; release it (E-stop controller or tablet) and start again")]
+    EStopped {
+        /// The asserted E-stops' names.
+        names: Vec<String>,
+    },
+    /// No E-stop endpoint is registered, so nothing could stop the robot in an emergency.
+    #[error(
+        "no E-stop endpoint is registered: connect the tablet or an E-stop controller to the \
+         robot and keep its E-stop in hand, then start again"
+    )]
+    NoEStop,
+    /// The robot reports system or behaviour faults.
+    #[error(
+        "the robot reports faults: system {system:?}, behaviour {behavior:?}; clear them \
+         (tablet) and start again"
+    )]
+    Faulted {
+        /// Names of the active system faults.
+        system: Vec<String>,
+        /// Active behaviour faults, `CAUSE_* (STATUS_*)`.
+        behavior: Vec<String>,
+    },
+    /// The odometry did not change while the robot was commanded to move.
+    #[error(
+        "the robot does not respond: commanded to move for {seconds:.1} s, its odometry did not change"
+    )]
+    NotMoving {
+        /// Seconds commanded to move without the odometry changing.
+        seconds: f64,
+    },
+    /// The run was interrupted (Ctrl-C).
+    #[error("interrupted")]
+    Interrupted,
     /// The client's async runtime could not be started.
     #[error("the client's runtime could not start")]
     Runtime(#[source] std::io::Error),

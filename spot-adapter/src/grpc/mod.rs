@@ -46,6 +46,8 @@ mod frame_tree;
 mod lease;
 mod local_grid;
 mod point_cloud;
+mod posture;
+mod power;
 mod robot_command;
 mod robot_state;
 mod session;
@@ -58,6 +60,7 @@ pub use error::SpotError;
 pub use frame_tree::{FrameError, FrameTree};
 pub use local_grid::LocalGrid;
 pub use point_cloud::SpotCloud;
+pub use robot_state::{EStop, MotorPower, RobotStatus};
 pub use spot_client::SpotClient;
 /// gRPC status codes, as [`SpotError::Rpc`] reports them.
 pub use tonic::Code as RpcCode;

@@ -170,6 +170,15 @@ impl Session {
 
     /// Send a stop (needs the lease, not the time sync).
     pub(crate) async fn send_stop(&self) -> Result<u32, SpotError> {
+        self.send_unclocked(stop_command()).await
+    }
+
+    /// Send a command without an end time (stop, stand, sit, safe power off): it needs the
+    /// lease, not the time sync.
+    pub(crate) async fn send_unclocked(
+        &self,
+        command: api::RobotCommand,
+    ) -> Result<u32, SpotError> {
         let lease = self.lease_for_command()?;
         let clock_identifier = self
             .clock
@@ -177,8 +186,7 @@ impl Session {
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .clock_identifier
             .clone();
-        self.robot_command(stop_command(), lease, clock_identifier)
-            .await
+        self.robot_command(command, lease, clock_identifier).await
     }
 
     async fn robot_command(

@@ -2,7 +2,10 @@
 //! the [`Robot`] the navigator drives.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+use slam_core::Pose3;
 
 use tokio::runtime::Runtime;
 use tokio::task::JoinHandle;
@@ -13,6 +16,8 @@ use crate::grpc::error::SpotError;
 use crate::grpc::frame_tree::FrameTree;
 use crate::grpc::local_grid::LocalGrid;
 use crate::grpc::point_cloud::SpotCloud;
+use crate::grpc::posture::Posture;
+use crate::grpc::robot_state::RobotStatus;
 use crate::grpc::session::Session;
 use crate::robot::{MobilityCommand, Robot, RobotDescription, Sample};
 
@@ -22,14 +27,37 @@ const RENEWAL_RETRY: Duration = Duration::from_secs(1);
 /// Pause between two asks for a scan newer than the last one.
 const SCAN_POLL: Duration = Duration::from_millis(20);
 
+/// The odometry must move this much (metres, radians) to count as motion.
+const MOTION_TRANSLATION: f64 = 0.01;
+const MOTION_ROTATION: f64 = 0.01;
+
+/// A command at least this fast (m/s, rad/s) asks the robot to move: over the 3 s stall
+/// timeout it moves the odometry well past the motion thresholds above, so a crawl on the
+/// final approach is not mistaken for a robot that does not respond.
+const MOVING_SPEED: f64 = 0.05;
+
+/// Since when the robot has been commanded to move, and where its odometry was then.
+#[derive(Clone, Copy, Debug)]
+struct Motion {
+    since: Instant,
+    odom_t_body: Pose3,
+}
+
 /// A connected, authenticated client holding the body lease.
 ///
 /// [`SpotClient::connect`] logs in, reads the directory, syncs time and acquires the lease;
 /// in the background it then retains the lease every [`SpotConfig::lease_retain_interval`],
 /// runs a time-sync round every [`TimeSyncConfig::resync_interval`](crate::grpc::TimeSyncConfig)
 /// and renews the token every [`SpotConfig::token_refresh_interval`]. Dropping it stops the
-/// background work and returns the lease. Every call waits at most
-/// [`SpotConfig::call_timeout`].
+/// background work, sends a stop and returns the lease (also when a panic unwinds). Every
+/// call waits at most [`SpotConfig::call_timeout`].
+///
+/// As a [`Robot`] it watches the robot it drives: each scan is delivered once (by its
+/// acquisition time); motion commands go out at the fixed [`SpotConfig::command_period`];
+/// every [`SpotConfig::health_interval`] the robot state is checked for E-stops and faults;
+/// odometry unchanged for [`SpotConfig::stall_timeout`] while commanded to move ends the run
+/// with [`SpotError::NotMoving`]; a raised interrupt flag ([`SpotClient::set_interrupt`])
+/// with [`SpotError::Interrupted`].
 ///
 /// It is a blocking client with a one-thread tokio runtime of its own: call it from ordinary
 /// threads, not from inside another async runtime (tokio refuses to block there).
@@ -39,6 +67,11 @@ pub struct SpotClient {
     background: Vec<JoinHandle<()>>,
     identity: RobotIdentity,
     last_scan_time: Option<f64>,
+    last_odom_t_body: Option<Pose3>,
+    motion: Option<Motion>,
+    last_command: Option<Instant>,
+    last_health: Option<Instant>,
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl SpotClient {
@@ -71,6 +104,11 @@ impl SpotClient {
             background,
             identity,
             last_scan_time: None,
+            last_odom_t_body: None,
+            motion: None,
+            last_command: None,
+            last_health: None,
+            interrupt: None,
         })
     }
 
@@ -148,6 +186,72 @@ impl SpotClient {
         self.runtime.block_on(self.session.send_stop())
     }
 
+    /// Power, E-stops and faults as the robot state reports them now.
+    ///
+    /// # Errors
+    /// Any call's error.
+    pub fn status(&self) -> Result<RobotStatus, SpotError> {
+        self.runtime.block_on(self.session.status())
+    }
+
+    /// Power the motors on (the SDK's `power_on`): `PowerCommand`, then its feedback and the
+    /// robot state polled until the motors are on, within [`SpotConfig::power_timeout`].
+    ///
+    /// # Errors
+    /// [`SpotError::StepFailed`] when the robot refuses (E-stopped, faulted),
+    /// [`SpotError::StepTimedOut`], [`SpotError::EStopped`], [`SpotError::NoEStop`],
+    /// [`SpotError::Faulted`], [`SpotError::LeaseLost`] and any call's error.
+    pub fn power_on(&self) -> Result<(), SpotError> {
+        let timeout = self.session.config.power_timeout;
+        self.runtime.block_on(self.session.power_on(timeout))
+    }
+
+    /// Stand (the SDK's `blocking_stand`): a synchronized stand command, then its feedback
+    /// polled until standing, within [`SpotConfig::posture_timeout`].
+    ///
+    /// # Errors
+    /// [`SpotError::StepFailed`], [`SpotError::StepTimedOut`], [`SpotError::LeaseLost`] and
+    /// any call's error.
+    pub fn stand(&self) -> Result<(), SpotError> {
+        let timeout = self.session.config.posture_timeout;
+        self.runtime
+            .block_on(self.session.blocking_posture(Posture::Stand, timeout))
+    }
+
+    /// Sit (the SDK's `blocking_sit`), within [`SpotConfig::posture_timeout`].
+    ///
+    /// # Errors
+    /// As [`SpotClient::stand`].
+    pub fn sit(&self) -> Result<(), SpotError> {
+        let timeout = self.session.config.posture_timeout;
+        self.runtime
+            .block_on(self.session.blocking_posture(Posture::Sit, timeout))
+    }
+
+    /// Power the motors off safely (the SDK's `safe_power_off_motors`: the robot sits first),
+    /// waiting for the robot state to say they are off, within [`SpotConfig::power_timeout`].
+    ///
+    /// # Errors
+    /// [`SpotError::StepFailed`], [`SpotError::StepTimedOut`], [`SpotError::CommandRefused`],
+    /// [`SpotError::LeaseLost`] and any call's error.
+    pub fn power_off(&self) -> Result<(), SpotError> {
+        let timeout = self.session.config.power_timeout;
+        self.runtime.block_on(self.session.safe_power_off(timeout))
+    }
+
+    /// A flag that, once raised (by a Ctrl-C handler), makes the next sample or command fail
+    /// with [`SpotError::Interrupted`].
+    pub fn set_interrupt(&mut self, flag: Arc<AtomicBool>) {
+        self.interrupt = Some(flag);
+    }
+
+    fn check_interrupt(&self) -> Result<(), SpotError> {
+        match &self.interrupt {
+            Some(flag) if flag.load(Ordering::Relaxed) => Err(SpotError::Interrupted),
+            _ => Ok(()),
+        }
+    }
+
     /// Renew the auth token now (the background does it on its interval).
     ///
     /// # Errors
@@ -168,8 +272,78 @@ impl SpotClient {
             .clone()
     }
 
+    /// E-stops and faults, every [`SpotConfig::health_interval`].
+    fn check_health(&mut self) -> Result<(), SpotError> {
+        if self
+            .last_health
+            .is_none_or(|t| t.elapsed() >= self.session.config.health_interval)
+        {
+            self.status()?.check_ready()?;
+            self.last_health = Some(Instant::now());
+        }
+        Ok(())
+    }
+
+    /// [`SpotError::NotMoving`] when the odometry has not changed for the stall timeout while
+    /// the robot was commanded to move.
+    fn check_motion(&mut self, odom_t_body: Pose3) -> Result<(), SpotError> {
+        self.last_odom_t_body = Some(odom_t_body);
+        let Some(motion) = &mut self.motion else {
+            return Ok(());
+        };
+        let step = motion.odom_t_body.inverse() * odom_t_body;
+        if step.translation.vector.norm() > MOTION_TRANSLATION
+            || step.rotation.angle() > MOTION_ROTATION
+        {
+            *motion = Motion {
+                since: Instant::now(),
+                odom_t_body,
+            };
+            return Ok(());
+        }
+        let still = motion.since.elapsed();
+        if still > self.session.config.stall_timeout {
+            return Err(SpotError::NotMoving {
+                seconds: still.as_secs_f64(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Note whether `command` asks the robot to move (starting the stall clock).
+    fn note_motion(&mut self, command: &MobilityCommand) {
+        let moving = match command {
+            MobilityCommand::Velocity(v) => {
+                v.forward.abs().max(v.lateral.abs()).max(v.yaw_rate.abs()) > MOVING_SPEED
+            }
+            MobilityCommand::Trajectory(_) => true,
+        };
+        self.motion = match (moving, self.motion, self.last_odom_t_body) {
+            (true, Some(motion), _) => Some(motion),
+            (true, None, Some(odom_t_body)) => Some(Motion {
+                since: Instant::now(),
+                odom_t_body,
+            }),
+            _ => None,
+        };
+    }
+
+    /// Wait for the next slot of the fixed command rate.
+    fn pace(&mut self) {
+        if let Some(last) = self.last_command {
+            let next = last + self.session.config.command_period;
+            let now = Instant::now();
+            if next > now {
+                std::thread::sleep(next - now);
+            }
+        }
+        self.last_command = Some(Instant::now());
+    }
+
     /// A scan newer than the last one delivered, as a [`Sample`].
     fn next_scan(&mut self) -> Result<Sample, SpotError> {
+        self.check_interrupt()?;
+        self.check_health()?;
         let deadline = Instant::now() + self.session.config.call_timeout;
         let scan = loop {
             let scan = self.point_cloud()?;
@@ -185,11 +359,13 @@ impl SpotClient {
                     seconds: self.session.config.call_timeout.as_secs_f64(),
                 });
             }
+            self.check_interrupt()?;
             std::thread::sleep(SCAN_POLL);
         };
         self.last_scan_time = Some(scan.acquisition_time);
         let odom_t_body = scan.frames.a_t_b("odom", "body")?;
         let body_t_lidar = scan.frames.a_t_b("body", &scan.frame_name)?;
+        self.check_motion(odom_t_body)?;
         Ok(Sample {
             stamp: scan.acquisition_time,
             odom_t_body,
@@ -223,10 +399,15 @@ impl Robot for SpotClient {
     }
 
     fn send(&mut self, command: &MobilityCommand) -> Result<(), SpotError> {
-        self.command(command).map(|_| ())
+        self.check_interrupt()?;
+        self.pace();
+        self.command(command)?;
+        self.note_motion(command);
+        Ok(())
     }
 
     fn stop(&mut self) -> Result<(), SpotError> {
+        self.motion = None;
         self.stand_still().map(|_| ())
     }
 }
@@ -236,8 +417,12 @@ impl Drop for SpotClient {
         for task in &self.background {
             task.abort();
         }
-        // Best effort: a robot that cannot be reached takes the lease back when retains stop.
-        let _ = self.runtime.block_on(self.session.return_lease());
+        // Best effort: a robot that cannot be reached stops when the last velocity command
+        // ends and takes the lease back when retains stop.
+        let _ = self.runtime.block_on(async {
+            let _ = self.session.send_stop().await;
+            self.session.return_lease().await
+        });
     }
 }
 

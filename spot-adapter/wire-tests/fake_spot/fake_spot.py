@@ -6,6 +6,15 @@ the official generated classes and logged as one JSON line (method, :authority, 
 the request as a dict). The robot's clock runs `--clock-offset` seconds ahead of the host's, the
 body moves by the velocity commands it takes, and control lines on stdin inject faults.
 
+Power and posture: the motors start on and standing (`--motors off`: off and sitting); a
+PowerCommand powers them on in POWER_ON_SECONDS, a stand or sit takes POSTURE_SECONDS, a safe power
+off sits and cuts power at once; motion with the motors off is refused STATUS_NOT_POWERED_ON.
+The robot state lists one hardware E-stop, released (`--estop asserted`, or `--estop none`: no
+endpoint), and the faults `--behavior-fault` (CAUSE_FALL, clearable) and `--system-fault NAME`
+ask for. `--frozen` takes every command and never moves; `--refuse-motion` refuses every
+velocity and trajectory command (STATUS_BEHAVIOR_FAULT); `--stale-cloud` serves the same scan
+(one acquisition time) again and again.
+
 Start-up prints one line `READY <port>` on stdout once the server listens; `<dir>/ca.pem` then
 holds the CA. Control lines (answered `OK <line>`): take-lease, stall-time-sync, malformed-cloud,
 drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
@@ -31,7 +40,7 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 from google.protobuf import json_format
 
-from bosdyn.api import (auth_pb2, auth_service_pb2_grpc, directory_pb2, directory_service_pb2_grpc,
+from bosdyn.api import (basic_command_pb2, power_pb2, power_service_pb2_grpc, auth_pb2, auth_service_pb2_grpc, directory_pb2, directory_service_pb2_grpc,
                         geometry_pb2, lease_pb2, lease_service_pb2_grpc, local_grid_pb2,
                         local_grid_service_pb2_grpc, point_cloud_pb2, point_cloud_service_pb2_grpc,
                         robot_command_pb2, robot_command_service_pb2_grpc, robot_id_pb2,
@@ -49,6 +58,7 @@ SERVICES = {
     "lease": ("bosdyn.api.LeaseService", "lease.spot.robot"),
     "robot-state": ("bosdyn.api.RobotStateService", "robot-state.spot.robot"),
     "robot-command": ("bosdyn.api.RobotCommandService", "command.spot.robot"),
+    "power": ("bosdyn.api.PowerService", "power.spot.robot"),
     "velodyne-point-cloud": ("bosdyn.api.PointCloudService", "velodyne.spot.robot"),
     "local-grid-service": ("bosdyn.api.LocalGridService", "local-grid.spot.robot"),
 }
@@ -127,6 +137,11 @@ class Robot:
         self.bridge_scan = None  # (data bytes, acquisition robot time, odom_T_body, body_T_lidar)
         self.command_arrived = threading.Condition(self.lock)
         self.last_command = None  # (kind, vx, vy, wz) of the latest accepted command
+        self.motors_on = args.motors == "on"
+        self.powering_on_until = None  # host time the motors will be on
+        self.standing = self.motors_on
+        self.posture_commands = {}  # command id -> (kind, host time it completes)
+        self.started = self.now()
 
     def now(self):
         """Robot clock, seconds."""
@@ -155,12 +170,23 @@ class Robot:
         h.error.code = header_pb2.CommonError.CODE_OK
         return h
 
+    def power(self):
+        """The motors' state, finishing a power-on in progress."""
+        if self.powering_on_until is not None and time.time() >= self.powering_on_until:
+            self.powering_on_until = None
+            self.motors_on = True
+        if self.motors_on:
+            return robot_state_pb2.PowerState.MOTOR_POWER_STATE_ON
+        if self.powering_on_until is not None:
+            return robot_state_pb2.PowerState.MOTOR_POWER_STATE_POWERING_ON
+        return robot_state_pb2.PowerState.MOTOR_POWER_STATE_OFF
+
     def step(self):
         """Integrate the body velocity in force (it ends at its end time)."""
         with self.lock:
             t = time.time()
             dt, self.last_step = t - self.last_step, t
-            if self.now() > self.velocity_end:
+            if self.now() > self.velocity_end or self.args.frozen:
                 self.velocity = (0.0, 0.0, 0.0)
             vx, vy, wz = self.velocity
             x, y, yaw = self.pose
@@ -465,6 +491,22 @@ class RobotStateServicer(robot_state_service_pb2_grpc.RobotStateServiceServicer)
         self.r.record("GetRobotState", context, request)
         self.r.step()
         response = robot_state_pb2.RobotStateResponse()
+        state = response.robot_state
+        state.power_state.motor_power_state = self.r.power()
+        if self.r.args.estop != "none":
+            estop = state.estop_states.add(name="hardware_estop",
+                                           type=robot_state_pb2.EStopState.TYPE_HARDWARE)
+            estop.state = (robot_state_pb2.EStopState.STATE_ESTOPPED
+                           if self.r.args.estop == "asserted"
+                           else robot_state_pb2.EStopState.STATE_NOT_ESTOPPED)
+        if self.r.args.behavior_fault:
+            state.behavior_fault_state.faults.add(
+                behavior_fault_id=7, cause=robot_state_pb2.BehaviorFault.CAUSE_FALL,
+                status=robot_state_pb2.BehaviorFault.STATUS_CLEARABLE)
+        if self.r.args.system_fault:
+            state.system_fault_state.faults.add(
+                name=self.r.args.system_fault, code=42,
+                severity=robot_state_pb2.SystemFault.SEVERITY_CRITICAL)
         kinematic = response.robot_state.kinematic_state
         kinematic.acquisition_timestamp.CopyFrom(self.r.stamp())
         kinematic.transforms_snapshot.CopyFrom(self.r.snapshot())
@@ -502,7 +544,8 @@ class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
             else:
                 points = known_points()
                 data = b"".join(struct.pack("<3f", *p) for p in points)
-                scan_time = math.floor(self.r.now() * 10.0) / 10.0
+                scan_time = math.floor((self.r.started if self.r.args.stale_cloud
+                                        else self.r.now()) * 10.0) / 10.0
                 count = len(points)
             cloud.source.acquisition_time.CopyFrom(self.r.stamp(scan_time))
             cloud.num_points = count + (1 if self.r.malformed_cloud else 0)
@@ -580,6 +623,55 @@ def command_times(command):
     return out
 
 
+POWER_ON_SECONDS = 0.5
+POSTURE_SECONDS = 0.3
+
+
+class Power(power_service_pb2_grpc.PowerServiceServicer):
+    """Motor power on and off; refused while E-stopped."""
+
+    def __init__(self, robot, leases):
+        self.r = robot
+        self.leases = leases
+        self.command_id = 0
+
+    def PowerCommand(self, request, context):
+        received = self.r.now()
+        self.r.record("PowerCommand", context, request)
+        response = power_pb2.PowerCommandResponse()
+        with self.r.lock:
+            response.lease_use_result.CopyFrom(self.leases.check(request.lease))
+            if response.lease_use_result.status != lease_pb2.LeaseUseResult.STATUS_OK:
+                response.status = power_pb2.STATUS_UNKNOWN
+            elif self.r.args.estop == "asserted":
+                response.status = power_pb2.STATUS_ESTOPPED
+            elif request.request == power_pb2.PowerCommandRequest.REQUEST_ON_MOTORS:
+                self.command_id += 1
+                response.power_command_id = self.command_id
+                if self.r.power() == robot_state_pb2.PowerState.MOTOR_POWER_STATE_ON:
+                    response.status = power_pb2.STATUS_SUCCESS
+                else:
+                    self.r.powering_on_until = time.time() + POWER_ON_SECONDS
+                    response.status = power_pb2.STATUS_IN_PROGRESS
+            elif request.request == power_pb2.PowerCommandRequest.REQUEST_OFF_MOTORS:
+                self.r.motors_on = self.r.standing = False
+                response.status = power_pb2.STATUS_SUCCESS
+            else:
+                response.status = power_pb2.INCOMPATIBLE_HARDWARE_ERROR
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
+
+    def PowerCommandFeedback(self, request, context):
+        received = self.r.now()
+        self.r.record("PowerCommandFeedback", context, request)
+        response = power_pb2.PowerCommandFeedbackResponse()
+        with self.r.lock:
+            on = self.r.power() == robot_state_pb2.PowerState.MOTOR_POWER_STATE_ON
+        response.status = power_pb2.STATUS_SUCCESS if on else power_pb2.STATUS_IN_PROGRESS
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
+
+
 class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
     """Checks the lease and the time sync's clock, then walks by velocity commands."""
 
@@ -618,8 +710,22 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
                 with self.r.lock:
                     self.r.velocity = (0.0, 0.0, 0.0)
                 return Status.STATUS_OK
+            if command.full_body_command.HasField("safe_power_off_request"):
+                with self.r.lock:
+                    self.r.velocity = (0.0, 0.0, 0.0)
+                    self.r.motors_on = self.r.standing = False
+                    self.r.powering_on_until = None
+                return Status.STATUS_OK
             return Status.STATUS_UNSUPPORTED
+        with self.r.lock:
+            if self.r.power() != robot_state_pb2.PowerState.MOTOR_POWER_STATE_ON:
+                return Status.STATUS_NOT_POWERED_ON
+            if self.r.args.behavior_fault:
+                return Status.STATUS_BEHAVIOR_FAULT
         mobility = command.synchronized_command.mobility_command
+        if self.r.args.refuse_motion and mobility.WhichOneof("command") in (
+                "se2_velocity_request", "se2_trajectory_request"):
+            return Status.STATUS_BEHAVIOR_FAULT
         if mobility.params.type_url:
             params = spot_command_pb2.MobilityParams()
             if not mobility.params.Unpack(params):
@@ -647,7 +753,39 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
             with self.r.lock:
                 self.r.velocity = (0.0, 0.0, 0.0)
             return Status.STATUS_OK
+        if kind in ("stand_request", "sit_request"):
+            with self.r.lock:
+                self.r.velocity = (0.0, 0.0, 0.0)
+                self.r.posture_commands[self.r.command_id + 1] = (kind,
+                                                                  time.time() + POSTURE_SECONDS)
+            return Status.STATUS_OK
         return Status.STATUS_UNSUPPORTED
+
+    def RobotCommandFeedback(self, request, context):
+        received = self.r.now()
+        self.r.record("RobotCommandFeedback", context, request)
+        response = robot_command_pb2.RobotCommandFeedbackResponse()
+        with self.r.lock:
+            kind, done_at = self.r.posture_commands.get(request.robot_command_id, (None, 0.0))
+            done = time.time() >= done_at
+            if kind == "stand_request" and done:
+                self.r.standing = True
+            elif kind == "sit_request" and done:
+                self.r.standing = False
+        mobility = response.feedback.synchronized_feedback.mobility_command_feedback
+        mobility.status = basic_command_pb2.RobotCommandFeedbackStatus.STATUS_PROCESSING
+        if kind == "stand_request":
+            mobility.stand_feedback.status = (
+                basic_command_pb2.StandCommand.Feedback.STATUS_IS_STANDING if done
+                else basic_command_pb2.StandCommand.Feedback.STATUS_IN_PROGRESS)
+        elif kind == "sit_request":
+            mobility.sit_feedback.status = (
+                basic_command_pb2.SitCommand.Feedback.STATUS_IS_SITTING if done
+                else basic_command_pb2.SitCommand.Feedback.STATUS_IN_PROGRESS)
+        else:
+            mobility.status = basic_command_pb2.RobotCommandFeedbackStatus.STATUS_UNKNOWN
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
 
 
 def main():
@@ -658,6 +796,15 @@ def main():
     parser.add_argument("--token-lifetime", type=float, default=3600.0, help="seconds")
     parser.add_argument("--username", default="user")
     parser.add_argument("--password", default="password")
+    parser.add_argument("--motors", choices=("on", "off"), default="on",
+                        help="motor power at start (on: standing, off: sitting)")
+    parser.add_argument("--estop", choices=("released", "asserted", "none"), default="released",
+                        help="the hardware E-stop's state, or none registered")
+    parser.add_argument("--behavior-fault", action="store_true", help="report a fall fault")
+    parser.add_argument("--system-fault", default="", help="report a system fault of this name")
+    parser.add_argument("--frozen", action="store_true", help="take commands, never move")
+    parser.add_argument("--refuse-motion", action="store_true", help="refuse every motion")
+    parser.add_argument("--stale-cloud", action="store_true", help="one scan, served forever")
     args = parser.parse_args()
     robot = Robot(args)
     key_pem, cert_pem = make_certificates(args.dir)
@@ -675,6 +822,7 @@ def main():
     local_grid_service_pb2_grpc.add_LocalGridServiceServicer_to_server(LocalGrids(robot), server)
     robot_command_service_pb2_grpc.add_RobotCommandServiceServicer_to_server(
         Commands(robot, leases), server)
+    power_service_pb2_grpc.add_PowerServiceServicer_to_server(Power(robot, leases), server)
     port = server.add_secure_port("127.0.0.1:0", grpc.ssl_server_credentials([(key_pem, cert_pem)]))
     server.start()
     print("READY %d" % port, flush=True)

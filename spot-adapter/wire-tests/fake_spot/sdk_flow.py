@@ -2,7 +2,10 @@
 
 Authenticates, syncs time, takes the lease, reads the robot state, the point cloud and both local
 grids, sends a velocity and a trajectory command and a stop, returns the lease, and prints one
-JSON line with what it read. Any SDK exception fails the script (exit status 1).
+JSON line with what it read. With `--power` it instead brings the robot up and down as a user's
+script does: `robot.power_on`, `blocking_stand`, `blocking_sit`, `robot.power_off` (a safe power
+off), then returns the lease; the fake's log then holds the SDK's requests for the tests to compare
+with spot-nav's. Any SDK exception fails the script (exit status 1).
 """
 
 import argparse
@@ -15,7 +18,8 @@ from bosdyn.client.frame_helpers import get_a_tform_b
 from bosdyn.client.lease import LeaseClient
 from bosdyn.client.local_grid import LocalGridClient
 from bosdyn.client.point_cloud import PointCloudClient
-from bosdyn.client.robot_command import RobotCommandBuilder, RobotCommandClient
+from bosdyn.client.robot_command import (RobotCommandBuilder, RobotCommandClient, blocking_sit,
+                                         blocking_stand)
 from bosdyn.client.robot_state import RobotStateClient
 
 
@@ -25,6 +29,7 @@ def main():
     parser.add_argument("--ca", required=True)
     parser.add_argument("--username", default="user")
     parser.add_argument("--password", default="password")
+    parser.add_argument("--power", action="store_true", help="power on, stand, sit, power off")
     args = parser.parse_args()
 
     sdk = bosdyn.client.create_standard_sdk("spot-nav-sdk-check")
@@ -37,6 +42,9 @@ def main():
     skew = robot.time_sync.get_robot_clock_skew()
     lease_client = robot.ensure_client(LeaseClient.default_service_name)
     lease = lease_client.acquire()
+    if args.power:
+        power_flow(robot, lease_client, lease)
+        return
     state = robot.ensure_client(RobotStateClient.default_service_name).get_robot_state(timeout=10)
     snapshot = state.kinematic_state.transforms_snapshot
     odom_t_body = get_a_tform_b(snapshot, "odom", "body")
@@ -61,6 +69,18 @@ def main():
         "num_points": clouds[0].point_cloud.num_points,
         "grids": [g.local_grid.local_grid_type_name for g in grids],
     }), flush=True)
+
+
+def power_flow(robot, lease_client, lease):
+    """Power on, stand, sit, power off, as the SDK's helpers do it, and return the lease."""
+    robot.lease_wallet.add(lease)
+    robot.power_on(timeout_sec=20)
+    commands = robot.ensure_client(RobotCommandClient.default_service_name)
+    blocking_stand(commands, timeout_sec=10)
+    blocking_sit(commands, timeout_sec=10)
+    robot.power_off(timeout_sec=20)
+    lease_client.return_lease(lease)
+    print(json.dumps({"powered": "on and off"}), flush=True)
 
 
 if __name__ == "__main__":

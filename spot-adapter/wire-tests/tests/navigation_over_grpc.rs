@@ -312,7 +312,8 @@ fn faults_mid_walk_stop_the_drive_and_no_motion_follows_them() {
             );
         }
         if stop_sent {
-            assert_eq!(stops, 1, "{fault}: the drive's stop reached the robot");
+            // The drive's stop must reach the robot, and the client's own when dropped may.
+            assert!((1..=2).contains(&stops), "{fault}: {stops} stops");
             assert_eq!(
                 after.last().unwrap()["decoded"]["kind"],
                 "full_body_command",

@@ -21,8 +21,15 @@ use spot_adapter::grpc::{Credentials, SpotConfig};
 pub const USERNAME: &str = "operator";
 pub const PASSWORD: &str = "correct-horse-battery-staple";
 
+/// `fake_spot/` of the wire tests, also when this module is included by another package's
+/// tests (the examples').
 fn fake_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("fake_spot")
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("fake_spot");
+    if here.is_dir() {
+        here
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../spot-adapter/wire-tests/fake_spot")
+    }
 }
 
 /// The venv's python, made on first use; `None` when the user opted out.
@@ -88,7 +95,7 @@ fn make_venv() -> Result<Option<PathBuf>, String> {
 
 /// A running fake Spot; killed on drop.
 pub struct FakeSpot {
-    child: Child,
+    pub child: Child,
     stdin: ChildStdin,
     lines: Receiver<String>,
     pub port: u16,
@@ -210,6 +217,25 @@ impl Drop for FakeSpot {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Run the official SDK's `fake_spot/sdk_flow.py` against `fake` with `extra` arguments; its
+/// stdout, after checking it succeeded.
+pub fn run_sdk_flow(fake: &FakeSpot, extra: &[&str]) -> Vec<u8> {
+    let output = Command::new(python().unwrap())
+        .arg(fake_dir().join("sdk_flow.py"))
+        .args(["--port", &fake.port.to_string(), "--ca"])
+        .arg(fake.dir.join("ca.pem"))
+        .args(["--username", USERNAME, "--password", PASSWORD])
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output.stdout
 }
 
 /// Skip the rest of a test when the user opted out (the skip is printed by `python()`).

@@ -263,25 +263,7 @@ fn a_connection_dropped_mid_walk_is_an_error_on_the_next_call() {
 #[test]
 fn the_official_sdk_runs_the_same_flow_against_the_fake() {
     let fake = fake_spot!("sdk", &["--clock-offset", "7.0"]);
-    let python = support::python().unwrap();
-    let output = std::process::Command::new(python)
-        .arg(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fake_spot/sdk_flow.py"))
-        .args(["--port", &fake.port.to_string(), "--ca"])
-        .arg(fake.dir.join("ca.pem"))
-        .args([
-            "--username",
-            support::USERNAME,
-            "--password",
-            support::PASSWORD,
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
+    let report: Value = serde_json::from_slice(&support::run_sdk_flow(&fake, &[])).unwrap();
     assert_eq!(report["serial"], "fake-0001");
     assert!((f(&report["clock_skew"]) - 7.0).abs() < 0.05, "{report}");
     assert_eq!(report["num_points"], 120);
