@@ -44,6 +44,10 @@ pub mod tracking;
 pub mod traits;
 mod voxel;
 
+/// The linear algebra of every signature here (points, vectors, isometries), re-exported so
+/// that users build against the same version: `slam_core::nalgebra::Point3`.
+pub use nalgebra;
+
 pub use cloud::{Aabb, PointCloud};
 pub use error::{
     BackendError, CloudError, Degeneracy, FactorizationFailure, FormatError, GraphValue, GridError,

@@ -17,6 +17,10 @@
 //! - [`nav`]: the [`Navigator`](nav::Navigator) (localise, plan, command) and
 //!   [`drive`](nav::drive), which runs it on any `Robot`.
 //! - [`pipelines`]: the Graph-SLAM engine put together with this workspace's backends.
+//! - [`prelude`]: the types a robot program needs, in one import
+//!   (`use spot_adapter::prelude::*;`); the backend crates and nalgebra are re-exported whole
+//!   at the root ([`slam_core`], [`registration`], [`posegraph`], [`gridmap`], [`pathfind`],
+//!   [`nalgebra`]), so one dependency on spot-adapter is enough.
 //!
 //! `robot`, `record` and `eval` need `slam-core` only; `nav` adds `gridmap` and `pathfind`;
 //! only `sim` uses random numbers. Build with `--no-default-features` to leave the simulator
@@ -53,10 +57,19 @@ pub mod eval;
 pub mod grpc;
 pub mod nav;
 pub mod pipelines;
+pub mod prelude;
 pub mod record;
 pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
+
+// The backend crates and nalgebra, whole: one dependency on spot-adapter pins them all.
+pub use gridmap;
+pub use pathfind;
+pub use posegraph;
+pub use registration;
+pub use slam_core;
+pub use slam_core::nalgebra;
 
 pub use error::AdapterError;
 pub use nav::DriveError;
