@@ -10,7 +10,7 @@
 //!   building with obstacles that can be added later, a VLP-16 model, drifting leg odometry,
 //!   routes, [`SimulatedSpot`](sim::SimulatedSpot) (walks a route) and
 //!   [`CommandedSpot`](sim::CommandedSpot) (a `Robot` driven by commands).
-//! - [`record`]: recordings in, streamed one scan at a time: ROS 1 and ROS 2 (MCAP) bags,
+//! - [`record`] (cargo feature `record`, on by default): recordings in, streamed one scan at a time: ROS 1 and ROS 2 (MCAP) bags,
 //!   KITTI sequences, folders of PCD/PLY scans and the spot-nav recording format, each opened
 //!   from its path by [`open_recording`](record::open_recording).
 //! - [`eval`]: accuracy against ground truth: ATE, drift, loop end-point error.
@@ -23,8 +23,9 @@
 //!   [`nalgebra`]), so one dependency on spot-adapter is enough.
 //!
 //! `robot`, `record` and `eval` need `slam-core` only; `nav` adds `gridmap` and `pathfind`;
-//! only `sim` uses random numbers. Build with `--no-default-features` to leave the simulator
-//! out.
+//! only `sim` uses random numbers and only `record` reads bags (mcap, rosbag, and the C
+//! libraries of their compressions). Build with `default-features = false` for a robot: no
+//! simulator, no recordings (`sim` needs `record`, which writes its runs).
 //!
 //! ```
 //! use slam_core::io::StampedPose;
@@ -58,6 +59,7 @@ pub mod grpc;
 pub mod nav;
 pub mod pipelines;
 pub mod prelude;
+#[cfg(feature = "record")]
 pub mod record;
 pub mod robot;
 #[cfg(feature = "sim")]
@@ -73,4 +75,5 @@ pub use slam_core::nalgebra;
 
 pub use error::AdapterError;
 pub use nav::DriveError;
+#[cfg(feature = "record")]
 pub use record::MessageError;

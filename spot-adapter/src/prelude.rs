@@ -7,7 +7,7 @@
 //! ([`Navigator`], [`NavigatorConfig`], [`NavPlanner`], [`drive`]), the robot interface
 //! ([`Robot`], [`Sample`]), poses and clouds ([`Pose3`], [`PointCloud`]) and the nalgebra
 //! types that appear in their signatures. With the `sim` feature, the simulated Spots; with
-//! `record`, [`open_recording`](crate::record::open_recording).
+//! `record`, `open_recording`.
 //!
 //! Everything else stays in its crate, re-exported whole at the root of this one
 //! ([`slam_core`], [`registration`], [`posegraph`], [`gridmap`], [`pathfind`], [`nalgebra`]),
@@ -84,6 +84,8 @@ pub use crate::pipelines::{
     LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_localiser, point_to_plane_slam,
     point_to_plane_tracker, slam_config,
 };
+#[cfg(feature = "record")]
+pub use crate::record::{OpenedSource, SourceConfig, open_recording};
 pub use crate::robot::{MotionLimits, Robot, RobotDescription, Sample, VelocityCommand};
 #[cfg(feature = "sim")]
 pub use crate::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
