@@ -40,6 +40,7 @@ pub mod io;
 pub mod pose_graph;
 pub mod robust_kernel;
 pub mod slam;
+mod test_data;
 pub mod tracking;
 pub mod traits;
 mod voxel;
