@@ -122,8 +122,10 @@ fn main() {
             continue;
         };
         for setup in &setups {
-            let mut config = SimulationConfig::default();
-            config.seed = seed_n;
+            let config = SimulationConfig {
+                seed: seed_n,
+                ..SimulationConfig::default()
+            };
             let simulate = || SimulatedSpot::corridor_loop(&config);
             let sim = match simulate() {
                 Ok(sim) => sim,

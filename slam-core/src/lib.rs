@@ -40,9 +40,14 @@ pub mod io;
 pub mod pose_graph;
 pub mod robust_kernel;
 pub mod slam;
+mod test_data;
 pub mod tracking;
 pub mod traits;
 mod voxel;
+
+/// The linear algebra of every signature here (points, vectors, isometries), re-exported so
+/// that users build against the same version: `slam_core::nalgebra::Point3`.
+pub use nalgebra;
 
 pub use cloud::{Aabb, PointCloud};
 pub use error::{

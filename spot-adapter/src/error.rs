@@ -6,6 +6,7 @@ use thiserror::Error;
 
 use crate::eval::EvalError;
 use crate::nav::NavError;
+#[cfg(feature = "record")]
 use crate::record::RecordError;
 use crate::robot::RobotError;
 #[cfg(feature = "sim")]
@@ -26,6 +27,7 @@ pub enum AdapterError {
     #[error(transparent)]
     Sim(#[from] SimError),
     /// From a recording's reader or writer.
+    #[cfg(feature = "record")]
     #[error(transparent)]
     Record(#[from] RecordError),
     /// From the evaluation against ground truth.

@@ -10,17 +10,22 @@
 //!   building with obstacles that can be added later, a VLP-16 model, drifting leg odometry,
 //!   routes, [`SimulatedSpot`](sim::SimulatedSpot) (walks a route) and
 //!   [`CommandedSpot`](sim::CommandedSpot) (a `Robot` driven by commands).
-//! - [`record`]: recordings in, streamed one scan at a time: ROS 1 and ROS 2 (MCAP) bags,
+//! - [`record`] (cargo feature `record`, on by default): recordings in, streamed one scan at a time: ROS 1 and ROS 2 (MCAP) bags,
 //!   KITTI sequences, folders of PCD/PLY scans and the spot-nav recording format, each opened
 //!   from its path by [`open_recording`](record::open_recording).
 //! - [`eval`]: accuracy against ground truth: ATE, drift, loop end-point error.
 //! - [`nav`]: the [`Navigator`](nav::Navigator) (localise, plan, command) and
 //!   [`drive`](nav::drive), which runs it on any `Robot`.
 //! - [`pipelines`]: the Graph-SLAM engine put together with this workspace's backends.
+//! - [`prelude`]: the types a robot program needs, in one import
+//!   (`use spot_adapter::prelude::*;`); the backend crates and nalgebra are re-exported whole
+//!   at the root ([`slam_core`], [`registration`], [`posegraph`], [`gridmap`], [`pathfind`],
+//!   [`nalgebra`]), so one dependency on spot-adapter is enough.
 //!
 //! `robot`, `record` and `eval` need `slam-core` only; `nav` adds `gridmap` and `pathfind`;
-//! only `sim` uses random numbers. Build with `--no-default-features` to leave the simulator
-//! out.
+//! only `sim` uses random numbers and only `record` reads bags (mcap, rosbag, and the C
+//! libraries of their compressions). Build with `default-features = false` for a robot: no
+//! simulator, no recordings (`sim` needs `record`, which writes its runs).
 //!
 //! ```
 //! use slam_core::io::StampedPose;
@@ -53,11 +58,22 @@ pub mod eval;
 pub mod grpc;
 pub mod nav;
 pub mod pipelines;
+pub mod prelude;
+#[cfg(feature = "record")]
 pub mod record;
 pub mod robot;
 #[cfg(feature = "sim")]
 pub mod sim;
 
+// The backend crates and nalgebra, whole: one dependency on spot-adapter pins them all.
+pub use gridmap;
+pub use pathfind;
+pub use posegraph;
+pub use registration;
+pub use slam_core;
+pub use slam_core::nalgebra;
+
 pub use error::AdapterError;
 pub use nav::DriveError;
+#[cfg(feature = "record")]
 pub use record::MessageError;

@@ -54,16 +54,25 @@ fn all_planners(map: &str, with_slow: bool) {
 
 #[test]
 fn arena_game_map() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     all_planners("arena", true);
 }
 
 #[test]
 fn ht_chantry_game_map() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     all_planners("ht_chantry", true);
 }
 
 #[test]
 fn room_map() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     all_planners("8room_000", false);
     // A* on every room scenario too (Dijkstra on 512 x 512 maps is left to the example).
     let m = read_map(data("8room_000.map")).unwrap();
@@ -72,11 +81,17 @@ fn room_map() {
 
 #[test]
 fn maze_map() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     all_planners("maze512-32-0", false);
 }
 
 #[test]
 fn random_map() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     all_planners("random512-10-0", false);
     let m = read_map(data("random512-10-0.map")).unwrap();
     run("A*", &mut AStar::new(&m.grid), &m.grid, "random512-10-0");
@@ -117,6 +132,9 @@ fn readers_reject_malformed_files() {
 /// The writers read back to the same map and queries (a real map and its scenarios).
 #[test]
 fn written_maps_and_scenarios_read_back() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let map = read_map(data("arena.map")).unwrap();
     let back = parse_map(&pathfind::movingai::map_text(&map)).unwrap();
     assert_eq!((back.grid, back.terrain), (map.grid, map.terrain));

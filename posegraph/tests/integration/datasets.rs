@@ -72,6 +72,9 @@ fn assert_rel(got: f64, want: f64, tol: f64, what: &str) {
 
 #[test]
 fn tiny_grid_3d() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let g = read_g2o(data("tinyGrid3D.g2o")).unwrap();
     let (lm, gn, _) = solve(&g, true);
     assert_rel(lm, 18.6278, 1e-4, "LM");
@@ -80,6 +83,9 @@ fn tiny_grid_3d() {
 
 #[test]
 fn small_grid_3d() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let g = read_g2o(data("smallGrid3D.g2o")).unwrap();
     let (lm, gn, _) = solve(&g, true);
     assert_rel(lm, 1035.85, 1e-4, "LM");
@@ -88,6 +94,9 @@ fn small_grid_3d() {
 
 #[test]
 fn manhattan_m3500_2d() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let g = read_g2o(data("input_M3500_g2o.g2o")).unwrap();
     let (lm, gn, g2o) = solve(&g, true);
     assert_rel(lm, 137.915, 1e-4, "LM");
@@ -175,6 +184,9 @@ fn malformed_files_and_bad_graphs_are_errors() {
 
 #[test]
 fn g2o_round_trip_is_exact() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let text = std::fs::read_to_string(data("tinyGrid3D.g2o")).unwrap();
     let G2oGraph::Se3(g) = parse_g2o(&text).unwrap() else {
         panic!("3D file")
@@ -282,6 +294,9 @@ fn toro_information_order() {
 /// README): tinyGrid3D 6.72788, smallGrid3D 458.154, `input_M3500_g2o` 137.913.
 #[test]
 fn g2o_error_model_reaches_g2o_optimum() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let config = SolverConfig {
         error_model: ErrorModel::G2o,
         ..SolverConfig::default()

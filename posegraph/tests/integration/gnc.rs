@@ -6,7 +6,7 @@
 //!
 //! The bundled M3500 and a synthetic ring run in the normal suite; `ring.g2o` (issue 17's
 //! Geman-McClure case and the wrong loops) and sphere2500 (shared data) with
-//! `cargo test -p posegraph --release --test integration gnc:: -- --ignored`.
+//! `cargo test -p spot-nav-posegraph --release --test integration gnc:: -- --ignored`.
 #![allow(clippy::unwrap_used, clippy::panic)]
 
 use std::path::PathBuf;
@@ -156,6 +156,9 @@ fn synthetic_ring_with_2_to_45_wrong_loops() {
 
 #[test]
 fn bundled_m3500_with_5_percent_wrong_loops() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let G2oGraph::Se2(mut clean) = read_g2o(bundled("input_M3500_g2o.g2o")).unwrap() else {
         panic!("M3500 is 2D")
     };
@@ -171,6 +174,9 @@ fn bundled_m3500_with_5_percent_wrong_loops() {
 
 #[test]
 fn clean_graphs_reach_the_lm_optimum() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     // smallGrid3D's noise is at its information's scale: 3 of its 297 edges are beyond the 0.99
     // chi-square quantile at the optimum and TLS rejects them (cost 1044.12 against 1035.85);
     // with the 0.9999 quantile it keeps them all.

@@ -48,6 +48,9 @@ fn with_indefinite_edges() -> (String, usize) {
 
 #[test]
 fn indefinite_information_is_refused_by_default_and_repaired_on_request() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let (text, bad) = with_indefinite_edges();
     assert!(bad > 90, "{bad} indefinite edges");
     let refused = parse_g2o(&text).unwrap_err();

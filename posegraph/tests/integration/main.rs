@@ -1,5 +1,5 @@
 //! posegraph's integration tests in one binary: one link instead of one per file, and one
-//! harness that runs every test across the cores (`cargo test -p posegraph --release --test
+//! harness that runs every test across the cores (`cargo test -p spot-nav-posegraph --release --test
 //! integration [MODULE::]NAME`).
 
 mod common;

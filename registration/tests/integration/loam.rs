@@ -36,6 +36,9 @@ fn run(r: &LoamRegistrator, source: &PointCloud, target: &PointCloud, initial: &
 
 #[test]
 fn features_of_a_real_scan() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let f = LoamFeatures::extract(&target_scan(), &hdl32e().config.features).unwrap();
     // 32 rings x 6 sectors x (20 + 40) is the cap.
     assert!(
@@ -60,6 +63,9 @@ fn features_of_a_real_scan() {
 
 #[test]
 fn random_halves_of_a_real_scan() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let (source, target, truth) = random_halves();
     let (rot, trans) = error(
         &truth,
@@ -71,6 +77,9 @@ fn random_halves_of_a_real_scan() {
 
 #[test]
 fn hdl32e_pair_matches_the_reference() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let source = read_ply(here("tests/data/source.ply")).unwrap();
     let target = target_scan();
     let reference = reference();
@@ -84,6 +93,9 @@ fn hdl32e_pair_matches_the_reference() {
 
 #[test]
 fn os1_128_steps_match_the_reference_poses() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let (frames, poses) = os1_128();
     let loam = LoamRegistrator::default();
     for k in 0..2 {
@@ -128,6 +140,9 @@ fn static_garage_sequence_does_not_drift() {
 
 #[test]
 fn degenerate_input_is_an_error_or_flagged() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let loam = LoamRegistrator::default();
     crate::common::rejects_empty_and_nan(&loam);
     let mut bad = loam;

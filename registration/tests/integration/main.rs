@@ -1,5 +1,5 @@
 //! registration's integration tests in one binary: one link instead of one per file, and one
-//! harness that runs every test across the cores (`cargo test -p registration --release --test
+//! harness that runs every test across the cores (`cargo test -p spot-nav-registration --release --test
 //! integration [MODULE::]NAME`).
 
 mod common;

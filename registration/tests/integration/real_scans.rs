@@ -27,6 +27,9 @@ fn run<R: Registrator>(r: &R, source: &PointCloud, target: &PointCloud, initial:
 /// known transform, and recover it.
 #[test]
 fn random_halves_of_a_real_scan() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let (source, target, truth) = random_halves();
     let fine = IcpConfig {
         source_voxel: 0.1,
@@ -55,6 +58,9 @@ fn random_halves_of_a_real_scan() {
 /// 0.13-0.14 degrees off here, pulled onto the other half's sampling lattice.
 #[test]
 fn random_halves_point_to_point() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let dense = IcpConfig {
         source_voxel: 0.0,
         target_voxel: 0.0,
@@ -96,6 +102,9 @@ fn random_halves_point_to_point() {
 /// degrees off the reference.
 #[test]
 fn hdl32e_pair_matches_the_reference() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let source = read_ply(here("tests/data/source.ply")).unwrap();
     let target = target_scan();
     let reference = reference();
@@ -137,6 +146,9 @@ fn hdl32e_pair_matches_the_reference() {
 /// backends end where they end without it, from identity and from 1 m and 10 degrees off.
 #[test]
 fn coarse_stage_ends_at_the_same_pose() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let source = read_ply(here("tests/data/source.ply")).unwrap();
     let target = target_scan();
     let off = reference() * pose3_from_xyz_rpy(0.8, -0.6, 0.0, 0.0, 0.0, 10f64.to_radians());
@@ -237,6 +249,9 @@ fn bad_settings(good: IcpConfig) -> Vec<(&'static str, IcpConfig)> {
 /// Every bad setting is refused by preparation and by alignment, never silently changed.
 #[test]
 fn invalid_settings_are_errors() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let cloud = target_scan();
     let good = IcpConfig::default();
     let p2p = PointToPointIcp { config: good };
@@ -317,6 +332,9 @@ fn degenerate_input_is_an_error_or_flagged() {
 /// (point-to-plane 2.9 s). Coincident and collinear targets are now refused when prepared.
 #[test]
 fn coincident_or_collinear_targets_are_refused() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let scan = target_scan();
     let p = scan.points()[0];
     let same = PointCloud::from_points(vec![p; 5000]);
@@ -355,6 +373,9 @@ fn coincident_or_collinear_targets_are_refused() {
 /// with them to 0.7-3.8 cm).
 #[test]
 fn os1_128_steps_match_the_reference_poses() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let (frames, poses) = crate::common::os1_128();
     let icp = PointToPlaneIcp::default();
     for k in 0..2 {
@@ -373,6 +394,9 @@ fn os1_128_steps_match_the_reference_poses() {
 /// 0.23 from `fast_gicp`'s, where every normal kept ends 0.17 and 0.28 degrees from them).
 #[test]
 fn plane_like_normals_hold_on_real_scans() {
+    if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
+        return;
+    }
     let plane_like = |config: IcpConfig| PointToPlaneIcp {
         config: IcpConfig {
             min_planarity: 0.2,

@@ -64,7 +64,7 @@ impl Default for TurnPersistence {
 }
 
 impl TurnPersistence {
-    /// The share of the last turn the next prediction repeats (1 until [`WARM_UP`] scans were
+    /// The share of the last turn the next prediction repeats (1 until five scans were
     /// scored).
     #[must_use]
     pub fn share(&self) -> f64 {

@@ -62,6 +62,9 @@ fn assert_same(a: &PointCloud, b: &PointCloud) {
 
 #[test]
 fn garage_pcd_with_padding_fields() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let cloud = read_pcd(data("hdl32e_garage_1503604882.703390000.pcd")).unwrap();
     assert_eq!(cloud.len(), 42_006);
     let ring = cloud.ring().unwrap();
@@ -89,6 +92,9 @@ fn garage_pcd_with_padding_fields() {
 
 #[test]
 fn ouster_pcd_with_time_and_ring() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let cloud = read_pcd(data("os1_128_frame_00_fid1795.pcd")).unwrap();
     assert_eq!(cloud.len(), 107_647);
     let t = cloud.time().unwrap();
@@ -103,6 +109,9 @@ fn ouster_pcd_with_time_and_ring() {
 
 #[test]
 fn small_gicp_ply() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let cloud = read_ply(data("hdl32e_pair_target.ply")).unwrap();
     assert_eq!(cloud.len(), 69_088);
     assert!(cloud.intensity().is_some());
@@ -118,6 +127,9 @@ fn small_gicp_ply() {
 
 #[test]
 fn ouster_kitti_poses() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     let poses = read_kitti_poses(data("os1_128_poses_kitti.txt")).unwrap();
     assert_eq!(poses.len(), 3);
     assert!(poses[0].translation.vector.norm() < 1e-15 && poses[0].rotation.angle() < 1e-15);

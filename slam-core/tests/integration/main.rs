@@ -1,5 +1,5 @@
 //! slam-core's integration tests in one binary: one link instead of one per file, and one
-//! harness that runs every test across the cores (`cargo test -p slam-core --release --test
+//! harness that runs every test across the cores (`cargo test -p spot-nav-slam-core --release --test
 //! integration [MODULE::]NAME`).
 
 mod bounded_memory;

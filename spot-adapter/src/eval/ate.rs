@@ -13,7 +13,6 @@ pub const DEFAULT_MAX_STAMP_DIFFERENCE: f64 = 0.01;
 
 /// Absolute trajectory error statistics (metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct AteReport {
     /// Root mean square of the position errors.
     pub rmse: f64,

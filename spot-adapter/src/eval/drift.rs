@@ -36,7 +36,6 @@ pub(crate) fn check_lengths(estimate: &[Pose3], reference: &[Pose3]) -> Result<(
 
 /// End-point error and relative drift of a whole run.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct EndPointDrift {
     /// Distance between where the estimate and the reference end, each taken relative to its
     /// own first pose (metres).
@@ -85,7 +84,6 @@ pub fn loop_end_point_error(estimate: &[Pose3]) -> f64 {
 
 /// KITTI-style segment drift, averaged over every segment evaluated.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct SegmentDrift {
     /// Mean translation error over segment length (a fraction: 0.01 is 1 %).
     pub translation: f64,

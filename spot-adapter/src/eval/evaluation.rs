@@ -33,7 +33,6 @@ pub fn body_trajectory(
 
 /// Accuracy of an estimated trajectory against the ground truth.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct TrajectoryEvaluation {
     /// Absolute trajectory error after rigid alignment.
     pub ate: AteReport,

@@ -9,7 +9,6 @@ use crate::eval::drift::{KITTI_SEGMENT_LENGTHS, check_lengths, kitti_segment_dri
 
 /// KITTI's relative pose error: the devkit's mean translation error over segment length.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct KittiRpe {
     /// Mean translation error over segment length, in percent (KITTI's "translation error";
     /// 1.0 is 1 m per 100 m).

@@ -5,7 +5,6 @@ use slam_core::InvalidSetting;
 
 /// How fast the robot may be commanded to move; commands beyond these are clamped to them.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct MotionLimits {
     /// Largest forward or backward speed, m/s: 1.6 m/s, Spot's top walking speed.
     pub max_forward_speed: f64,
@@ -50,7 +49,6 @@ impl MotionLimits {
 
 /// A robot's description: its body and LiDAR mounting, and its motion limits.
 #[derive(Clone, Debug, Default, PartialEq)]
-#[non_exhaustive]
 pub struct RobotDescription {
     /// Body size and LiDAR mounting.
     pub geometry: SpotGeometry,

@@ -22,7 +22,7 @@ pub struct Sample {
     /// (`start_R_body`): it drifts, but its change between two samples is the body's rotation
     /// between them. `None` when the source has no IMU, outside the IMU's readings, and for the
     /// first sample after a gap in them (so that two consecutive samples that both have one are
-    /// joined by integrated readings). Bags: see [`GyroIntegrator`](crate::record::GyroIntegrator).
+    /// joined by integrated readings). Bags: see `record::GyroIntegrator` (feature `record`).
     pub gyro_orientation: Option<UnitQuaternion<f64>>,
 }
 

@@ -4,7 +4,6 @@ use crate::sim::SimError;
 
 /// Ranges the generator draws from (metres). Defaults give realistic office scales.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct BuildingConfig {
     /// Corridor width between wall centre lines, e.g. 1.8..2.6 m (1.6..2.4 m free).
     pub corridor_width: (f64, f64),

@@ -22,7 +22,6 @@ const FADE: f64 = 1.0;
 /// the pose it started from. The phases are fixed, so the ground truth does not depend on the
 /// seed.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct HandShake {
     /// Height bob amplitude (metres), 0.02 m.
     pub height: f64,

@@ -47,7 +47,6 @@ impl MotionProfile {
 /// its walking speed and yaw rate are [`SimulationConfig::speed`](crate::sim::SimulationConfig::speed)
 /// and [`MotionLimits::max_yaw_rate`](crate::robot::MotionLimits::max_yaw_rate).
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct FastTurnsConfig {
     /// Speeding up and slowing down along a leg (m/s²), 1.0: 0.6 m/s reached in 0.6 s.
     pub acceleration: f64,
@@ -97,7 +96,6 @@ impl FastTurnsConfig {
 ///
 /// [`SimulationConfig::spot`]: crate::sim::SimulationConfig::spot
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct HandheldConfig {
     /// Walking speed along a leg (m/s), 1.2.
     pub speed: f64,

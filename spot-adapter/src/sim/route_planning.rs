@@ -14,7 +14,6 @@ use crate::sim::route::Route;
 
 /// Settings of [`Route::between`].
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct RouteConfig {
     /// Grid resolution (metres per cell), 0.1 m.
     pub resolution: f64,

@@ -22,7 +22,6 @@ use crate::sim::timed_walk::{TimedWalk, WalkLimits};
 
 /// Settings of a simulated run.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct SimulationConfig {
     /// Seeds the sensor noise and the odometry drift, and the building in
     /// [`SimulatedSpot::corridor_loop`] (a building made with [`Building::generate`] has its

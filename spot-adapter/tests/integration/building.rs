@@ -349,8 +349,10 @@ fn added_boxes_are_seen_and_removed_boxes_are_gone() {
 #[test]
 fn repeated_rooms_look_the_same_one_pitch_apart() {
     for seed in [1, 2, 3] {
-        let mut config = BuildingConfig::default();
-        config.repeated_rooms = true;
+        let config = BuildingConfig {
+            repeated_rooms: true,
+            ..BuildingConfig::default()
+        };
         let b = Building::generate(seed, &config).unwrap();
         let c = b.corridor_loop();
         let south_core: Vec<_> = b
@@ -422,8 +424,10 @@ fn repeated_rooms_look_the_same_one_pitch_apart() {
 #[test]
 fn the_blank_corridor_has_flat_walls_and_changes_nothing_else() {
     for seed in [1, 2, 3] {
-        let mut config = BuildingConfig::default();
-        config.blank_corridor = true;
+        let config = BuildingConfig {
+            blank_corridor: true,
+            ..BuildingConfig::default()
+        };
         let b = Building::generate(seed, &config).unwrap();
         let plain = building(seed);
         let c = *b.corridor_loop();

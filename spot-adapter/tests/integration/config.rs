@@ -26,34 +26,53 @@ fn invalid<T: std::fmt::Debug, E: Into<AdapterError>>(r: Result<T, E>, setting: 
 }
 
 #[test]
-fn bad_settings_are_rejected() {
-    let mut c = BuildingConfig::default();
-    c.corridor_width = (2.0, 1.0);
+fn bad_building_lidar_and_odometry_settings_are_rejected() {
+    let c = BuildingConfig {
+        corridor_width: (2.0, 1.0),
+        ..BuildingConfig::default()
+    };
     assert!(invalid(Building::generate(0, &c), "corridor_width.1"));
-    let mut c = BuildingConfig::default();
-    c.door_height = 5.0;
+    let c = BuildingConfig {
+        door_height: 5.0,
+        ..BuildingConfig::default()
+    };
     assert!(invalid(Building::generate(0, &c), "door_height"));
-    let mut c = BuildingConfig::default();
-    c.wall_thickness = f64::NAN;
+    let c = BuildingConfig {
+        wall_thickness: f64::NAN,
+        ..BuildingConfig::default()
+    };
     assert!(invalid(Building::generate(0, &c), "wall_thickness"));
 
-    let mut l = LidarConfig::default();
-    l.rings = 0;
+    let l = LidarConfig {
+        rings: 0,
+        ..LidarConfig::default()
+    };
     assert!(invalid(SpinningLidar::new(l), "rings"));
-    let mut l = LidarConfig::default();
-    l.dropout_probability = 1.5;
+    let l = LidarConfig {
+        dropout_probability: 1.5,
+        ..LidarConfig::default()
+    };
     assert!(invalid(SpinningLidar::new(l), "dropout_probability"));
-    let mut l = LidarConfig::default();
-    l.max_range = 0.1;
+    let l = LidarConfig {
+        max_range: 0.1,
+        ..LidarConfig::default()
+    };
     assert!(invalid(SpinningLidar::new(l), "max_range"));
 
-    let mut o = OdometryDriftConfig::default();
-    o.drift_rate = -0.01;
+    let o = OdometryDriftConfig {
+        drift_rate: -0.01,
+        ..OdometryDriftConfig::default()
+    };
     assert!(invalid(OdometryModel::new(o, 0), "drift_rate"));
-    let mut o = OdometryDriftConfig::default();
-    o.vertical_fraction = 2.0;
+    let o = OdometryDriftConfig {
+        vertical_fraction: 2.0,
+        ..OdometryDriftConfig::default()
+    };
     assert!(invalid(OdometryModel::new(o, 0), "vertical_fraction"));
+}
 
+#[test]
+fn bad_route_simulation_and_navigator_settings_are_rejected() {
     assert!(invalid(Route::new(vec![Vector2::zeros()], false), "points"));
     assert!(invalid(
         Route::new(vec![Vector2::zeros(); 3], false),
@@ -63,15 +82,21 @@ fn bad_settings_are_rejected() {
     let lap = Route::corridor_loop(&b);
     assert!(invalid(lap.walk(0.0, 5.0, 0.5), "speed"));
     assert!(invalid(lap.walk(0.6, f64::INFINITY, 0.5), "rate"));
-    let mut s = SimulationConfig::default();
-    s.speed = -1.0;
+    let s = SimulationConfig {
+        speed: -1.0,
+        ..SimulationConfig::default()
+    };
     assert!(invalid(SimulatedSpot::new(b.clone(), &lap, &s), "speed"));
-    let mut r = RouteConfig::default();
-    r.clearance = -1.0;
+    let r = RouteConfig {
+        clearance: -1.0,
+        ..RouteConfig::default()
+    };
     let p = b.rooms()[0].entry_point();
     assert!(invalid(Route::between(&b, p, p, &r), "clearance"));
-    let mut r = RouteConfig::default();
-    r.resolution = 0.0;
+    let r = RouteConfig {
+        resolution: 0.0,
+        ..RouteConfig::default()
+    };
     assert!(matches!(
         Route::between(&b, p, p, &r),
         Err(SimError::Grid(_))
@@ -285,8 +310,10 @@ fn bad_motion_settings_are_rejected() {
     // Zero means something for these: stop to turn on the spot, a steady hand.
     let mut still = HandheldConfig::default();
     (still.corner_speed, still.shake) = (0.0, HandShake::none());
-    let mut c = SimulationConfig::default();
-    c.motion = MotionProfile::Handheld(still);
+    let c = SimulationConfig {
+        motion: MotionProfile::Handheld(still),
+        ..SimulationConfig::default()
+    };
     assert!(simulate(&c).is_ok());
 }
 
@@ -319,8 +346,10 @@ fn bad_walking_scan_settings_are_rejected() {
 
 #[test]
 fn the_error_message_names_the_setting_and_its_value() {
-    let mut l = LidarConfig::default();
-    l.range_noise = -0.5;
+    let l = LidarConfig {
+        range_noise: -0.5,
+        ..LidarConfig::default()
+    };
     let message = SpinningLidar::new(l).unwrap_err().to_string();
     assert!(
         message.contains("range_noise") && message.contains("-0.5"),

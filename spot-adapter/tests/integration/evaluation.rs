@@ -267,6 +267,9 @@ fn close(a: f64, b: f64, tolerance: f64, what: &str) {
 // The golden figures are written as the tools printed them, to be found in the README.
 #[allow(clippy::unreadable_literal)]
 fn evo_golden_figures() {
+    if slam_core::skip_without_test_data!("tests/data") {
+        return;
+    }
     // Golden answers: evo 1.38.1's `evo_ape tum ground_truth.tum estimate.tum -a` and `evo_rpe
     // ... -r angle_deg --delta 1 --delta_unit f` to full precision (evo_figures.py), and the
     // KITTI devkit's translation error through KISS-ICP 1.3.0's port (kitti_figures.py);

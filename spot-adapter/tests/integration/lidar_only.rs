@@ -31,6 +31,9 @@ fn garage_scan() -> PathBuf {
 
 #[test]
 fn a_static_scan_folder_runs_lidar_only_without_drifting() {
+    if slam_core::skip_without_test_data!("../slam-core/tests/data") {
+        return;
+    }
     // The same real scan ten times, named by stamp: the true motion is zero.
     let dir = temp_dir("static-folder");
     for i in 0..10 {
@@ -104,6 +107,9 @@ fn pose(x: f64, yaw: f64) -> Pose3 {
 
 #[test]
 fn a_folder_with_odometry_takes_it_at_each_scan_stamp() {
+    if slam_core::skip_without_test_data!("../slam-core/tests/data") {
+        return;
+    }
     let dir = temp_dir("folder-odometry");
     let scans = dir.join("scans");
     std::fs::create_dir_all(&scans).unwrap();

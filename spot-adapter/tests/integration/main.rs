@@ -1,5 +1,5 @@
 //! spot-adapter's integration tests in one binary: one link instead of one per file, and one
-//! harness that runs every test across the cores (`cargo test -p spot-adapter --release --test
+//! harness that runs every test across the cores (`cargo test -p spot-nav-adapter --release --test
 //! integration [MODULE::]NAME`). Each module is one subject; `common` is what the navigation
 //! tests share.
 

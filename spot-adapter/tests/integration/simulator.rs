@@ -53,9 +53,10 @@ pub(crate) fn on_surface(
 }
 
 fn noiseless() -> LidarConfig {
-    let mut c = LidarConfig::default();
-    c.range_noise = 0.0;
-    c
+    LidarConfig {
+        range_noise: 0.0,
+        ..LidarConfig::default()
+    }
 }
 
 #[test]
@@ -160,8 +161,10 @@ fn noise_and_dropouts_have_the_configured_size() {
     let clean = SpinningLidar::new(noiseless())
         .unwrap()
         .scan(&b, &pose, &mut SimRng::new(0, 0));
-    let mut noisy_cfg = LidarConfig::default();
-    noisy_cfg.range_noise = 0.02;
+    let noisy_cfg = LidarConfig {
+        range_noise: 0.02,
+        ..LidarConfig::default()
+    };
     let noisy = SpinningLidar::new(noisy_cfg)
         .unwrap()
         .scan(&b, &pose, &mut SimRng::new(0, 0));
@@ -186,8 +189,10 @@ fn noise_and_dropouts_have_the_configured_size() {
 
 #[test]
 fn same_seeds_same_samples() {
-    let mut config = SimulationConfig::default();
-    config.seed = 9;
+    let config = SimulationConfig {
+        seed: 9,
+        ..SimulationConfig::default()
+    };
     let building = Building::generate(5, &BuildingConfig::default()).unwrap();
     let lap = Route::corridor_loop(&building);
     let run = |config: &SimulationConfig| -> Vec<_> {
@@ -199,8 +204,10 @@ fn same_seeds_same_samples() {
     let a = run(&config);
     let b = run(&config);
     assert!(a == b, "same seeds, same samples");
-    let mut other = SimulationConfig::default();
-    other.seed = 10;
+    let other = SimulationConfig {
+        seed: 10,
+        ..SimulationConfig::default()
+    };
     let c = run(&other);
     assert!(a[2].cloud != c[2].cloud);
     assert_ne!(a[2].odom_t_body, c[2].odom_t_body);

@@ -18,9 +18,11 @@ fn meets_the_accuracy_targets<R: MapRegistrator, C: MapRegistrator, O: Optimizer
     skewed: bool,
 ) -> f64 {
     let seed = 3;
-    let mut config = SimulationConfig::default();
-    config.seed = seed;
-    config.motion_distortion = skewed;
+    let config = SimulationConfig {
+        seed,
+        motion_distortion: skewed,
+        ..SimulationConfig::default()
+    };
     let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
@@ -262,8 +264,10 @@ fn finished_run<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
 /// and counts the fault; the simulator's ground truth is the oracle.
 #[test]
 fn an_odometry_jump_is_detected_and_the_lap_stays_accurate() {
-    let mut config = SimulationConfig::default();
-    config.seed = 3;
+    let config = SimulationConfig {
+        seed: 3,
+        ..SimulationConfig::default()
+    };
     let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
