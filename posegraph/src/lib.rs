@@ -43,6 +43,7 @@
 //! leads LM to it, as on torus3D, but nothing certifies it: use SE-Sync), or for landmark-based
 //! factor graphs (this crate handles between-pose constraints only).
 
+mod block_factor;
 mod chordal;
 mod error;
 pub mod g2o;
@@ -50,6 +51,7 @@ mod gauss_newton;
 mod gnc;
 mod gnc_loss;
 mod graph_text_lines;
+mod incremental;
 pub mod information_repair;
 mod levenberg_marquardt;
 mod linearize;
@@ -66,6 +68,7 @@ pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use gnc::{GncConfig, GncReport, GraduatedNonConvexity, KnownInliers};
 pub use gnc_loss::GncLoss;
+pub use incremental::{IncrementalConfig, IncrementalSmoother};
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
 pub use solver::{SolverConfig, SolverPose};
