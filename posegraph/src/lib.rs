@@ -39,6 +39,12 @@
 //! # Ok::<(), slam_core::OptimizeError>(())
 //! ```
 //!
+//! Incremental smoothing: [`IncrementalSmoother`] follows a growing graph through
+//! [`slam_core::IncrementalOptimizer::update`] with iSAM2's fluid relinearisation and partial
+//! re-elimination (Kaess et al., "iSAM2: Incremental smoothing and mapping using the Bayes
+//! tree", IJRR 2012) on a block sparse Cholesky factor: a loop closure re-factors the nodes it
+//! affects and their ancestors in the elimination tree, not the whole graph.
+//!
 //! When not to use it: for graphs that need a certified global optimum (the chordal guess usually
 //! leads LM to it, as on torus3D, but nothing certifies it: use SE-Sync), or for landmark-based
 //! factor graphs (this crate handles between-pose constraints only).

@@ -43,11 +43,12 @@ where
     for e in file.edges() {
         let (a, b) = (file.nodes()[e.from].id, file.nodes()[e.to].id);
         match (g.pose(a).copied(), g.pose(b).copied()) {
-            (Some(pa), None) => _ = g.add_node(b, compose(&pa, &e.measurement)).unwrap(),
+            (Some(pa), None) => {
+                g.add_node(b, compose(&pa, &e.measurement)).unwrap();
+            }
             (None, Some(pb)) => {
-                _ = g
-                    .add_node(a, compose(&pb, &inverse(&e.measurement)))
-                    .unwrap()
+                g.add_node(a, compose(&pb, &inverse(&e.measurement)))
+                    .unwrap();
             }
             (Some(_), Some(_)) => {}
             (None, None) => panic!("edge {a}-{b} joins two unseen nodes"),
