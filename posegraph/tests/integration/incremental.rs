@@ -115,6 +115,34 @@ fn bundled_graphs_fed_edge_by_edge_reach_the_batch_cost() {
     }
 }
 
+/// A whole file at once: `optimize` eliminates everything in minimum degree order and iterates
+/// Gauss-Newton from the file's guess to LM's optimum.
+#[test]
+fn whole_files_at_once_reach_the_batch_cost() {
+    for name in ["smallGrid3D.g2o", "input_M3500_g2o.g2o"] {
+        let t = std::time::Instant::now();
+        let (got, iterations, want) = match read_g2o(data(name)).unwrap() {
+            G2oGraph::Se3(file) => {
+                let mut g = file.clone();
+                g.fix(g.nodes()[0].id).unwrap();
+                let r = IncrementalSmoother::default().optimize(&mut g).unwrap();
+                (r.final_cost, r.iterations, batch(&file))
+            }
+            G2oGraph::Se2(file) => {
+                let mut g = file.clone();
+                g.fix(g.nodes()[0].id).unwrap();
+                let r = IncrementalSmoother::default().optimize(&mut g).unwrap();
+                (r.final_cost, r.iterations, batch(&file))
+            }
+        };
+        eprintln!(
+            "{name}: {iterations} updates, {got} vs LM {want} ({:?} both)",
+            t.elapsed()
+        );
+        assert_rel(got, want, 1e-6, name);
+    }
+}
+
 /// A random walk of `n` poses: odometry with noise, `loops` loop edges from the newest pose back
 /// to a random older one, each added when its newer end arrives; the smoother updates after
 /// each pose. `step` and `noise` draw a motion and a measurement error from uniform numbers in
