@@ -39,10 +39,17 @@
 //! # Ok::<(), slam_core::OptimizeError>(())
 //! ```
 //!
+//! Incremental smoothing: [`IncrementalSmoother`] follows a growing graph through
+//! [`slam_core::IncrementalOptimizer::update`] with iSAM2's fluid relinearisation and partial
+//! re-elimination (Kaess et al., "iSAM2: Incremental smoothing and mapping using the Bayes
+//! tree", IJRR 2012) on a block sparse Cholesky factor: a loop closure re-factors the nodes it
+//! affects and their ancestors in the elimination tree, not the whole graph.
+//!
 //! When not to use it: for graphs that need a certified global optimum (the chordal guess usually
 //! leads LM to it, as on torus3D, but nothing certifies it: use SE-Sync), or for landmark-based
 //! factor graphs (this crate handles between-pose constraints only).
 
+mod block_factor;
 mod chordal;
 mod error;
 pub mod g2o;
@@ -50,6 +57,7 @@ mod gauss_newton;
 mod gnc;
 mod gnc_loss;
 mod graph_text_lines;
+mod incremental;
 pub mod information_repair;
 mod levenberg_marquardt;
 mod linearize;
@@ -66,6 +74,7 @@ pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use gnc::{GncConfig, GncReport, GraduatedNonConvexity, KnownInliers};
 pub use gnc_loss::GncLoss;
+pub use incremental::{IncrementalConfig, IncrementalSmoother};
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
 pub use solver::{SolverConfig, SolverPose};

@@ -10,6 +10,22 @@ use slam_core::{GraphPose, OptimizeError, PoseGraph};
 use crate::linearize::{ErrorModel, Linearize};
 use crate::sparse_cholesky::SparseCholesky;
 
+/// Whether `graph` starts with nodes of these `fixed` flags and edges with these `ends` (node
+/// indices): the same structure, possibly grown.
+pub(crate) fn grows_from<P: GraphPose>(
+    fixed: &[bool],
+    ends: &[(usize, usize)],
+    graph: &PoseGraph<P>,
+) -> bool {
+    graph.node_count() >= fixed.len()
+        && graph.edge_count() >= ends.len()
+        && fixed.iter().zip(graph.nodes()).all(|(&f, n)| f == n.fixed)
+        && ends
+            .iter()
+            .zip(graph.edges())
+            .all(|(&(a, b), e)| a == e.from && b == e.to)
+}
+
 /// Where each edge's blocks go in the value array.
 #[derive(Clone, Copy, Debug)]
 struct EdgeSlots {
@@ -48,16 +64,7 @@ impl<const D: usize> NormalEquations<D> {
     pub(crate) fn fits<P: GraphPose>(&self, graph: &PoseGraph<P>) -> bool {
         self.fixed.len() == graph.node_count()
             && self.ends.len() == graph.edge_count()
-            && self
-                .fixed
-                .iter()
-                .zip(graph.nodes())
-                .all(|(&f, n)| f == n.fixed)
-            && self
-                .ends
-                .iter()
-                .zip(graph.edges())
-                .all(|(&(a, b), e)| a == e.from && b == e.to)
+            && grows_from(&self.fixed, &self.ends, graph)
     }
 
     /// Build the pattern and the symbolic factorisation for `graph`, with `D` unknowns per free

@@ -48,28 +48,34 @@ impl SolverConfig {
             self.max_iterations as f64,
             "at least 1",
         )?;
-        for (setting, v) in [
+        check_tolerances(&[
             (
                 "SolverConfig::relative_cost_tolerance",
                 self.relative_cost_tolerance,
             ),
             ("SolverConfig::step_tolerance", self.step_tolerance),
-        ] {
-            InvalidSetting::check(
-                v.is_finite() && v >= 0.0,
-                setting,
-                v,
-                "finite and not negative",
-            )?;
-        }
-        Ok(())
+        ])
     }
+}
+
+/// [`InvalidSetting`] for the first of `settings` (name, value) that is not finite and not
+/// negative.
+pub(crate) fn check_tolerances(settings: &[(&'static str, f64)]) -> Result<(), InvalidSetting> {
+    for &(setting, v) in settings {
+        InvalidSetting::check(
+            v.is_finite() && v >= 0.0,
+            setting,
+            v,
+            "finite and not negative",
+        )?;
+    }
+    Ok(())
 }
 
 /// `sum rho(e^T Omega e)` with `poses` in place of the graph's; with `weights` (one per edge),
 /// `sum w e^T Omega e` instead (the kernels ignored).
 /// Geman-McClure kernels are taken at `gm_scale` times their `c^2` (see [`graduated`]).
-fn cost_with<P: Linearize<D>, const D: usize>(
+pub(crate) fn cost_with<P: Linearize<D>, const D: usize>(
     graph: &PoseGraph<P>,
     poses: &[P],
     model: ErrorModel,

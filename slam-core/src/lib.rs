@@ -63,7 +63,9 @@ pub use slam::{
     EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, LoopRejection, LoopRejections,
     ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew,
 };
-pub use traits::optimizer::{OptimizationReport, Optimizer, StopReason};
+pub use traits::optimizer::{
+    IncrementalOptimizer, IncrementalReport, OptimizationReport, Optimizer, StopReason,
+};
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
 pub use traits::registrator::{Alignment, MapRegistrator, Reach, Registrator, SweepAlignment};

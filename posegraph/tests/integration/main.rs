@@ -7,6 +7,7 @@ mod common;
 mod chordal;
 mod datasets;
 mod gnc;
+mod incremental;
 mod information_repair;
 mod robust;
 mod solver_faults;

@@ -69,3 +69,44 @@ pub trait Optimizer<P: GraphPose> {
         None
     }
 }
+
+/// What one incremental update did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct IncrementalReport {
+    /// Nodes new since the last update.
+    pub new_nodes: usize,
+    /// Edges new since the last update.
+    pub new_edges: usize,
+    /// Free nodes whose linearisation point moved (their step exceeded the threshold).
+    pub relinearized: usize,
+    /// Free nodes whose part of the factor was recomputed (the ones the update affected and all
+    /// their ancestors in the elimination tree).
+    pub refactored: usize,
+    /// Free nodes in the graph.
+    pub variables: usize,
+}
+
+/// An optimiser that follows a growing [`PoseGraph`]: each call to
+/// [`update`](IncrementalOptimizer::update) takes in the nodes and edges appended since the
+/// previous call and moves the estimate by redoing only the work they affect (an iSAM2-style
+/// smoother), instead of re-solving the whole graph. [`Optimizer::optimize`] on such an
+/// optimiser takes in what is new and then iterates to convergence.
+///
+/// The graph must only grow between calls (nodes and edges appended, no node's fixed flag
+/// changed); an implementation that meets another graph starts afresh. The poses of the nodes
+/// already seen are the optimiser's: it writes its estimate into every node at each call.
+pub trait IncrementalOptimizer<P: GraphPose>: Optimizer<P> {
+    /// Take in the nodes and edges appended to `graph` since the last call and update every free
+    /// node's pose (one relinearisation and partial re-factorisation step, not a converged
+    /// solve).
+    ///
+    /// # Errors
+    /// As [`Optimizer::optimize`]: a new node's pose or a new edge's error that is not finite, a
+    /// graph without a gauge, a factorisation that fails. The optimiser's state is then reset
+    /// and the next call starts afresh; the graph's poses are left as they were.
+    fn update(&mut self, graph: &mut PoseGraph<P>) -> Result<IncrementalReport, OptimizeError>;
+
+    /// Forget everything: the next call starts from the graph's poses as a new graph.
+    fn reset(&mut self);
+}
