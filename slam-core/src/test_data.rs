@@ -7,10 +7,15 @@
 /// test harness's capture, and returns early; in the repository a missing folder fails it.
 /// A macro so that `CARGO_MANIFEST_DIR` is the calling package's.
 ///
-/// ```ignore
-/// if slam_core::skip_without_test_data!("tests/data", "../slam-core/tests/data") {
-///     return;
+/// ```
+/// fn a_test_on_bundled_data() {
+///     // The calling package's folders: this one's `src/` is always there.
+///     if slam_core::skip_without_test_data!("src") {
+///         return;
+///     }
+///     assert!(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src").is_dir());
 /// }
+/// a_test_on_bundled_data();
 /// ```
 #[doc(hidden)]
 #[macro_export]
