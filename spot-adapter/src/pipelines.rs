@@ -2,7 +2,7 @@
 //! simulated and recorded runs use it: one place for the settings that the example, the tests
 //! and the benches share.
 
-use posegraph::GraduatedNonConvexity;
+use posegraph::{GncConfig, GraduatedNonConvexity, KnownInliers};
 use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
     ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
@@ -28,7 +28,8 @@ pub fn slam_config() -> GraphSlamConfig {
 
 /// The engine with `odometry` and `refine`, the thesis' loop check (point-to-point ICP on
 /// voxelised keyframes) and graduated non-convexity over Levenberg-Marquardt with its defaults
-/// (truncated least squares on loop edges, odometry edges known inliers): a loop that passes
+/// (truncated least squares on loop edges, odometry edges known inliers: the edges without a
+/// kernel, so keep [`GraphSlamConfig::loop_kernel`] set): a loop that passes
 /// the geometric check yet disagrees with the rest of the graph (a look-alike place) is
 /// weighted out instead of bending the map.
 fn assemble<R: MapRegistrator>(
@@ -45,13 +46,14 @@ fn assemble<R: MapRegistrator>(
             ..IcpConfig::default()
         },
     };
-    GraphSlam::try_new(
-        config,
-        odometry,
-        loop_check,
-        refine,
-        GraduatedNonConvexity::default(),
-    )
+    // Odometry edges carry no kernel and loops carry the engine's loop kernel: the ones without
+    // are the known inliers (an odometry edge from an old keyframe the walk rode on joins ids
+    // that are not consecutive).
+    let gnc = GraduatedNonConvexity::try_new(GncConfig {
+        known_inliers: KnownInliers::WithoutKernel,
+        ..GncConfig::default()
+    })?;
+    GraphSlam::try_new(config, odometry, loop_check, refine, gnc)
 }
 
 /// Point-to-plane ICP for tracking a scan against a map (the SLAM odometry's fine stage after the

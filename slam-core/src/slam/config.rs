@@ -45,8 +45,24 @@ pub struct GraphSlamConfig {
     pub keyframe_distance: f64,
     /// ... or turned this much (radians; default 10 degrees).
     pub keyframe_rotation: f64,
-    /// Keyframes in the local map that scans are registered against (thesis: n = 40).
+    /// Keyframes in the local map that scans are registered against (thesis: n = 40): the
+    /// last ones the robot was at, which on a revisit are old keyframes it rode on.
     pub local_map_keyframes: usize,
+    /// No new keyframe where the map already is (metres; default 0.5, 0 turns it off): a scan
+    /// registered where a new keyframe would be made rides instead on the newest keyframe
+    /// within this distance, when that keyframe (or one next to it in the graph) is in the
+    /// local map the scan was registered against and the registration matched at least
+    /// [`revisit_min_inlier_ratio`](Self::revisit_min_inlier_ratio) of the scan. A robot
+    /// walking a building again therefore localises against the keyframes it made the first
+    /// time, and the graph, the map and each loop's optimisation stay the size of the
+    /// building, not of the walk. A revisit starts when a loop closes: the old keyframes
+    /// around the loop join the local map. Where the place changed (a poorer match), a new
+    /// keyframe is made, so the map follows the change.
+    pub revisit_radius: f64,
+    /// With [`revisit_radius`](Self::revisit_radius): the share of the scan's points the
+    /// registration must match (0 to 1; default 0.8) to ride on an old keyframe instead of
+    /// making a new one.
+    pub revisit_min_inlier_ratio: f64,
     /// How keyframes (and, without odometry, every scan) are registered against the local
     /// map: the adaptive reach, the checks a registration must pass, and the retries. An
     /// odometry step that ends further than [`TrackerConfig::arbitration_distance`] (0.5 m) from
@@ -150,6 +166,8 @@ impl Default for GraphSlamConfig {
             keyframe_distance: 0.20,
             keyframe_rotation: 10f64.to_radians(),
             local_map_keyframes: 40,
+            revisit_radius: 0.5,
+            revisit_min_inlier_ratio: 0.8,
             tracker: TrackerConfig::default(),
             loop_search_radius: 0.5,
             loop_neighbours: 20,
@@ -254,6 +272,7 @@ impl GraphSlamConfig {
                 "GraphSlamConfig::loop_max_drift_rate",
                 self.loop_max_drift_rate,
             ),
+            ("GraphSlamConfig::revisit_radius", self.revisit_radius),
         ] {
             InvalidSetting::check(
                 v.is_finite() && v >= 0.0,
@@ -267,6 +286,12 @@ impl GraphSlamConfig {
             "GraphSlamConfig::sweep_min_gain",
             self.sweep_min_gain,
             "in [0, 1)",
+        )?;
+        InvalidSetting::check(
+            (0.0..=1.0).contains(&self.revisit_min_inlier_ratio),
+            "GraphSlamConfig::revisit_min_inlier_ratio",
+            self.revisit_min_inlier_ratio,
+            "in [0, 1]",
         )?;
         let voxel = f64::from(self.map_voxel_size);
         InvalidSetting::check(

@@ -9,11 +9,12 @@ use nalgebra::{Matrix6, UnitQuaternion};
 use super::config::GraphSlamConfig;
 use super::information::edge_information;
 use super::keyframes::{Keyframe, ScanPose};
-use super::local_map::LocalMap;
+use super::local_map::{LocalMap, LocalWindow};
 use super::loop_closure::LoopQueue;
 use super::node_index::NodeIndex;
 use super::prediction::{Prediction, TurnBasis};
 use super::report::{ScanOutcome, SkipReason, SlamReport};
+use super::revisit::Reference;
 use super::scan_preparation::Prepared;
 use crate::cloud::PointCloud;
 use crate::error::{InvalidSetting, OptimizeError};
@@ -71,6 +72,15 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     pub(super) graph: PoseGraph<Pose3>,
     pub(super) keyframes: Vec<Keyframe<R::Source, C::Source>>,
     pub(super) local_map: Option<LocalMap<R::Target>>,
+    /// The keyframes the local map is made of.
+    pub(super) window: LocalWindow,
+    /// On a revisit, the last scan that rode on an old keyframe: the next scans' reference.
+    pub(super) anchor: Option<Reference>,
+    /// The first keyframe made since the last revisit: those from it on are being laid down
+    /// now, and are not ridden on.
+    pub(super) chain_start: usize,
+    /// The loop edges' indices in the graph's edges.
+    pub(super) loop_edges: Vec<usize>,
     pub(super) node_index: NodeIndex,
     /// Loop candidates waiting for a loop-closure step.
     pub(super) loops: LoopQueue,
@@ -142,6 +152,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             graph: PoseGraph::new(),
             keyframes: Vec::new(),
             local_map: None,
+            window: LocalWindow::default(),
+            anchor: None,
+            chain_start: 0,
+            loop_edges: Vec::new(),
             node_index: NodeIndex::default(),
             loops: LoopQueue::default(),
             scan_poses: Vec::new(),
@@ -177,6 +191,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     #[must_use]
     pub fn graph(&self) -> &PoseGraph<Pose3> {
         &self.graph
+    }
+
+    /// The loop-closure edges' indices in [`PoseGraph::edges`]; every other edge is an
+    /// odometry edge (from the previous keyframe, or on a revisit from the old keyframe the walk
+    /// rode on, so node ids alone do not tell the two apart).
+    #[must_use]
+    pub fn loop_edges(&self) -> &[usize] {
+        &self.loop_edges
     }
 
     /// The optimiser, e.g. for the weight it left each loop edge with
@@ -286,8 +308,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Ok(Prediction::LidarOnly {
                 guess,
                 velocity,
-                keyframe,
-            }) => (vec![guess], velocity, Some(keyframe)),
+                reference,
+            }) => (vec![guess], velocity, Some(reference)),
         };
         // 2. Prepare: thin, deskew with the predicted velocity.
         let prepared = match self.prepare(scan, velocity) {
@@ -309,18 +331,40 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         // 4. Keyframe decision: an odometry step was long enough already; LiDAR-only, the
         //    registered pose decides.
-        if let Some(last) = lidar_only {
-            let mut delta = self.keyframe_pose(last).inverse() * tracked.pose;
+        if let Some(reference) = lidar_only {
+            let mut delta = self.reference_pose(&reference).inverse() * tracked.pose;
             delta.rotation.renormalize();
             let moved = delta.translation.vector.norm() >= self.config.keyframe_distance
                 || delta.rotation.angle() >= self.config.keyframe_rotation;
-            if !moved && pose3_is_finite(&delta) {
+            let mut keyframe_t_lidar =
+                self.keyframe_pose(reference.keyframe).inverse() * tracked.pose;
+            keyframe_t_lidar.rotation.renormalize();
+            if !moved && pose3_is_finite(&keyframe_t_lidar) {
                 let sweep = tracked.prepared.sweep;
                 let registered = tracked.information.is_some();
-                return self.ride(scan, last, delta, sweep, registered, started);
+                return self.ride(
+                    scan,
+                    reference.keyframe,
+                    keyframe_t_lidar,
+                    sweep,
+                    registered,
+                    started,
+                );
             }
         }
-        // 5. Keyframe: a node, the local map slid, a loop candidate queued, a loop step.
+        // 5. Revisit: where the map already has a keyframe, the scan rides on it.
+        if tracked.information.is_some()
+            && let Some(old) = self.revisited_keyframe(&tracked.pose, tracked.inlier_ratio)
+        {
+            let mut keyframe_t_lidar = self.keyframe_pose(old).inverse() * tracked.pose;
+            keyframe_t_lidar.rotation.renormalize();
+            if pose3_is_finite(&keyframe_t_lidar) {
+                self.revisit(old, keyframe_t_lidar, odom_t_lidar);
+                let sweep = tracked.prepared.sweep;
+                return self.ride(scan, old, keyframe_t_lidar, sweep, true, started);
+            }
+        }
+        // 6. Keyframe: a node, the local map slid, a loop candidate queued, a loop step.
         self.add_keyframe(
             scan,
             tracked.prepared,
@@ -366,17 +410,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         ScanOutcome::Tracked { registered }
     }
 
-    /// Add node `id` at `pose` with its odometry edge `(step, information)` from the previous
-    /// node, or fixed as the gauge without one. Checked first with the graph's own predicates,
-    /// so that a refusal leaves the graph unchanged.
+    /// Add node `id` at `pose` with its odometry edge `(from, step, information)`, or fixed as
+    /// the gauge without one. Checked first with the graph's own predicates, so that a refusal
+    /// leaves the graph unchanged.
     fn insert_node(
         &mut self,
         id: u64,
         pose: Pose3,
-        edge: Option<&(Pose3, Matrix6<f64>)>,
+        edge: Option<&(u64, Pose3, Matrix6<f64>)>,
     ) -> Result<(), OptimizeError> {
         if !pose3_is_finite(&pose)
-            || edge.is_some_and(|(step, info)| {
+            || edge.is_some_and(|(_, step, info)| {
                 !pose3_is_finite(step) || !Pose3::information_is_valid(info)
             })
         {
@@ -385,11 +429,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             });
         }
         self.graph.add_node(id, pose)?;
-        match (edge, id.checked_sub(1)) {
-            (Some(&(step, info)), Some(prev)) => {
-                self.graph.add_edge(prev, id, step, info, None)?;
+        match edge {
+            Some(&(from, step, info)) => {
+                self.graph.add_edge(from, id, step, info, None)?;
             }
-            _ => self.graph.fix(id)?,
+            None => self.graph.fix(id)?,
         }
         Ok(())
     }
@@ -438,13 +482,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         };
         let index = self.keyframes.len();
         let id = index as u64;
-        let edge = if index == 0 {
-            None
-        } else {
-            let step = self.keyframe_pose(index - 1).inverse() * pose;
+        // The odometry edge comes from the reference: the last keyframe, or on a revisit the old
+        // keyframe the walk rode on.
+        let parent = self.reference().map(|r| r.keyframe);
+        let edge = parent.map(|from| {
+            let step = self.keyframe_pose(from).inverse() * pose;
             let info = edge_information(self.config.odometry_information, reg_info, &pose);
-            Some((step, info))
-        };
+            (from as u64, step, info)
+        });
         if self.insert_node(id, pose, edge.as_ref()).is_err() {
             return self.skip(SkipReason::NonFinitePose, started);
         }
@@ -462,14 +507,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             }
             None => Vec::new(),
         };
-        let walked = match index {
-            0 => 0.0,
-            _ => {
-                self.keyframes[index - 1].walked
-                    + (pose.translation.vector - self.keyframe_pose(index - 1).translation.vector)
-                        .norm()
-            }
-        };
+        let walked = parent.map_or(0.0, |from| {
+            self.keyframes[from].walked
+                + (pose.translation.vector - self.keyframe_pose(from).translation.vector).norm()
+        });
         self.keyframes.push(Keyframe {
             walked,
             stamp: scan.stamp,
@@ -477,9 +518,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             source: self.odometry.keyframe_source(source),
             coarse: self.loop_coarse.keyframe_source(coarse),
             cloud,
+            parent,
         });
         self.report.keyframes += 1;
-        self.slide_local_map(index);
+        self.anchor = None;
+        self.visit_keyframe(index);
         self.last_stamp = scan.stamp;
         self.scan_poses.push(ScanPose {
             stamp: scan.stamp,

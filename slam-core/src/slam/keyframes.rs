@@ -25,6 +25,9 @@ pub(super) struct Keyframe<S, C> {
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     pub(super) walked: f64,
+    /// The keyframe its odometry edge comes from (the previous one, or on a revisit the old
+    /// keyframe the walk rode on); `None` for the first.
+    pub(super) parent: Option<usize>,
 }
 
 /// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the

@@ -58,10 +58,13 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         let gap = self.config.loop_min_keyframe_gap;
         let may_try = |last: Option<usize>| last.is_none_or(|l| index >= l + gap);
+        // Keyframes in the local map are tied to this one by its registration already.
         let near = may_try(self.loops.last_near)
             .then(|| {
                 self.node_index
-                    .oldest_within(pose, self.config.loop_search_radius, index - window)
+                    .oldest_within(pose, self.config.loop_search_radius, |i| {
+                        i < index - window && !self.window.contains(i)
+                    })
             })
             .flatten();
         let candidate = match near {
@@ -73,7 +76,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             // rarely the same place.
             None if may_try(self.loops.last_look_alike) => look_alikes
                 .first()
-                .filter(|m| m.keyframe < index - window)
+                .filter(|m| m.keyframe < index - window && !self.window.contains(m.keyframe))
                 .map(|m| {
                     self.loops.last_look_alike = Some(index);
                     let turn = Pose3::from_parts(
@@ -194,6 +197,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Some(&refined.information),
             &refined.pose,
         );
+        self.loop_edges.push(self.graph.edges().len());
         self.graph
             .add_edge(
                 cand as u64,
@@ -202,7 +206,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 info,
                 self.config.loop_kernel,
             )
-            .map_err(|_| LoopRejection::EdgeRefused)?;
+            .map_err(|_| {
+                self.loop_edges.pop();
+                LoopRejection::EdgeRefused
+            })?;
         Ok(mse)
     }
 
@@ -213,18 +220,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             self.report.optimizer_failures += 1;
         }
         if let Some(weights) = self.optimizer.edge_weights() {
-            // Odometry edges join consecutive keyframes; every other edge is a loop.
-            let nodes = self.graph.nodes();
             self.report.loops_weighted_out = self
-                .graph
-                .edges()
+                .loop_edges
                 .iter()
-                .zip(weights)
-                .filter(|(e, w)| nodes[e.from].id.abs_diff(nodes[e.to].id) != 1 && **w < 0.5)
+                .filter(|&&k| weights.get(k).is_some_and(|&w| w < 0.5))
                 .count();
         }
         self.report.loops_closed += 1;
         self.report.place_loops_closed += usize::from(candidate.guess.is_some());
+        self.start_revisit(candidate.old, candidate.new);
         // The keyframes moved: rebuild the local map now, within this step, so that the next
         // scan's odometry does not pay for it.
         self.local_map = None;

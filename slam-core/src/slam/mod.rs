@@ -9,11 +9,14 @@
 //! fit kept; [`SlamReport::odometry_faults`] counts the steps it overruled. New keyframes near old ones queue loop-closure candidates; a loop-closure step aligns the
 //! new keyframe to the candidate's neighbourhood (coarse, then refined), adds an edge and
 //! optimises the graph. Keyframe scans with a per-point `time` channel are deskewed first, with
-//! the velocity the odometry showed since the previous scan.
+//! the velocity the odometry showed since the previous scan. A scan registered where the map
+//! already has a keyframe rides on it instead of making a new one
+//! ([`GraphSlamConfig::revisit_radius`]), so a walk through a mapped building again adds
+//! nothing to the graph.
 //!
 //! One file a stage: `prediction` (where the scan should be), `scan_preparation` (thinning and
 //! deskewing), `scan_tracking` (registration against the local map, the sweep's own motion),
-//! `local_map`, `keyframes` (what is kept, the trajectories and the map), `loop_closure` (the
+//! `local_map`, `revisit` (riding on old keyframes), `keyframes` (what is kept, the trajectories and the map), `loop_closure` (the
 //! candidate queue and the checks, each rejection counted by its [`LoopRejection`]),
 //! `information` (edge information); `engine` holds the state and runs the stages in order.
 
@@ -27,6 +30,7 @@ mod loop_closure;
 mod node_index;
 mod prediction;
 mod report;
+mod revisit;
 mod scan_preparation;
 mod scan_tracking;
 

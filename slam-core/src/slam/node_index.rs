@@ -32,18 +32,31 @@ impl NodeIndex {
         self.tree.insert(GeomWithData::new([t.x, t.y, t.z], index));
     }
 
-    /// The smallest keyframe index within `radius` of `pose` and below `max_index`.
+    /// The smallest keyframe index within `radius` of `pose` that `admit` admits.
     pub(crate) fn oldest_within(
         &self,
         pose: &Pose3,
         radius: f64,
-        max_index: usize,
+        admit: impl Fn(usize) -> bool,
     ) -> Option<usize> {
+        self.within(pose, radius).filter(|&i| admit(i)).min()
+    }
+
+    /// The largest keyframe index within `radius` of `pose` that `admit` admits.
+    pub(crate) fn newest_within(
+        &self,
+        pose: &Pose3,
+        radius: f64,
+        admit: impl Fn(usize) -> bool,
+    ) -> Option<usize> {
+        self.within(pose, radius).filter(|&i| admit(i)).max()
+    }
+
+    /// The keyframe indices within `radius` of `pose`.
+    fn within(&self, pose: &Pose3, radius: f64) -> impl Iterator<Item = usize> + '_ {
         let t = pose.translation.vector;
         self.tree
             .locate_within_distance([t.x, t.y, t.z], radius * radius)
             .map(|e| e.data)
-            .filter(|&i| i < max_index)
-            .min()
     }
 }

@@ -9,6 +9,7 @@ use super::config::TurnPrediction;
 use super::engine::{GraphSlam, GyroReading, ScanInput};
 use super::keyframes::ScanPose;
 use super::report::SkipReason;
+use super::revisit::Reference;
 use crate::geometry::{Pose3, se3_exp, se3_log};
 use crate::io::StampedPose;
 use crate::tracking::{TURN_SHARES, TurnPersistence};
@@ -37,11 +38,11 @@ pub(super) enum Prediction {
         velocity: Option<Vector6<f64>>,
     },
     /// LiDAR-only: registered from `guess`, deskewed with `velocity`, then refined with its
-    /// sweep's own motion; a keyframe once it moved far enough from `keyframe`.
+    /// sweep's own motion; a keyframe once it moved far enough from `reference`.
     LidarOnly {
         guess: Pose3,
         velocity: Option<Vector6<f64>>,
-        keyframe: usize,
+        reference: Reference,
     },
 }
 
@@ -58,7 +59,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     ) -> Result<Prediction, SkipReason> {
         self.turn_basis = None;
         let odometry_velocity = self.odometry_velocity(scan.stamp, odom_t_lidar, swept);
-        let Some(last) = self.keyframes.len().checked_sub(1) else {
+        let Some(reference) = self.reference() else {
             if swept && odom_t_lidar.is_some() && odometry_velocity.is_none() {
                 self.last_stamp = scan.stamp;
                 return Err(SkipReason::AwaitingVelocity);
@@ -68,13 +69,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 velocity: odometry_velocity,
             });
         };
-        // Odometry now and at the last keyframe: predicted from it. Otherwise LiDAR-only.
-        if let (Some(now), Some(then)) = (odom_t_lidar, self.keyframes[last].odom_t_lidar) {
-            return Ok(self.odometry_prediction(scan.stamp, now, then, last, odometry_velocity));
+        // Odometry now and at the reference: predicted from it. Otherwise LiDAR-only.
+        if let (Some(now), Some(then)) = (odom_t_lidar, reference.odom_t_lidar) {
+            return Ok(self.odometry_prediction(
+                scan.stamp,
+                now,
+                then,
+                &reference,
+                odometry_velocity,
+            ));
         }
         let (guess, velocity, basis) = self
             .motion_prior(scan.stamp)
-            .unwrap_or_else(|| (self.keyframe_pose(last), None, None));
+            .unwrap_or_else(|| (self.reference_pose(&reference), None, None));
         let gyro_before = self.report.gyro_predictions;
         let (guess, velocity) = self.gyro_prior(scan, guess, velocity);
         if basis.is_some() && self.report.gyro_predictions == gyro_before {
@@ -84,7 +91,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Ok(Prediction::LidarOnly {
             guess,
             velocity: velocity.filter(|_| swept),
-            keyframe: last,
+            reference,
         })
     }
 
@@ -108,24 +115,24 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             })
     }
 
-    /// A scan with odometry: predicted from the odometry since keyframe `last`; registered only
-    /// once it moved far enough for a new keyframe.
+    /// A scan with odometry: predicted from the odometry since `reference` (whose odometry is
+    /// `reference_odom_t_lidar`); registered only once it moved far enough for a new keyframe.
     fn odometry_prediction(
         &self,
         stamp: f64,
         odom_t_lidar: Pose3,
-        keyframe_odom_t_lidar: Pose3,
-        last: usize,
+        reference_odom_t_lidar: Pose3,
+        reference: &Reference,
         velocity: Option<Vector6<f64>>,
     ) -> Prediction {
-        let delta = keyframe_odom_t_lidar.inverse() * odom_t_lidar;
-        let predicted = self.keyframe_pose(last) * delta;
+        let delta = reference_odom_t_lidar.inverse() * odom_t_lidar;
+        let predicted = self.reference_pose(reference) * delta;
         let moved = delta.translation.vector.norm() >= self.config.keyframe_distance
             || delta.rotation.angle() >= self.config.keyframe_rotation;
         if !moved {
             return Prediction::Short {
-                keyframe: last,
-                keyframe_t_lidar: delta,
+                keyframe: reference.keyframe,
+                keyframe_t_lidar: reference.keyframe_t_lidar * delta,
             };
         }
         let prior = self.motion_prior(stamp);

@@ -209,6 +209,9 @@ pub struct SlamReport {
     pub turn_shares: [usize; 3],
     /// Skipped scans: a non-finite keyframe pose ([`SkipReason::NonFinitePose`]).
     pub skipped_non_finite_pose: usize,
+    /// Registered scans that rode on a keyframe already in the map instead of making a new one
+    /// ([`GraphSlamConfig::revisit_radius`](super::GraphSlamConfig::revisit_radius)).
+    pub revisits: usize,
     /// Loop candidates tried.
     pub loops_attempted: usize,
     /// Loops accepted.

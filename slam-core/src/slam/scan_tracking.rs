@@ -17,6 +17,8 @@ pub(super) struct TrackedScan<S> {
     pub(super) pose: Pose3,
     /// The registration's information; `None` on a fallback.
     pub(super) information: Option<Matrix6<f64>>,
+    /// The share of the scan's points the registration matched (0 on a fallback).
+    pub(super) inlier_ratio: f64,
 }
 
 impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, O> {
@@ -32,16 +34,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         velocity: Option<Vector6<f64>>,
         refine_sweep: bool,
     ) -> TrackedScan<R::Source> {
-        let (pose, information) = self.register(&prepared, guesses);
+        let (pose, information, inlier_ratio) = self.register(&prepared, guesses);
         let mut tracked = TrackedScan {
             prepared,
             pose,
             information,
+            inlier_ratio,
         };
         if refine_sweep
             && self.config.sweep_motion
             && tracked.information.is_some()
-            && let Some((at, information, correction)) =
+            && let Some((at, information, correction, inlier_ratio)) =
                 self.sweep_motion(&tracked.prepared, &tracked.pose)
         {
             // The second scan has no velocity yet: its sweep's own motion is all there is.
@@ -49,11 +52,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             tracked.prepared = self.redeskew(scan, tracked.prepared, v + correction);
             tracked.pose = at;
             tracked.information = Some(information);
+            tracked.inlier_ratio = inlier_ratio;
         }
         tracked
     }
 
-    /// The pose of a scan and its registration's information: registered against the local
+    /// The pose of a scan, its registration's information and matched share: registered against the local
     /// map from `guesses` (the prediction first) by the tracker; the prediction, counted as a
     /// fallback, when it cannot be (no map, or the registration is not taken). An alternative
     /// guess that wins counts as an odometry fault.
@@ -61,7 +65,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         &mut self,
         prepared: &Prepared<R::Source>,
         guesses: &[Pose3],
-    ) -> (Pose3, Option<Matrix6<f64>>) {
+    ) -> (Pose3, Option<Matrix6<f64>>, f64) {
         let has_map = self.ensure_local_map();
         let target = self
             .local_map
@@ -84,12 +88,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let mut pose = outcome.pose;
         pose.rotation.renormalize();
         self.last_fit = outcome.alignment.as_ref().map(|a| a.rmse);
-        (pose, outcome.alignment.map(|a| a.information))
+        let inlier_ratio = outcome.alignment.as_ref().map_or(0.0, |a| a.inlier_ratio);
+        (pose, outcome.alignment.map(|a| a.information), inlier_ratio)
     }
 
     /// The scan registered again from `pose` (its registration) together with its sweep's own
     /// motion ([`Registrator::align_sweep`](crate::Registrator::align_sweep)): the pose at the
-    /// sweep's start, its information, and the correction to the velocity it was deskewed with.
+    /// sweep's start, its information, the correction to the velocity it was deskewed with, and
+    /// the share of points matched.
     /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
     /// pose, too small a gain over the scan's registration:
     /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain)).
@@ -97,7 +103,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         &self,
         prepared: &Prepared<R::Source>,
         pose: &Pose3,
-    ) -> Option<(Pose3, Matrix6<f64>, Vector6<f64>)> {
+    ) -> Option<(Pose3, Matrix6<f64>, Vector6<f64>, f64)> {
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
@@ -115,6 +121,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         (pose3_is_finite(&a.pose)
             && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
             && better)
-            .then_some((a.pose, a.information, sweep.velocity_correction))
+            .then_some((
+                a.pose,
+                a.information,
+                sweep.velocity_correction,
+                a.inlier_ratio,
+            ))
     }
 }

@@ -25,4 +25,5 @@ mod point_cloud2_fuzz;
 mod recording;
 mod simulator;
 mod slam_loop;
+mod slam_revisits;
 mod tracking;
