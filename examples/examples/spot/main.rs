@@ -5,17 +5,32 @@
 //!     --host 192.168.80.3 --ca robot-ca.pem --user admin --password-env SPOT_PASSWORD --goal 3,0
 //! ```
 //!
-//! Connects (login, directory, time sync, body lease) and checks the robot state: it refuses to
+//! Connects (login, directory, time sync, body lease: a lease the tablet holds is refused,
+//! naming `--take-lease`, which takes it instead) and checks the robot state: it refuses to
 //! start while an E-stop is asserted, when no E-stop endpoint is registered, or with a system
 //! or behaviour fault, naming what to do. It powers the motors on if they are off and stands
-//! Spot up (each step with a timeout), and only then walks. It then either loads `--map` (a PCD cloud
-//! in the map frame, with the robot's pose in it given by `--start X,Y,YAW`) or maps where it
-//! stands: Spot turns once in place at 0.3 rad/s and the scans at their odometry poses make the
-//! map (the map frame is then the odometry frame). The goal is in the frame of the body where
-//! the run started (x forward, y left, metres) without `--map`, in the map frame with it. The
-//! navigator then walks Spot there; it stops on arrival and on every fault. With `--sit` Spot
-//! sits and powers off at the end. The password is read from the environment variable named
-//! by `--password-env`, never from the command line.
+//! Spot up (each step with a timeout), and only then walks.
+//!
+//! Without `--map` it maps with the Graph-SLAM engine, live: each new scan of the point-cloud
+//! service goes to the engine with the body odometry of the robot state as its prior, while
+//! Spot walks the waypoints of `--route FILE` (one `x y` a line, metres in the start frame:
+//! the body's frame where the run started, x forward, y left; `#` comments) or, without a
+//! route, turns once in place at 0.3 rad/s. The occupancy grid is then built from the
+//! optimised keyframes, and `--save-map DIR` saves the map cloud (`map.pcd`, `map.ply`), the
+//! pose graph (`graph.g2o`) and the grid (`grid.yaml` + `grid.pgm`), all in the start frame.
+//! A later run navigates on it with `--map DIR` (no mapping), its pose in the map given by
+//! `--start X,Y,YAW` (`0,0,0` when it starts where the mapping run did); `--map` also takes a
+//! PCD file alone.
+//!
+//! The goal is in the start frame without `--map`, in the map frame with it. The navigator
+//! then walks Spot there; it stops on arrival and on every fault, and the run exits 0 only
+//! when Spot arrived (or, without `--goal`, once the map is saved). With `--sit` Spot sits and
+//! powers off at the end. The password is read from the environment variable named by
+//! `--password-env`, never from the command line.
+//!
+//! On a bench without an E-stop controller, `--software-estop` registers the example's own
+//! software E-stop endpoint and keeps it alive (as the SDK's `EstopEndpoint` and
+//! `EstopKeepAlive`); on exit it is set to settle-then-cut, so Spot sits and cuts power.
 //!
 //! On Ctrl-C, on every error and on a panic Spot is sent a stop and the lease is returned
 //! (Ctrl-C exits 130; a second Ctrl-C exits at once). A robot whose odometry does not change
@@ -23,20 +38,22 @@
 //!
 //! Keep the e-stop in hand. Speeds are capped by `--max-speed` (default 0.5 m/s).
 
+mod mapping;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Parser;
-use nalgebra::{Point3, Vector2, Vector3};
-use slam_core::{PointCloud, Pose3};
+use nalgebra::{Vector2, Vector3};
+use slam_core::Pose3;
 use spot_adapter::grpc::{Credentials, MotorPower, SpotClient, SpotConfig, SpotError};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_localiser;
-use spot_adapter::robot::{MobilityCommand, Robot, VelocityCommand};
+use spot_adapter::robot::Robot;
 use spot_nav_examples::{parse_goal, parse_numbers};
 
 /// Walk a real Spot to a goal.
@@ -58,11 +75,19 @@ struct Args {
     #[arg(long, default_value = "SPOT_PASSWORD")]
     password_env: String,
     /// The goal X,Y (metres): in the start body frame, or in the map frame with --map.
-    #[arg(long, value_parser = parse_goal)]
-    goal: Vector2<f64>,
-    /// A map cloud (PCD) to navigate on instead of mapping in place.
-    #[arg(long)]
+    /// Without it the run ends once the map is made (and saved with --save-map).
+    #[arg(long, value_parser = parse_goal, required_unless_present = "save_map")]
+    goal: Option<Vector2<f64>>,
+    /// A map to navigate on instead of mapping: a folder written by --save-map, or a PCD file.
+    #[arg(long, conflicts_with_all = ["route", "save_map"])]
     map: Option<PathBuf>,
+    /// Map while walking these waypoints (one `x y` a line, metres in the start frame; `#`
+    /// comments) instead of turning once in place.
+    #[arg(long, value_name = "FILE")]
+    route: Option<PathBuf>,
+    /// Save the map made here (map.pcd, map.ply, graph.g2o, grid.yaml + grid.pgm) for --map.
+    #[arg(long, value_name = "DIR")]
+    save_map: Option<PathBuf>,
     /// The robot's pose X,Y,YAW (metres, radians) in the --map frame.
     #[arg(long, value_parser = parse_numbers::<3>, default_value = "0,0,0")]
     start: [f64; 3],
@@ -72,6 +97,14 @@ struct Args {
     /// The most navigator cycles (scans) before giving up.
     #[arg(long, default_value_t = 3000)]
     cycles: usize,
+    /// Take the body lease from whoever holds it (the tablet) instead of asking for it.
+    #[arg(long)]
+    take_lease: bool,
+    /// Bench setups without an E-stop controller: register our own software E-stop endpoint
+    /// with this timeout in seconds (9 when given alone), keep it alive while running, and on
+    /// exit set it to settle-then-cut (Spot sits and cuts power). Stop it with Ctrl-C.
+    #[arg(long, value_name = "SECONDS", num_args = 0..=1, default_missing_value = "9")]
+    software_estop: Option<f64>,
     /// At the end, sit and power the motors off.
     #[arg(long)]
     sit: bool,
@@ -139,29 +172,8 @@ fn bring_up(spot: &SpotClient, interrupt: &AtomicBool) -> Result<()> {
     Ok(())
 }
 
-/// Turn once in place, keeping every scan at its odometry pose: `(odom_T_lidar, cloud)`.
-fn map_in_place(spot: &mut SpotClient) -> Result<Vec<(Pose3, PointCloud)>> {
-    let mut scans = Vec::new();
-    let (mut turned, mut last_yaw) = (0.0, None::<f64>);
-    while turned < std::f64::consts::TAU {
-        let sample = spot.next_sample()?;
-        let yaw = sample.odom_t_body.rotation.euler_angles().2;
-        if let Some(last) = last_yaw {
-            turned += (yaw - last + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                - std::f64::consts::PI;
-        }
-        last_yaw = Some(yaw);
-        scans.push((sample.odom_t_lidar(), sample.cloud.voxel_downsample(0.05)?));
-        spot.send(&MobilityCommand::Velocity(VelocityCommand::new(0.0, 0.3)))?;
-        if scans.len() > 2000 {
-            bail!("the robot did not turn a full circle in 2000 scans");
-        }
-    }
-    spot.stop()?;
-    Ok(scans)
-}
-
-fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<DriveOutcome> {
+/// Run as `args` ask; whether it did all it was asked (arrived, or mapped without a goal).
+fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<bool> {
     let password = std::env::var(&args.password_env).with_context(|| {
         format!(
             "set the environment variable {} to the password",
@@ -172,7 +184,22 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<DriveOutcome> {
     let mut config = SpotConfig::new(&args.host, ca, Credentials::new(&args.user, password));
     config.port = args.port;
     config.description.limits.max_forward_speed = args.max_speed;
-    let mut spot = SpotClient::connect(config).context("connecting to the robot")?;
+    config.take_lease = args.take_lease;
+    config.software_estop = args
+        .software_estop
+        .map(Duration::try_from_secs_f64)
+        .transpose()
+        .context("--software-estop takes a timeout in seconds")?;
+    let mut spot = SpotClient::connect(config).map_err(|error| {
+        let hint = match &error {
+            SpotError::LeaseRefused { owner, .. } if !args.take_lease => format!(
+                "the body lease is held by {owner:?} (the tablet?): release it there, or run \
+                 with --take-lease to take it"
+            ),
+            _ => "connecting to the robot".to_owned(),
+        };
+        anyhow::Error::new(error).context(hint)
+    })?;
     spot.set_interrupt(Arc::clone(interrupt));
     println!(
         "connected to {} ({})",
@@ -181,30 +208,42 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<DriveOutcome> {
     );
     bring_up(&spot, interrupt)?;
     let nav_config = NavigatorConfig::default();
-    let geometry = &spot.description().geometry;
+    let geometry = spot.description().geometry.clone();
     let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
-    let (map, navigation, map_t_body, goal) = if let Some(path) = &args.map {
-        let map = slam_core::io::read_pcd(path)?;
+    let (map, navigation, map_t_body) = if let Some(path) = &args.map {
         let [x, y, yaw] = args.start;
         let map_t_body = Pose3::new(Vector3::new(x, y, 0.0), Vector3::new(0.0, 0.0, yaw));
-        let lidar = map_t_body * geometry.body_t_lidar;
-        let navigation =
-            NavigationMap::from_cloud(&map, &[lidar], lidar_height, &nav_config.map_config())?;
-        (map, navigation, map_t_body, args.goal)
+        let loaded = mapping::load(path, map_t_body * geometry.body_t_lidar)?;
+        let navigation = NavigationMap::from_cloud(
+            &loaded.map,
+            &loaded.viewpoints,
+            lidar_height,
+            &nav_config.map_config(),
+        )?;
+        (loaded.map, navigation, map_t_body)
     } else {
-        let odom_t_start = spot.frame_tree()?.a_t_b("odom", "body")?;
-        println!("mapping: turning once in place");
-        let scans = map_in_place(&mut spot)?;
-        let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
-        let navigation = NavigationMap::from_scans(&refs, lidar_height, &nav_config.map_config())?;
-        let points: Vec<Point3<f32>> = scans
-            .iter()
-            .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
-            .collect();
-        let map = PointCloud::from_points(points).voxel_downsample(0.05)?;
-        let goal = odom_t_start * Point3::new(args.goal.x, args.goal.y, 0.0);
-        let odom_t_body = spot.frame_tree()?.a_t_b("odom", "body")?;
-        (map, navigation, odom_t_body, goal.coords.xy())
+        let route = args.route.as_deref().map(mapping::read_route).transpose()?;
+        match &route {
+            Some(route) => println!("mapping: walking a route of {} waypoints", route.len()),
+            None => println!("mapping: turning once in place"),
+        }
+        let mapped = mapping::map_live(
+            &mut spot,
+            route.as_deref(),
+            args.max_speed,
+            args.cycles,
+            lidar_height,
+        )?;
+        let [x, y, yaw] = xy_yaw(&mapped.start_t_body);
+        println!("mapping ended at ({x:.3}, {y:.3}, {yaw:.3}) in the start frame");
+        if let Some(dir) = &args.save_map {
+            mapping::save(dir, &mapped)?;
+        }
+        (mapped.map, mapped.navigation, mapped.start_t_body)
+    };
+    let Some(goal) = args.goal else {
+        finish(&spot, args.sit)?;
+        return Ok(true);
     };
     let mut navigator = Navigator::new(
         point_to_plane_localiser(),
@@ -217,12 +256,24 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<DriveOutcome> {
     println!("walking to ({:.2}, {:.2})", goal.x, goal.y);
     let report = drive(&mut spot, &mut navigator, goal, args.cycles, |_| {})?;
     println!("{:?} after {} scans", report.outcome, report.cycles);
-    if args.sit {
+    finish(&spot, args.sit)?;
+    Ok(report.outcome == DriveOutcome::Arrived)
+}
+
+/// A planar pose's x, y and yaw.
+fn xy_yaw(pose: &Pose3) -> [f64; 3] {
+    let t = pose.translation.vector;
+    [t.x, t.y, pose.rotation.euler_angles().2]
+}
+
+/// With `sit`, sit down and power the motors off.
+fn finish(spot: &SpotClient, sit: bool) -> Result<()> {
+    if sit {
         println!("sitting down and powering the motors off");
         spot.sit()?;
         spot.power_off()?;
     }
-    Ok(report.outcome)
+    Ok(())
 }
 
 /// Whether `error` comes from Ctrl-C.
@@ -238,8 +289,8 @@ fn main() -> ExitCode {
     // the lease.
     let result = interrupt_flag().and_then(|flag| run(&args, &flag));
     match result {
-        Ok(DriveOutcome::Arrived) => ExitCode::SUCCESS,
-        Ok(_) => ExitCode::FAILURE,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
         Err(error) if interrupted(&error) => {
             eprintln!("interrupted: the robot was sent a stop and the lease returned");
             ExitCode::from(INTERRUPTED)
