@@ -53,7 +53,7 @@ use slam_core::Pose3;
 use spot_adapter::grpc::{Credentials, MotorPower, SpotClient, SpotConfig, SpotError};
 use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
 use spot_adapter::pipelines::point_to_plane_localiser;
-use spot_adapter::robot::Robot;
+use spot_adapter::robot::{Robot, SpotGeometry};
 use spot_nav_examples::{parse_goal, parse_numbers};
 
 /// Walk a real Spot to a goal.
@@ -174,6 +174,17 @@ fn bring_up(spot: &SpotClient, interrupt: &AtomicBool) -> Result<()> {
 
 /// Run as `args` ask; whether it did all it was asked (arrived, or mapped without a goal).
 fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<bool> {
+    // The files first: a bad route or map stops the run before it connects.
+    let geometry = SpotGeometry::default();
+    let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
+    let route = args.route.as_deref().map(mapping::read_route).transpose()?;
+    let [x, y, yaw] = args.start;
+    let map_t_start = Pose3::new(Vector3::new(x, y, 0.0), Vector3::new(0.0, 0.0, yaw));
+    let loaded = args
+        .map
+        .as_deref()
+        .map(|path| mapping::load(path, map_t_start * geometry.body_t_lidar))
+        .transpose()?;
     let password = std::env::var(&args.password_env).with_context(|| {
         format!(
             "set the environment variable {} to the password",
@@ -183,6 +194,7 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<bool> {
     let ca = std::fs::read(&args.ca).with_context(|| format!("{}", args.ca.display()))?;
     let mut config = SpotConfig::new(&args.host, ca, Credentials::new(&args.user, password));
     config.port = args.port;
+    config.description.geometry = geometry;
     config.description.limits.max_forward_speed = args.max_speed;
     config.take_lease = args.take_lease;
     config.software_estop = args
@@ -208,21 +220,15 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<bool> {
     );
     bring_up(&spot, interrupt)?;
     let nav_config = NavigatorConfig::default();
-    let geometry = spot.description().geometry.clone();
-    let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
-    let (map, navigation, map_t_body) = if let Some(path) = &args.map {
-        let [x, y, yaw] = args.start;
-        let map_t_body = Pose3::new(Vector3::new(x, y, 0.0), Vector3::new(0.0, 0.0, yaw));
-        let loaded = mapping::load(path, map_t_body * geometry.body_t_lidar)?;
+    let (map, navigation, map_t_body) = if let Some(loaded) = loaded {
         let navigation = NavigationMap::from_cloud(
             &loaded.map,
             &loaded.viewpoints,
             lidar_height,
             &nav_config.map_config(),
         )?;
-        (loaded.map, navigation, map_t_body)
+        (loaded.map, navigation, map_t_start)
     } else {
-        let route = args.route.as_deref().map(mapping::read_route).transpose()?;
         match &route {
             Some(route) => println!("mapping: walking a route of {} waypoints", route.len()),
             None => println!("mapping: turning once in place"),

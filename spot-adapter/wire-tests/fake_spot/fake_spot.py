@@ -17,14 +17,16 @@ velocity and trajectory command (STATUS_BEHAVIOR_FAULT); `--stale-cloud` serves 
 walled room with a floor and two pillars fixed in odom, seen from the body's current pose: the
 clouds of a robot that moves, for mapping and navigating. `--lease-held` starts with the body
 lease held by another client (the tablet): AcquireLease answers STATUS_RESOURCE_ALREADY_CLAIMED,
-TakeLease takes it. `--power-on-seconds S` makes a power-on take S seconds. The E-stop service
+TakeLease takes it. `--odom-scale K` makes the odometry (odom_T_body in the frame tree) count
+every motion K times while the clouds show the true pose. `--power-on-seconds S` makes a power-on take S seconds. The E-stop service
 has one configuration with a `PDB_rooted` role: an endpoint registered there checks in with the
 complement of the last challenge, and the robot state lists it as a software E-stop, released
 while its last check-in was ESTOP_LEVEL_NONE within its timeout.
 
 Start-up prints one line `READY <port>` on stdout once the server listens; `<dir>/ca.pem` then
 holds the CA. Control lines (answered `OK <line>`): take-lease, stall-time-sync, malformed-cloud,
-pose (answered `OK pose <x> <y> <yaw>`, the body's true pose in odom), drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
+pose (answered `OK pose <x> <y> <yaw> <x> <y> <yaw>`, the body's true pose in odom, then
+the odometry's), drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
 <body_T_lidar>` and reads the command that answered with `wait-command <seconds>`.
 """
 
@@ -162,7 +164,10 @@ class Robot:
         self.time_sync_rounds = {}  # client name -> [(rtt, skew)]
         self.time_sync_stalled = False
         self.malformed_cloud = False
-        self.pose = [1.0, 2.0, 0.3]  # odom_T_body x, y, yaw
+        self.pose = [1.0, 2.0, 0.3]  # the body's true pose in odom: x, y, yaw
+        # What the odometry says (odom_T_body in the frame tree): the true pose unless
+        # --odom-scale makes it over- or under-count every motion.
+        self.odom_pose = list(self.pose)
         self.velocity = (0.0, 0.0, 0.0)  # body frame vx, vy, wz
         self.velocity_end = 0.0  # robot-clock seconds
         self.command_id = 0
@@ -231,12 +236,17 @@ class Robot:
             x, y, yaw = self.pose
             c, s = math.cos(yaw), math.sin(yaw)
             self.pose = [x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, yaw + wz * dt]
+            k = self.args.odom_scale
+            x, y, yaw = self.odom_pose
+            c, s = math.cos(yaw), math.sin(yaw)
+            self.odom_pose = [x + (c * vx - s * vy) * dt * k, y + (s * vx + c * vy) * dt * k,
+                              yaw + wz * dt * k]
 
     def snapshot(self):
         """Frame tree rooted at body, as Spot sends it: odom, vision and the LiDAR below it."""
         snap = geometry_pb2.FrameTreeSnapshot()
         with self.lock:
-            x, y, yaw = self.pose
+            x, y, yaw = self.odom_pose
             bridged = self.bridge_scan
         if bridged is not None:
             # Rooted at odom: the simulator's odometry and LiDAR mounting as given.
@@ -952,6 +962,8 @@ def main():
     parser.add_argument("--stale-cloud", action="store_true", help="one scan, served forever")
     parser.add_argument("--world", choices=("helix", "room"), default="helix",
                         help="the clouds: the known helix, or a room seen from the body's pose")
+    parser.add_argument("--odom-scale", type=float, default=1.0,
+                        help="the odometry counts every motion this many times (1.05: 5 %% long)")
     parser.add_argument("--lease-held", action="store_true",
                         help="the body lease starts held by another client (the tablet)")
     parser.add_argument("--power-on-seconds", type=float, default=POWER_ON_SECONDS,
@@ -993,11 +1005,11 @@ def main():
         elif line == "malformed-cloud":
             robot.malformed_cloud = True
         elif line == "pose":
-            # The body's true pose in odom: x y yaw.
+            # The body's true pose in odom, then the odometry's: x y yaw x y yaw.
             robot.step()
             with robot.lock:
-                x, y, yaw = robot.pose
-            print("OK pose %r %r %r" % (x, y, yaw), flush=True)
+                pose = robot.pose + robot.odom_pose
+            print("OK pose " + " ".join(repr(v) for v in pose), flush=True)
             continue
         elif line.startswith("scan "):
             # scan <file of little-endian f32 xyz> <odom_T_body: 7 numbers> <body_T_lidar: 7>
