@@ -307,6 +307,23 @@ fn ctrl_c_while_the_motors_power_on_sends_a_stop_and_returns_the_lease() {
     );
 }
 
+#[test]
+fn ctrl_c_while_standing_up_sends_a_stop_and_returns_the_lease() {
+    let fake = fake_spot!("example-ctrl-c-stand", &["--posture-seconds", "30"]);
+    let requests = interrupt_after(
+        &fake,
+        &[],
+        |r| is_command(r, "stand_request"),
+        "stand command",
+    );
+    // Interrupted while waiting for the stand: never walked.
+    assert!(
+        !requests
+            .iter()
+            .any(|r| is_command(r, "se2_velocity_request"))
+    );
+}
+
 /// The fake's true body pose in odom, `[x, y, yaw]`.
 fn true_pose(fake: &mut FakeSpot) -> [f64; 3] {
     poses(fake)[0]

@@ -18,7 +18,7 @@ walled room with a floor and two pillars fixed in odom, seen from the body's cur
 clouds of a robot that moves, for mapping and navigating. `--lease-held` starts with the body
 lease held by another client (the tablet): AcquireLease answers STATUS_RESOURCE_ALREADY_CLAIMED,
 TakeLease takes it. `--odom-scale K` makes the odometry (odom_T_body in the frame tree) count
-every motion K times while the clouds show the true pose. `--power-on-seconds S` makes a power-on take S seconds. The E-stop service
+every motion K times while the clouds show the true pose. `--power-on-seconds S` makes a power-on take S seconds, `--posture-seconds S` a stand or a sit. The E-stop service
 has one configuration with a `PDB_rooted` role: an endpoint registered there checks in with the
 complement of the last challenge, and the robot state lists it as a software E-stop, released
 while its last check-in was ESTOP_LEVEL_NONE within its timeout.
@@ -912,7 +912,7 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
             with self.r.lock:
                 self.r.velocity = (0.0, 0.0, 0.0)
                 self.r.posture_commands[self.r.command_id + 1] = (kind,
-                                                                  time.time() + POSTURE_SECONDS)
+                                                                  time.time() + self.r.args.posture_seconds)
             return Status.STATUS_OK
         return Status.STATUS_UNSUPPORTED
 
@@ -966,6 +966,8 @@ def main():
                         help="the odometry counts every motion this many times (1.05: 5 %% long)")
     parser.add_argument("--lease-held", action="store_true",
                         help="the body lease starts held by another client (the tablet)")
+    parser.add_argument("--posture-seconds", type=float, default=POSTURE_SECONDS,
+                        help="how long a stand or a sit takes")
     parser.add_argument("--power-on-seconds", type=float, default=POWER_ON_SECONDS,
                         help="how long a power-on takes")
     args = parser.parse_args()
