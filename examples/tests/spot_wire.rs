@@ -518,6 +518,59 @@ fn arrive_on_saved_map(
     assert_stopped_and_lease_returned(run2);
 }
 
+#[test]
+fn maps_a_room_by_turning_in_place_with_graph_slam_and_saves_it() {
+    let mut fake = fake_spot!(
+        "example-map-turn",
+        &["--world", "room", "--odom-scale", "1.2"]
+    );
+    let origin = true_pose(&mut fake);
+    let saved = fake.dir.join("map");
+    let (output, took) = finish(
+        spawn_example(
+            &fake,
+            &["--turn-rate", "1.0", "--save-map", saved.to_str().unwrap()],
+        ),
+        Duration::from_secs(60),
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stdout}\n{stderr}");
+    eprintln!("turning run: {took:?}\n{stdout}");
+    assert!(stdout.contains("turning once in place"), "{stdout}");
+    // The odometry counts every turn 1.2 times; the engine ends where the robot truly is.
+    let [truth, odometry] = poses(&mut fake);
+    let (truth, odometry) = (relative(origin, truth), relative(origin, odometry));
+    let estimate = numbers_after(&stdout, "mapping ended at");
+    let heading_error = |a: f64, b: f64| {
+        (a - b + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    };
+    assert!(
+        heading_error(estimate[2], truth[2]).abs() < 0.05 && estimate[0].hypot(estimate[1]) < 0.05,
+        "{estimate:?} against the truth {truth:?} (odometry {odometry:?})"
+    );
+    assert!(
+        heading_error(odometry[2], truth[2]).abs() > 0.5,
+        "{odometry:?} {truth:?}"
+    );
+    // A full circle truly turned (counted on the engine's estimate, not the odometry's).
+    assert!(heading_error(truth[2], 0.0).abs() < 0.15, "{truth:?}");
+    // The walls all round: the map spans the room (7 m by 6.5 m).
+    let map = slam_core::io::read_pcd(saved.join("map.pcd")).unwrap();
+    let (mut low, mut high) = ([f32::MAX; 2], [f32::MIN; 2]);
+    for p in map.points() {
+        for k in 0..2 {
+            low[k] = low[k].min(p[k]);
+            high[k] = high[k].max(p[k]);
+        }
+    }
+    assert!(
+        high[0] - low[0] > 6.0 && high[1] - low[1] > 6.0,
+        "{low:?} {high:?}"
+    );
+    assert_stopped_and_lease_returned(&fake.requests());
+}
+
 /// Run the example with `args` and no robot behind `--host` (nothing listens on port 1).
 fn without_robot(args: &[&str]) -> Output {
     let output = Command::new(common::example("spot"))

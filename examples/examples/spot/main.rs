@@ -15,7 +15,7 @@
 //! service goes to the engine with the body odometry of the robot state as its prior, while
 //! Spot walks the waypoints of `--route FILE` (one `x y` a line, metres in the start frame:
 //! the body's frame where the run started, x forward, y left; `#` comments) or, without a
-//! route, turns once in place at 0.3 rad/s. The occupancy grid is then built from the
+//! route, turns once in place at `--turn-rate` (0.3 rad/s). The occupancy grid is then built from the
 //! optimised keyframes, and `--save-map DIR` saves the map cloud (`map.pcd`, `map.ply`), the
 //! pose graph (`graph.g2o`) and the grid (`grid.yaml` + `grid.pgm`), all in the start frame.
 //! A later run navigates on it with `--map DIR` (no mapping), its pose in the map given by
@@ -85,6 +85,9 @@ struct Args {
     /// comments) instead of turning once in place.
     #[arg(long, value_name = "FILE")]
     route: Option<PathBuf>,
+    /// Without --route: the rate of the turn in place that maps, rad/s.
+    #[arg(long, default_value_t = 0.3, value_parser = positive)]
+    turn_rate: f64,
     /// Save the map made here (map.pcd, map.ply, graph.g2o, grid.yaml + grid.pgm) for --map.
     #[arg(long, value_name = "DIR")]
     save_map: Option<PathBuf>,
@@ -108,6 +111,14 @@ struct Args {
     /// At the end, sit and power the motors off.
     #[arg(long)]
     sit: bool,
+}
+
+/// A finite number above zero.
+fn positive(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("{text:?} is not a number above zero"))
 }
 
 /// The exit status after Ctrl-C (128 + SIGINT), as a shell reports it.
@@ -236,6 +247,7 @@ fn run(args: &Args, interrupt: &Arc<AtomicBool>) -> Result<bool> {
         let mapped = mapping::map_live(
             &mut spot,
             route.as_deref(),
+            args.turn_rate,
             args.max_speed,
             args.cycles,
             lidar_height,

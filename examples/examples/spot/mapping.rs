@@ -113,7 +113,7 @@ pub(crate) struct Mapped {
 }
 
 /// Map with the Graph-SLAM engine while Spot walks `route` (waypoints in the start frame) or,
-/// without one, turns once in place; at most `max_scans` scans.
+/// without one, turns once in place at `turn_rate` (rad/s); at most `max_scans` scans.
 ///
 /// # Errors
 /// Any robot error (the caller's client then stops the robot), a route not walked in
@@ -121,6 +121,7 @@ pub(crate) struct Mapped {
 pub(crate) fn map_live(
     spot: &mut SpotClient,
     route: Option<&[Vector2<f64>]>,
+    turn_rate: f64,
     max_speed: f64,
     max_scans: usize,
     lidar_height: f64,
@@ -160,14 +161,14 @@ pub(crate) fn map_live(
         let command = if let Some(follower) = follower.as_mut() {
             follower.command(&start_t_body)
         } else {
-            // The turn is counted on the odometry: it is what the robot did, whatever the
-            // engine made of the scans.
-            let yaw = sample.odom_t_body.rotation.euler_angles().2;
+            // The turn is counted on the engine's estimate: an odometry that over- or
+            // under-counts turns would end the turn short of or past a full circle.
+            let yaw = start_t_body.rotation.euler_angles().2;
             if let Some(last) = last_yaw {
                 turned += wrap_angle(yaw - last);
             }
             last_yaw = Some(yaw);
-            (turned < std::f64::consts::TAU).then(|| VelocityCommand::new(0.0, 0.3))
+            (turned < std::f64::consts::TAU).then(|| VelocityCommand::new(0.0, turn_rate))
         };
         match command {
             Some(command) => spot.send(&MobilityCommand::Velocity(command))?,
