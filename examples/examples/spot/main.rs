@@ -2,7 +2,8 @@
 //!
 //! ```text
 //! SPOT_PASSWORD=... cargo run --release --features grpc --example spot -- \
-//!     --host 192.168.80.3 --ca robot-ca.pem --user admin --password-env SPOT_PASSWORD --goal 3,0
+//!     --host 192.168.80.3 --ca robot-ca.pem --user admin --password-env SPOT_PASSWORD \
+//!     --route route.txt --save-map office --goal 3,0
 //! ```
 //!
 //! Connects (login, directory, time sync, body lease: a lease the tablet holds is refused,
@@ -15,9 +16,10 @@
 //! service goes to the engine with the body odometry of the robot state as its prior, while
 //! Spot walks the waypoints of `--route FILE` (one `x y` a line, metres in the start frame:
 //! the body's frame where the run started, x forward, y left; `#` comments) or, without a
-//! route, turns once in place at `--turn-rate` (0.3 rad/s). The occupancy grid is then built from the
-//! optimised keyframes, and `--save-map DIR` saves the map cloud (`map.pcd`, `map.ply`), the
-//! pose graph (`graph.g2o`) and the grid (`grid.yaml` + `grid.pgm`), all in the start frame.
+//! route, turns once in place at `--turn-rate` (0.3 rad/s). The occupancy grid is then built
+//! from the optimised keyframes, and `--save-map DIR` saves the map cloud (`map.pcd`,
+//! `map.ply`), the pose graph (`graph.g2o`) and the grid (`grid.yaml` + `grid.pgm`), all in the
+//! start frame.
 //! A later run navigates on it with `--map DIR` (no mapping), its pose in the map given by
 //! `--start X,Y,YAW` (`0,0,0` when it starts where the mapping run did); `--map` also takes a
 //! PCD file alone.
