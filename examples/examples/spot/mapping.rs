@@ -89,7 +89,7 @@ impl RouteFollower<'_> {
             let max_turn = self.limits.max_yaw_rate;
             let yaw_rate = (1.5 * error).clamp(-max_turn, max_turn);
             // Turn in place while the waypoint is well off the heading, then walk, slowing on
-            // the last half metre (never below a crawl that the robot still takes).
+            // the approach (0.8 m/s per metre left, never below a crawl the robot still takes).
             let forward = if error.abs() > 0.5 {
                 0.0
             } else {
