@@ -18,6 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "bosdyn/api/local_grid.proto",
         "bosdyn/api/robot_command.proto",
         "bosdyn/api/power.proto",
+        "bosdyn/api/estop.proto",
         "bosdyn/api/spot/robot_command.proto",
     ];
     println!("cargo::rerun-if-changed=proto");

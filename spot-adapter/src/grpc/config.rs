@@ -90,6 +90,14 @@ pub struct SpotConfig {
     pub call_timeout: Duration,
     /// How often the auth token is renewed (the robot's tokens live much longer): 30 min.
     pub token_refresh_interval: Duration,
+    /// Take the body lease (`TakeLease`, the tablet's "force take") instead of acquiring it
+    /// (`AcquireLease`, refused while another client such as the tablet holds it): `false`.
+    pub take_lease: bool,
+    /// Register a software E-stop endpoint of our own with this timeout (the robot cuts motor
+    /// power when no check-in arrives within it) and keep it alive, checking in every third
+    /// of it, as the SDK's `EstopEndpoint` and `EstopKeepAlive`: for a bench setup without an
+    /// E-stop controller. `None` (the default): the tablet's or a controller's E-stop is used.
+    pub software_estop: Option<Duration>,
     /// How often the lease is retained: 2 s, as the SDK's `LeaseKeepAlive`.
     pub lease_retain_interval: Duration,
     /// Time sync pacing.
@@ -131,6 +139,8 @@ impl SpotConfig {
             client_name: "spot-nav".to_owned(),
             call_timeout: Duration::from_secs(5),
             token_refresh_interval: Duration::from_secs(30 * 60),
+            take_lease: false,
+            software_estop: None,
             lease_retain_interval: Duration::from_secs(2),
             time_sync: TimeSyncConfig::default(),
             point_cloud_service: "velodyne-point-cloud".to_owned(),
@@ -170,6 +180,10 @@ impl SpotConfig {
             ("time_sync.resync_interval", self.time_sync.resync_interval),
             ("time_sync.max_age", self.time_sync.max_age),
             ("velocity_hold", self.velocity_hold),
+            (
+                "software_estop",
+                self.software_estop.unwrap_or(Duration::from_secs(1)),
+            ),
         ] {
             if value.is_zero() {
                 return bad(setting, "must be longer than zero");

@@ -94,12 +94,15 @@ pub enum SpotError {
         /// The configured bound, seconds.
         max_age: f64,
     },
-    /// The robot would not grant the lease.
+    /// The robot would not grant the lease: `STATUS_RESOURCE_ALREADY_CLAIMED` while another
+    /// client (the tablet) holds it, which [`SpotConfig::take_lease`] takes from it.
+    ///
+    /// [`SpotConfig::take_lease`]: crate::grpc::SpotConfig::take_lease
     #[error("the lease of {resource:?} was refused: {status} (held by {owner:?})")]
     LeaseRefused {
         /// The resource asked for (`body`).
         resource: String,
-        /// `AcquireLeaseResponse.Status` as named on the wire.
+        /// `AcquireLeaseResponse.Status` (or `TakeLeaseResponse.Status`) as named on the wire.
         status: &'static str,
         /// The client holding it, when the robot says.
         owner: String,
@@ -204,6 +207,14 @@ pub enum SpotError {
     NotMoving {
         /// Seconds commanded to move without the odometry changing.
         seconds: f64,
+    },
+    /// The robot refused our software E-stop endpoint or its check-in.
+    #[error("software E-stop: {method} answered {status}")]
+    EstopRefused {
+        /// `RegisterEstopEndpoint` or `EstopCheckIn`.
+        method: &'static str,
+        /// The response status as named on the wire.
+        status: &'static str,
     },
     /// The run was interrupted (Ctrl-C).
     #[error("interrupted")]

@@ -65,33 +65,47 @@ impl Session {
         Err(SpotError::LeaseLost { status, owner })
     }
 
-    /// Acquire the body lease.
-    pub(crate) async fn acquire_lease(&self) -> Result<(), SpotError> {
+    /// Acquire the body lease, or with `take` take it from whoever holds it (the SDK's
+    /// `LeaseClient.take`, as the tablet's "force take").
+    pub(crate) async fn acquire_lease(&self, take: bool) -> Result<(), SpotError> {
         let mut client = LeaseServiceClient::new(self.service("lease")?);
-        let request = api::AcquireLeaseRequest {
-            header: Some(self.header()),
-            resource: BODY_RESOURCE.to_owned(),
+        let (lease, status, owner) = if take {
+            let request = api::TakeLeaseRequest {
+                header: Some(self.header()),
+                resource: BODY_RESOURCE.to_owned(),
+            };
+            let response = self.rpc("TakeLease", client.take_lease(request)).await?;
+            check_header("TakeLease", response.header.as_ref())?;
+            let ok = response.status == api::take_lease_response::Status::Ok as i32;
+            let status = api::take_lease_response::Status::try_from(response.status)
+                .map_or("STATUS_UNRECOGNISED", |s| s.as_str_name());
+            (response.lease.filter(|_| ok), status, response.lease_owner)
+        } else {
+            let request = api::AcquireLeaseRequest {
+                header: Some(self.header()),
+                resource: BODY_RESOURCE.to_owned(),
+            };
+            let response = self
+                .rpc("AcquireLease", client.acquire_lease(request))
+                .await?;
+            check_header("AcquireLease", response.header.as_ref())?;
+            let ok = response.status == api::acquire_lease_response::Status::Ok as i32;
+            let status = api::acquire_lease_response::Status::try_from(response.status)
+                .map_or("STATUS_UNRECOGNISED", |s| s.as_str_name());
+            (response.lease.filter(|_| ok), status, response.lease_owner)
         };
-        let response = self
-            .rpc("AcquireLease", client.acquire_lease(request))
-            .await?;
-        check_header("AcquireLease", response.header.as_ref())?;
-        if response.status != api::acquire_lease_response::Status::Ok as i32 {
+        let Some(lease) = lease else {
             return Err(SpotError::LeaseRefused {
                 resource: BODY_RESOURCE.to_owned(),
-                status: api::acquire_lease_response::Status::try_from(response.status)
-                    .map_or("STATUS_UNRECOGNISED", |s| s.as_str_name()),
-                owner: response
-                    .lease_owner
-                    .map(|o| o.client_name)
-                    .unwrap_or_default(),
+                status,
+                owner: owner.map(|o| o.client_name).unwrap_or_default(),
             });
-        }
+        };
         let mut state = self
             .lease
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        state.lease = response.lease;
+        state.lease = Some(lease);
         state.lost = None;
         Ok(())
     }

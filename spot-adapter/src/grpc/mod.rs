@@ -18,6 +18,10 @@
 //!   returned on drop. Once the robot says the lease is not ours (another client took it),
 //!   every command is refused with [`SpotError::LeaseLost`].
 //!
+//! - With [`SpotConfig::software_estop`], a software E-stop endpoint of our own (bench setups
+//!   without an E-stop controller): registered at connection, checked in every third of its
+//!   timeout with the challenge answered, and set to `ESTOP_LEVEL_SETTLE_THEN_CUT` on drop.
+//!
 //! The `.proto` files in `proto/` are spot-nav's own subset, written from the wire facts; the
 //! tests prove it against the official `bosdyn-api` package acting as the robot.
 //!
@@ -42,6 +46,7 @@ mod clock;
 mod config;
 mod directory;
 mod error;
+mod estop;
 mod frame_tree;
 mod lease;
 mod local_grid;

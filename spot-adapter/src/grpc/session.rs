@@ -15,6 +15,7 @@ use crate::grpc::api;
 use crate::grpc::clock;
 use crate::grpc::config::SpotConfig;
 use crate::grpc::error::SpotError;
+use crate::grpc::estop::EstopState;
 use crate::grpc::lease::LeaseState;
 use crate::grpc::time_sync::ClockSync;
 
@@ -76,6 +77,8 @@ pub(crate) struct Session {
     pub(crate) token_text: Mutex<String>,
     pub(crate) clock: Mutex<ClockSync>,
     pub(crate) lease: Mutex<LeaseState>,
+    /// Our software E-stop endpoint, when one is registered.
+    pub(crate) estop: Mutex<EstopState>,
 }
 
 impl Session {
@@ -92,6 +95,7 @@ impl Session {
             token_text: Mutex::default(),
             clock: Mutex::default(),
             lease: Mutex::default(),
+            estop: Mutex::default(),
         };
         for authority in [AUTH_AUTHORITY, DIRECTORY_AUTHORITY, ROBOT_ID_AUTHORITY] {
             session.add_channel(authority)?;

@@ -13,6 +13,7 @@ use tokio::task::JoinHandle;
 use crate::grpc::config::SpotConfig;
 use crate::grpc::directory::RobotIdentity;
 use crate::grpc::error::SpotError;
+use crate::grpc::estop::StopLevel;
 use crate::grpc::frame_tree::FrameTree;
 use crate::grpc::local_grid::LocalGrid;
 use crate::grpc::point_cloud::SpotCloud;
@@ -94,7 +95,13 @@ impl SpotClient {
             let identity = session.robot_id().await?;
             session.read_directory().await?;
             session.converge_time_sync().await?;
-            session.acquire_lease().await?;
+            session.acquire_lease(session.config.take_lease).await?;
+            if let Some(timeout) = session.config.software_estop
+                && let Err(error) = session.register_estop(timeout).await
+            {
+                let _ = session.return_lease().await;
+                return Err(error);
+            }
             Ok::<_, SpotError>(identity)
         })?;
         let background = spawn_background(&runtime, &session);
@@ -203,7 +210,7 @@ impl SpotClient {
     /// [`SpotError::Faulted`], [`SpotError::LeaseLost`] and any call's error.
     pub fn power_on(&self) -> Result<(), SpotError> {
         let timeout = self.session.config.power_timeout;
-        self.runtime.block_on(self.session.power_on(timeout))
+        self.interruptible(self.session.power_on(timeout))
     }
 
     /// Stand (the SDK's `blocking_stand`): a synchronized stand command, then its feedback
@@ -214,8 +221,7 @@ impl SpotClient {
     /// any call's error.
     pub fn stand(&self) -> Result<(), SpotError> {
         let timeout = self.session.config.posture_timeout;
-        self.runtime
-            .block_on(self.session.blocking_posture(Posture::Stand, timeout))
+        self.interruptible(self.session.blocking_posture(Posture::Stand, timeout))
     }
 
     /// Sit (the SDK's `blocking_sit`), within [`SpotConfig::posture_timeout`].
@@ -240,9 +246,31 @@ impl SpotClient {
     }
 
     /// A flag that, once raised (by a Ctrl-C handler), makes the next sample or command fail
-    /// with [`SpotError::Interrupted`].
+    /// with [`SpotError::Interrupted`], and ends a power-on or a stand being waited for.
     pub fn set_interrupt(&mut self, flag: Arc<AtomicBool>) {
         self.interrupt = Some(flag);
+    }
+
+    /// Run `step` to its end, or until the interrupt flag is raised (checked every 50 ms):
+    /// then [`SpotError::Interrupted`], the step's remaining polls dropped.
+    fn interruptible<T>(
+        &self,
+        step: impl Future<Output = Result<T, SpotError>>,
+    ) -> Result<T, SpotError> {
+        self.check_interrupt()?;
+        let Some(flag) = self.interrupt.clone() else {
+            return self.runtime.block_on(step);
+        };
+        self.runtime.block_on(async move {
+            tokio::select! {
+                result = step => result,
+                () = async {
+                    while !flag.load(Ordering::Relaxed) {
+                        tokio::time::sleep(Duration::from_millis(50)).await;
+                    }
+                } => Err(SpotError::Interrupted),
+            }
+        })
     }
 
     fn check_interrupt(&self) -> Result<(), SpotError> {
@@ -421,7 +449,9 @@ impl Drop for SpotClient {
         // ends and takes the lease back when retains stop.
         let _ = self.runtime.block_on(async {
             let _ = self.session.send_stop().await;
-            self.session.return_lease().await
+            let returned = self.session.return_lease().await;
+            let _ = self.session.estop_check_in(StopLevel::SettleThenCut).await;
+            returned
         });
     }
 }
@@ -433,7 +463,8 @@ fn spawn_background(runtime: &Runtime, session: &Arc<Session>) -> Vec<JoinHandle
     let retain = Arc::clone(session);
     let sync = Arc::clone(session);
     let renew = Arc::clone(session);
-    vec![
+    let estop = Arc::clone(session);
+    let mut tasks = vec![
         runtime.spawn(async move {
             let mut ticks = ticks(retain.config.lease_retain_interval);
             loop {
@@ -461,7 +492,18 @@ fn spawn_background(runtime: &Runtime, session: &Arc<Session>) -> Vec<JoinHandle
                 };
             }
         }),
-    ]
+    ];
+    if let Some(timeout) = estop.config.software_estop {
+        // The SDK's `EstopKeepAlive`: a check-in every third of the endpoint's timeout.
+        tasks.push(runtime.spawn(async move {
+            let mut ticks = ticks(timeout / 3);
+            loop {
+                ticks.tick().await;
+                let _ = estop.estop_check_in(StopLevel::None).await;
+            }
+        }));
+    }
+    tasks
 }
 
 /// Ticks every `period`, the first one `period` from now; late ticks are not bunched up.

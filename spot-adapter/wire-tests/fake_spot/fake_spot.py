@@ -13,11 +13,20 @@ The robot state lists one hardware E-stop, released (`--estop asserted`, or `--e
 endpoint), and the faults `--behavior-fault` (CAUSE_FALL, clearable) and `--system-fault NAME`
 ask for. `--frozen` takes every command and never moves; `--refuse-motion` refuses every
 velocity and trajectory command (STATUS_BEHAVIOR_FAULT); `--stale-cloud` serves the same scan
-(one acquisition time) again and again.
+(one acquisition time) again and again. `--world room` serves, instead of the known helix, a
+walled room with a floor and two pillars fixed in odom, seen from the body's current pose: the
+clouds of a robot that moves, for mapping and navigating. `--lease-held` starts with the body
+lease held by another client (the tablet): AcquireLease answers STATUS_RESOURCE_ALREADY_CLAIMED,
+TakeLease takes it. `--odom-scale K` makes the odometry (odom_T_body in the frame tree) count
+every motion K times while the clouds show the true pose. `--power-on-seconds S` makes a power-on take S seconds, `--posture-seconds S` a stand or a sit. The E-stop service
+has one configuration with a `PDB_rooted` role: an endpoint registered there checks in with the
+complement of the last challenge, and the robot state lists it as a software E-stop, released
+while its last check-in was ESTOP_LEVEL_NONE within its timeout.
 
 Start-up prints one line `READY <port>` on stdout once the server listens; `<dir>/ca.pem` then
 holds the CA. Control lines (answered `OK <line>`): take-lease, stall-time-sync, malformed-cloud,
-drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
+pose (answered `OK pose <x> <y> <yaw> <x> <y> <yaw>`, the body's true pose in odom, then
+the odometry's), drop (stop serving and exit); a simulator feeds scans with `scan <file> <odom_T_body>
 <body_T_lidar>` and reads the command that answered with `wait-command <seconds>`.
 """
 
@@ -45,7 +54,8 @@ from bosdyn.api import (basic_command_pb2, power_pb2, power_service_pb2_grpc, au
                         local_grid_service_pb2_grpc, point_cloud_pb2, point_cloud_service_pb2_grpc,
                         robot_command_pb2, robot_command_service_pb2_grpc, robot_id_pb2,
                         robot_id_service_pb2_grpc, robot_state_pb2, robot_state_service_pb2_grpc,
-                        header_pb2, time_sync_pb2, time_sync_service_pb2_grpc)
+                        header_pb2, time_sync_pb2, time_sync_service_pb2_grpc, estop_pb2,
+                        estop_service_pb2_grpc)
 from bosdyn.api.spot import robot_command_pb2 as spot_command_pb2
 
 CLOCK_ID = "fake-spot-clock"
@@ -59,6 +69,7 @@ SERVICES = {
     "robot-state": ("bosdyn.api.RobotStateService", "robot-state.spot.robot"),
     "robot-command": ("bosdyn.api.RobotCommandService", "command.spot.robot"),
     "power": ("bosdyn.api.PowerService", "power.spot.robot"),
+    "estop": ("bosdyn.api.EstopService", "estop.spot.robot"),
     "velodyne-point-cloud": ("bosdyn.api.PointCloudService", "velodyne.spot.robot"),
     "local-grid-service": ("bosdyn.api.LocalGridService", "local-grid.spot.robot"),
 }
@@ -72,6 +83,31 @@ ODOM_T_VISION = (0.5, -0.25, 0.1)
 def known_points(n=120):
     """The cloud the fake serves: n points on a known helix (the tests recompute it)."""
     return [(0.05 * i, -0.02 * i, 0.01 * (i % 7)) for i in range(n)]
+
+
+def room_points():
+    """The `--world room` points in odom: walls x -2..5, y -1..5.5 from the floor (z -0.5) to
+    z 1.5 every 0.1 m, the floor every 0.25 m, and two 0.4 m pillars away from the middle."""
+    points = []
+    x0, x1, y0, y1 = -2.0, 5.0, -1.0, 5.5
+    heights = [-0.5 + 0.1 * k for k in range(21)]
+    nx, ny = int(round((x1 - x0) / 0.1)), int(round((y1 - y0) / 0.1))
+    for z in heights:
+        for i in range(nx + 1):
+            x = x0 + 0.1 * i
+            points += [(x, y0, z), (x, y1, z)]
+        for j in range(1, ny):
+            y = y0 + 0.1 * j
+            points += [(x0, y, z), (x1, y, z)]
+        for cx, cy in ((3.8, 4.3), (-1.0, -0.2)):
+            for k in range(5):
+                d = -0.2 + 0.1 * k
+                points += [(cx + d, cy - 0.2, z), (cx + d, cy + 0.2, z),
+                           (cx - 0.2, cy + d, z), (cx + 0.2, cy + d, z)]
+    for i in range(int((x1 - x0) / 0.25) + 1):
+        for j in range(int((y1 - y0) / 0.25) + 1):
+            points.append((x0 + 0.25 * i, y0 + 0.25 * j, -0.5))
+    return points
 
 
 def grid_value(x, y):
@@ -128,7 +164,10 @@ class Robot:
         self.time_sync_rounds = {}  # client name -> [(rtt, skew)]
         self.time_sync_stalled = False
         self.malformed_cloud = False
-        self.pose = [1.0, 2.0, 0.3]  # odom_T_body x, y, yaw
+        self.pose = [1.0, 2.0, 0.3]  # the body's true pose in odom: x, y, yaw
+        # What the odometry says (odom_T_body in the frame tree): the true pose unless
+        # --odom-scale makes it over- or under-count every motion.
+        self.odom_pose = list(self.pose)
         self.velocity = (0.0, 0.0, 0.0)  # body frame vx, vy, wz
         self.velocity_end = 0.0  # robot-clock seconds
         self.command_id = 0
@@ -142,6 +181,11 @@ class Robot:
         self.standing = self.motors_on
         self.posture_commands = {}  # command id -> (kind, host time it completes)
         self.started = self.now()
+        # Software E-stop: the registered endpoint, its challenge, level and last check-in.
+        self.estop_endpoint = None
+        self.estop_challenge = None
+        self.estop_level = estop_pb2.ESTOP_LEVEL_CUT
+        self.estop_checked_in = 0.0  # host time
 
     def now(self):
         """Robot clock, seconds."""
@@ -192,12 +236,17 @@ class Robot:
             x, y, yaw = self.pose
             c, s = math.cos(yaw), math.sin(yaw)
             self.pose = [x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, yaw + wz * dt]
+            k = self.args.odom_scale
+            x, y, yaw = self.odom_pose
+            c, s = math.cos(yaw), math.sin(yaw)
+            self.odom_pose = [x + (c * vx - s * vy) * dt * k, y + (s * vx + c * vy) * dt * k,
+                              yaw + wz * dt * k]
 
     def snapshot(self):
         """Frame tree rooted at body, as Spot sends it: odom, vision and the LiDAR below it."""
         snap = geometry_pb2.FrameTreeSnapshot()
         with self.lock:
-            x, y, yaw = self.pose
+            x, y, yaw = self.odom_pose
             bridged = self.bridge_scan
         if bridged is not None:
             # Rooted at odom: the simulator's odometry and LiDAR mounting as given.
@@ -499,6 +548,17 @@ class RobotStateServicer(robot_state_service_pb2_grpc.RobotStateServiceServicer)
             estop.state = (robot_state_pb2.EStopState.STATE_ESTOPPED
                            if self.r.args.estop == "asserted"
                            else robot_state_pb2.EStopState.STATE_NOT_ESTOPPED)
+        with self.r.lock:
+            endpoint = self.r.estop_endpoint
+            released = (endpoint is not None
+                        and self.r.estop_level == estop_pb2.ESTOP_LEVEL_NONE
+                        and time.time() - self.r.estop_checked_in
+                        < endpoint.timeout.seconds + endpoint.timeout.nanos * 1e-9)
+        if endpoint is not None:
+            software = state.estop_states.add(name=endpoint.name,
+                                              type=robot_state_pb2.EStopState.TYPE_SOFTWARE)
+            software.state = (robot_state_pb2.EStopState.STATE_NOT_ESTOPPED if released
+                              else robot_state_pb2.EStopState.STATE_ESTOPPED)
         if self.r.args.behavior_fault:
             state.behavior_fault_state.faults.add(
                 behavior_fault_id=7, cause=robot_state_pb2.BehaviorFault.CAUSE_FALL,
@@ -515,10 +575,11 @@ class RobotStateServicer(robot_state_service_pb2_grpc.RobotStateServiceServicer)
 
 
 class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
-    """Serves `velodyne-point-cloud`: the known points, a new scan every 0.1 s."""
+    """Serves `velodyne-point-cloud`: the known points (or the room), a new scan every 0.1 s."""
 
     def __init__(self, robot):
         self.r = robot
+        self.room = None
 
     def GetPointCloud(self, request, context):
         received = self.r.now()
@@ -541,6 +602,9 @@ class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
             if bridged is not None:
                 data, scan_time = bridged[0], bridged[1]
                 count = len(data) // 12
+            elif self.r.args.world == "room":
+                data, count = self.room_scan()
+                scan_time = math.floor(self.r.now() * 10.0) / 10.0
             else:
                 points = known_points()
                 data = b"".join(struct.pack("<3f", *p) for p in points)
@@ -552,6 +616,22 @@ class PointClouds(point_cloud_service_pb2_grpc.PointCloudServiceServicer):
             cloud.data = data
         response.header.CopyFrom(self.r.header(request, received))
         return response
+
+
+    def room_scan(self):
+        """The room's points in the LiDAR frame at the body's current pose."""
+        with self.r.lock:
+            x, y, yaw = self.r.pose
+        if self.room is None:
+            self.room = room_points()
+        c, s = math.cos(yaw), math.sin(yaw)
+        bx, by, bz = BODY_T_VELODYNE
+        lx, ly = x + c * bx - s * by, y + s * bx + c * by
+        out = []
+        for px, py, pz in self.room:
+            dx, dy = px - lx, py - ly
+            out.append(struct.pack("<3f", c * dx + s * dy, -s * dx + c * dy, pz - bz))
+        return b"".join(out), len(out)
 
 
 class LocalGrids(local_grid_service_pb2_grpc.LocalGridServiceServicer):
@@ -627,6 +707,81 @@ POWER_ON_SECONDS = 0.5
 POSTURE_SECONDS = 0.3
 
 
+class Estop(estop_service_pb2_grpc.EstopServiceServicer):
+    """One configuration, `fake-estop-config`, with a `PDB_rooted` role to register into."""
+
+    CONFIG_ID = "fake-estop-config"
+
+    def __init__(self, robot):
+        self.r = robot
+
+    def config(self):
+        config = estop_pb2.EstopConfig(unique_id=self.CONFIG_ID)
+        endpoint = config.endpoints.add(role="PDB_rooted")
+        if self.r.estop_endpoint is not None:
+            endpoint.CopyFrom(self.r.estop_endpoint)
+        return config
+
+    def GetEstopConfig(self, request, context):
+        received = self.r.now()
+        self.r.record("GetEstopConfig", context, request)
+        response = estop_pb2.GetEstopConfigResponse()
+        response.request.CopyFrom(request)
+        with self.r.lock:
+            response.active_config.CopyFrom(self.config())
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
+
+    def RegisterEstopEndpoint(self, request, context):
+        received = self.r.now()
+        self.r.record("RegisterEstopEndpoint", context, request)
+        response = estop_pb2.RegisterEstopEndpointResponse()
+        response.request.CopyFrom(request)
+        with self.r.lock:
+            if request.target_config_id != self.CONFIG_ID:
+                response.status = estop_pb2.RegisterEstopEndpointResponse.STATUS_CONFIG_MISMATCH
+            elif request.target_endpoint.role != "PDB_rooted" or \
+                    request.new_endpoint.role != "PDB_rooted":
+                response.status = estop_pb2.RegisterEstopEndpointResponse.STATUS_ENDPOINT_MISMATCH
+            else:
+                endpoint = estop_pb2.EstopEndpoint()
+                endpoint.CopyFrom(request.new_endpoint)
+                endpoint.unique_id = secrets.token_hex(4)
+                self.r.estop_endpoint = endpoint
+                self.r.estop_challenge = None
+                self.r.estop_level = estop_pb2.ESTOP_LEVEL_CUT
+                response.new_endpoint.CopyFrom(endpoint)
+                response.status = estop_pb2.RegisterEstopEndpointResponse.STATUS_SUCCESS
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
+
+    def EstopCheckIn(self, request, context):
+        received = self.r.now()
+        self.r.record("EstopCheckIn", context, request,
+                      answered=(self.r.estop_challenge is not None and
+                                request.challenge == self.r.estop_challenge and
+                                request.response == (~self.r.estop_challenge) & (2**64 - 1)))
+        response = estop_pb2.EstopCheckInResponse()
+        response.request.CopyFrom(request)
+        with self.r.lock:
+            endpoint = self.r.estop_endpoint
+            if endpoint is None or request.endpoint.unique_id != endpoint.unique_id:
+                response.status = estop_pb2.EstopCheckInResponse.STATUS_ENDPOINT_UNKNOWN
+            elif (self.r.estop_challenge is None or request.challenge != self.r.estop_challenge
+                  or request.response != (~self.r.estop_challenge) & (2**64 - 1)):
+                response.status = \
+                    estop_pb2.EstopCheckInResponse.STATUS_INCORRECT_CHALLENGE_RESPONSE
+            else:
+                response.status = estop_pb2.EstopCheckInResponse.STATUS_OK
+                self.r.estop_level = request.stop_level
+                self.r.estop_checked_in = time.time()
+            if endpoint is not None:
+                self.r.estop_challenge = secrets.randbits(64)
+                response.challenge = self.r.estop_challenge
+        response.header.CopyFrom(self.r.header(request, received))
+        return response
+
+
 class Power(power_service_pb2_grpc.PowerServiceServicer):
     """Motor power on and off; refused while E-stopped."""
 
@@ -651,7 +806,7 @@ class Power(power_service_pb2_grpc.PowerServiceServicer):
                 if self.r.power() == robot_state_pb2.PowerState.MOTOR_POWER_STATE_ON:
                     response.status = power_pb2.STATUS_SUCCESS
                 else:
-                    self.r.powering_on_until = time.time() + POWER_ON_SECONDS
+                    self.r.powering_on_until = time.time() + self.r.args.power_on_seconds
                     response.status = power_pb2.STATUS_IN_PROGRESS
             elif request.request == power_pb2.PowerCommandRequest.REQUEST_OFF_MOTORS:
                 self.r.motors_on = self.r.standing = False
@@ -757,7 +912,7 @@ class Commands(robot_command_service_pb2_grpc.RobotCommandServiceServicer):
             with self.r.lock:
                 self.r.velocity = (0.0, 0.0, 0.0)
                 self.r.posture_commands[self.r.command_id + 1] = (kind,
-                                                                  time.time() + POSTURE_SECONDS)
+                                                                  time.time() + self.r.args.posture_seconds)
             return Status.STATUS_OK
         return Status.STATUS_UNSUPPORTED
 
@@ -805,12 +960,24 @@ def main():
     parser.add_argument("--frozen", action="store_true", help="take commands, never move")
     parser.add_argument("--refuse-motion", action="store_true", help="refuse every motion")
     parser.add_argument("--stale-cloud", action="store_true", help="one scan, served forever")
+    parser.add_argument("--world", choices=("helix", "room"), default="helix",
+                        help="the clouds: the known helix, or a room seen from the body's pose")
+    parser.add_argument("--odom-scale", type=float, default=1.0,
+                        help="the odometry counts every motion this many times (1.05: 5 %% long)")
+    parser.add_argument("--lease-held", action="store_true",
+                        help="the body lease starts held by another client (the tablet)")
+    parser.add_argument("--posture-seconds", type=float, default=POSTURE_SECONDS,
+                        help="how long a stand or a sit takes")
+    parser.add_argument("--power-on-seconds", type=float, default=POWER_ON_SECONDS,
+                        help="how long a power-on takes")
     args = parser.parse_args()
     robot = Robot(args)
     key_pem, cert_pem = make_certificates(args.dir)
     server = grpc.server(futures.ThreadPoolExecutor(max_workers=8),
                          interceptors=[TokenCheck(robot)])
     leases = Leases(robot)
+    if args.lease_held:
+        leases.grant("tablet")
     auth_service_pb2_grpc.add_AuthServiceServicer_to_server(Auth(robot), server)
     directory_service_pb2_grpc.add_DirectoryServiceServicer_to_server(Directory(robot), server)
     robot_id_service_pb2_grpc.add_RobotIdServiceServicer_to_server(RobotIdServicer(robot), server)
@@ -823,6 +990,7 @@ def main():
     robot_command_service_pb2_grpc.add_RobotCommandServiceServicer_to_server(
         Commands(robot, leases), server)
     power_service_pb2_grpc.add_PowerServiceServicer_to_server(Power(robot, leases), server)
+    estop_service_pb2_grpc.add_EstopServiceServicer_to_server(Estop(robot), server)
     port = server.add_secure_port("127.0.0.1:0", grpc.ssl_server_credentials([(key_pem, cert_pem)]))
     server.start()
     print("READY %d" % port, flush=True)
@@ -838,6 +1006,13 @@ def main():
             robot.time_sync_stalled = True
         elif line == "malformed-cloud":
             robot.malformed_cloud = True
+        elif line == "pose":
+            # The body's true pose in odom, then the odometry's: x y yaw x y yaw.
+            robot.step()
+            with robot.lock:
+                pose = robot.pose + robot.odom_pose
+            print("OK pose " + " ".join(repr(v) for v in pose), flush=True)
+            continue
         elif line.startswith("scan "):
             # scan <file of little-endian f32 xyz> <odom_T_body: 7 numbers> <body_T_lidar: 7>
             words = line.split()

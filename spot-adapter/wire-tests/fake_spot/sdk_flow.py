@@ -4,7 +4,10 @@ Authenticates, syncs time, takes the lease, reads the robot state, the point clo
 grids, sends a velocity and a trajectory command and a stop, returns the lease, and prints one
 JSON line with what it read. With `--power` it instead brings the robot up and down as a user's
 script does: `robot.power_on`, `blocking_stand`, `blocking_sit`, `robot.power_off` (a safe power
-off), then returns the lease; the fake's log then holds the SDK's requests for the tests to compare
+off), then returns the lease. With `--take` it takes the lease (`LeaseClient.take`, as from the
+tablet) and returns it. With `--estop SECONDS` it registers a software E-stop endpoint with that
+timeout (`EstopEndpoint.register` in the active configuration), keeps it alive with
+`EstopKeepAlive` for one timeout, then checks in at SETTLE_THEN_CUT and stops. The fake's log then holds the SDK's requests for the tests to compare
 with spot-nav's. Any SDK exception fails the script (exit status 1).
 """
 
@@ -30,6 +33,9 @@ def main():
     parser.add_argument("--username", default="user")
     parser.add_argument("--password", default="password")
     parser.add_argument("--power", action="store_true", help="power on, stand, sit, power off")
+    parser.add_argument("--take", action="store_true", help="take the lease and return it")
+    parser.add_argument("--estop", type=float, default=0.0,
+                        help="register a software E-stop with this timeout and keep it alive")
     args = parser.parse_args()
 
     sdk = bosdyn.client.create_standard_sdk("spot-nav-sdk-check")
@@ -40,7 +46,15 @@ def main():
     robot_id = robot.get_id()
     robot.time_sync.wait_for_sync(timeout_sec=10)
     skew = robot.time_sync.get_robot_clock_skew()
+    if args.estop > 0.0:
+        estop_flow(robot, args.estop)
+        return
     lease_client = robot.ensure_client(LeaseClient.default_service_name)
+    if args.take:
+        lease = lease_client.take()
+        lease_client.return_lease(lease)
+        print(json.dumps({"taken": list(lease.lease_proto.sequence)}), flush=True)
+        return
     lease = lease_client.acquire()
     if args.power:
         power_flow(robot, lease_client, lease)
@@ -69,6 +83,20 @@ def main():
         "num_points": clouds[0].point_cloud.num_points,
         "grids": [g.local_grid.local_grid_type_name for g in grids],
     }), flush=True)
+
+
+def estop_flow(robot, timeout):
+    """Register a software E-stop endpoint, keep it alive for `timeout`, then settle and cut."""
+    from bosdyn.client.estop import EstopClient, EstopEndpoint, EstopKeepAlive
+    client = robot.ensure_client(EstopClient.default_service_name)
+    config = client.get_config()
+    endpoint = EstopEndpoint(client, "spot-nav", estop_timeout=timeout)
+    endpoint.register(config.unique_id)
+    keep_alive = EstopKeepAlive(endpoint)
+    time.sleep(timeout)
+    keep_alive.settle_then_cut()
+    keep_alive.shutdown()
+    print(json.dumps({"estop": endpoint.unique_id}), flush=True)
 
 
 def power_flow(robot, lease_client, lease):

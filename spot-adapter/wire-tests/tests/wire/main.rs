@@ -12,6 +12,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod estop;
 mod power;
 mod robot;
 mod session;

@@ -308,3 +308,60 @@ fn a_command_answered_with_a_newer_lease_marks_the_lease_lost() {
     );
     assert!(spot.lease_lost().is_some());
 }
+
+/// A request's fields without its header (whose client name and time differ between clients).
+fn without_header(request: &Value) -> Value {
+    let mut request = request["request"].clone();
+    request.as_object_mut().unwrap().remove("header");
+    request
+}
+
+#[test]
+fn a_lease_the_tablet_holds_is_refused_and_taken_with_take_lease_as_the_sdk_takes_it() {
+    let fake = fake_spot!("lease-held", &["--lease-held"]);
+    let error = SpotClient::connect(fake.config()).expect_err("the lease is the tablet's");
+    assert!(
+        matches!(
+            &error,
+            SpotError::LeaseRefused { status: "STATUS_RESOURCE_ALREADY_CLAIMED", owner, .. }
+                if owner == "tablet"
+        ),
+        "{error:?}"
+    );
+    assert!(fake.requests_of("TakeLease").is_empty());
+
+    let mut config = fake.config();
+    config.take_lease = true;
+    let mut spot = SpotClient::connect(config).expect("the lease is taken");
+    spot.send(&VelocityCommand::new(0.2, 0.0).into()).unwrap();
+    drop(spot);
+    let commands = fake.requests_of("RobotCommand");
+    assert_eq!(commands[0]["request"]["lease"]["sequence"][0], 2);
+    let ours = fake.requests_of("TakeLease");
+    assert_eq!(ours.len(), 1);
+    let returned = fake.requests_of("ReturnLease");
+    assert_eq!(returned.len(), 1);
+    assert_eq!(returned[0]["request"]["lease"]["sequence"][0], 2);
+
+    // The official client's `LeaseClient.take` against the same fake.
+    support::run_sdk_flow(&fake, &["--take"]);
+    let sdk = fake.requests_of("TakeLease");
+    assert_eq!(sdk.len(), 2);
+    assert_eq!(without_header(&ours[0]), without_header(&sdk[1]));
+    assert_eq!(
+        without_header(&ours[0]),
+        serde_json::json!({"resource": "body"})
+    );
+    assert_eq!(ours[0]["authority"], sdk[1]["authority"]);
+    let fields = |r: &Value| {
+        let mut keys: Vec<String> = r["request"]["header"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect();
+        keys.sort();
+        keys
+    };
+    assert_eq!(fields(&ours[0]), fields(&sdk[1]));
+}
