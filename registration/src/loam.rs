@@ -397,6 +397,12 @@ impl MapRegistrator for LoamRegistrator {
         source
     }
 
+    /// `None`: the features run along each ring in firing order, so a scan must come as the
+    /// sensor gave it.
+    fn source_voxel(&self) -> Option<f32> {
+        None
+    }
+
     /// A local map with the local-map voxels, updated in place as keyframes enter and leave.
     fn empty_map(&self) -> Option<Self::Target> {
         let c = &self.config;
