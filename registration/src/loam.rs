@@ -16,6 +16,11 @@ use crate::voxel_hash_map::VoxelHashMap;
 
 /// Settings of [`LoamRegistrator`]. Lengths in metres, angles in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LoamConfig {
     /// Feature extraction.
     pub features: LoamFeatureConfig,
