@@ -1,6 +1,7 @@
 //! `--print-config` and `--config FILE` of the examples that have settings (`slam`, `mission`,
 //! `register`): the printed defaults are TOML that reads back to the same settings; a field
-//! changed in a file takes effect, an option given on the command line wins over the file; a
+//! changed in a file takes effect (in the printed settings, and in a run of `register` and
+//! `slam`), an option given on the command line wins over the file; a
 //! misspelt field or a value of the wrong type fails naming the file and the field.
 #![allow(clippy::expect_used, clippy::panic)]
 
@@ -205,6 +206,13 @@ fn slam_settings_round_trip_take_effect_and_yield_to_options() {
         value(&printed, "slam.keyframe_distance").as_float(),
         Some(0.5)
     );
+    // A run with a file that asks more points of a scan than the simulated LiDAR gives: every
+    // scan is skipped, and the example fails saying so (about 3 s of simulation).
+    let path = write(&dir, "skip.toml", "[slam]\nmin_scan_points = 100000000\n");
+    let out = run("slam", &["--config", &path]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("accepted none of the"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
     bad_fields(
         "slam",
