@@ -13,35 +13,38 @@
 //! 2. Navigation: from where the lap ended, the navigator walks Spot to the entry of the room
 //!    farthest away, planning with `OwnPlanner`. Prints how far the true body ended from it.
 //!
+//! The loop refinement's ICP settings (an `IcpConfig`) and the navigator's (a `NavigatorConfig`)
+//! come from a TOML file, `examples/config/own_backends.toml` unless `--config` names another,
+//! read with serde and the `toml` crate: fields the file leaves out keep their defaults.
+//!
+//! Like a crate of your own, this file uses nothing of spot-nav but the one `spot-adapter`
+//! dependency (with its `serde` feature): the prelude, and the backend crates it re-exports.
+//!
 //! Exits with status 1 when the ATE exceeds `--max-ate`, a backend was never called, or the
 //! goal was not reached within 0.10 m.
 //!
-//! `cargo run --release -p spot-nav-examples --example own_backends -- [--seed N] [--max-ate M]`
+//! `cargo run --release -p spot-nav-examples --example own_backends -- [--seed N] [--max-ate M] [--config FILE]`
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use std::path::PathBuf;
+
 use anyhow::{Context, Result, bail};
 use clap::Parser;
-use gridmap::PlanningGrid;
-use nalgebra::Point3;
-use pathfind::movement::DIRECTIONS;
-use posegraph::LevenbergMarquardt;
-use registration::{IcpConfig, IcpKernel, PointToPlaneIcp, PointToPointIcp};
-use slam_core::{
-    Alignment, BitGrid, Cell, GraphSlam, GridPath, MapRegistrator, OptimizationReport,
-    OptimizeError, Optimizer, PlanError, Planner, PointCloud, Pose3, PoseGraph, Reach,
-    RegistrationError, Registrator, SweepAlignment, validate_endpoints,
+use serde::Deserialize;
+use spot_adapter::pathfind::movement::DIRECTIONS;
+use spot_adapter::prelude::{
+    Alignment, Cell, CommandedSpot, DriveOutcome, GraphSlam, GridPath, IcpConfig,
+    LevenbergMarquardt, MapRegistrator, NavPlanner, NavigationMap, Navigator, NavigatorConfig,
+    OptimizationReport, OptimizeError, Optimizer, PlanError, Planner, PlanningGrid, Point3,
+    PointCloud, PointToPlaneIcp, PointToPointIcp, Pose3, PoseGraph, RegistrationError, Registrator,
+    Robot, SimulatedSpot, SimulationConfig, TrajectoryEvaluation, drive, point_to_plane_localiser,
+    point_to_plane_tracker, slam_config,
 };
-use spot_adapter::eval::TrajectoryEvaluation;
-use spot_adapter::nav::{
-    DriveOutcome, NavPlanner, NavigationMap, NavigationMapConfig, Navigator, NavigatorConfig, drive,
-};
-use spot_adapter::pipelines::{point_to_plane_localiser, point_to_plane_tracker, slam_config};
-use spot_adapter::robot::Robot;
-use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
+use spot_adapter::slam_core::{BitGrid, Reach, SweepAlignment, validate_endpoints};
 use spot_nav_examples::out;
 
 /// A goal counts as reached within this distance of the true body (metres).
@@ -61,12 +64,41 @@ struct Args {
     /// Fail above this absolute trajectory error of the mapping lap (metres, RMS).
     #[arg(long, default_value_t = 0.05)]
     max_ate: f64,
+    /// The settings file (TOML: `[icp]`, `[navigator]`) [default: the bundled
+    /// `examples/config/own_backends.toml`].
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
 }
 
 // ---------------------------------------------------------------------------------------------
-// A registrator: ours, wrapped. Every method is forwarded, the defaulted ones too: a wrapper
-// that left out `empty_map`/`add_to_map`/`remove_from_map` would still compile, and the engine
-// would rebuild its local map whole for every keyframe instead of sliding it in place.
+// Settings from a file: spot-nav's configuration structs with its `serde` feature, each under a
+// table. `serde(default)` here and on each struct: what the file leaves out keeps its default.
+
+/// The settings file.
+#[derive(Debug, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct Settings {
+    /// The loop refinement's point-to-plane ICP.
+    icp: IcpConfig,
+    /// The navigator, and the map it plans on.
+    navigator: NavigatorConfig,
+}
+
+impl Settings {
+    /// The settings in the TOML file at `path`.
+    fn read(path: &std::path::Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read the settings file {}", path.display()))?;
+        toml::from_str(&text).with_context(|| format!("settings file {}", path.display()))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A registrator: ours, wrapped. Every method is forwarded: `MapRegistrator` has no defaults, so
+// a wrapper that left out `empty_map`/`add_to_map`/`remove_from_map` would not compile (with
+// defaults it would, and the engine would rebuild its local map whole for every keyframe instead
+// of sliding it in place). A backend that builds maps only whole implements
+// `WholeMapRegistrator` instead.
 
 /// Point-to-plane ICP with its alignments counted.
 #[derive(Debug, Default)]
@@ -324,6 +356,10 @@ fn main() -> ExitCode {
 type OwnSlam = GraphSlam<CountingIcp, PointToPointIcp, CountingLevenbergMarquardt>;
 
 fn own_backends(args: &Args) -> Result<()> {
+    let path = args.config.clone().unwrap_or_else(|| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/own_backends.toml")
+    });
+    let settings = Settings::read(&path)?;
     let config = SimulationConfig::with_seed(args.seed);
     let sim = SimulatedSpot::corridor_loop(&config)?;
     let building = sim.building().clone();
@@ -331,7 +367,7 @@ fn own_backends(args: &Args) -> Result<()> {
     let truth = sim.ground_truth();
 
     // 1. Mapping with your registrator and optimizer.
-    let mut slam = own_slam()?;
+    let mut slam = own_slam(settings.icp)?;
     for sample in sim {
         // A skipped scan is counted in the report.
         let _outcome = slam.process(&sample.scan_input());
@@ -362,7 +398,7 @@ fn own_backends(args: &Args) -> Result<()> {
     let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let navigation =
-        NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default())?;
+        NavigationMap::from_scans(&scans, lidar_height, &settings.navigator.map_config())?;
     let lap_end = truth.last().context("empty lap")?.pose;
     let start = lap_end.translation.vector.xy();
     let goal_world = building
@@ -386,9 +422,20 @@ fn own_backends(args: &Args) -> Result<()> {
         &navigation,
         map_t_lidar * body_t_lidar.inverse(),
         spot.description(),
-        NavigatorConfig::default(),
+        settings.navigator,
     )?
     .with_planner(planner);
+    // What the backends were built with, read back from them.
+    out!(
+        "settings    {}: loop refinement kernel {:?}, reach {} m; navigator replans every {} cycles",
+        path.display(),
+        slam.loop_refine_registrator().icp.config.kernel,
+        slam.loop_refine_registrator()
+            .icp
+            .config
+            .max_correspondence_distance,
+        navigator.config().replan_every
+    )?;
     let walk = drive(&mut spot, &mut navigator, goal, MAX_CYCLES, |_| {})?;
     let error = (spot.position() - goal_world).norm();
     let OwnPlanner { queries, found, .. } = *navigator.planner();
@@ -417,9 +464,9 @@ fn own_backends(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// The engine with your registrator (odometry and loop refinement, as the pipelines' point-to-plane
-/// settings) and optimizer; our point-to-point ICP checks loop candidates.
-fn own_slam() -> Result<OwnSlam> {
+/// The engine with your registrator (odometry as the pipelines' point-to-plane tracker, loop
+/// refinement with `refine`) and optimizer; our point-to-point ICP checks loop candidates.
+fn own_slam(refine: IcpConfig) -> Result<OwnSlam> {
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
@@ -427,13 +474,7 @@ fn own_slam() -> Result<OwnSlam> {
             ..IcpConfig::default()
         },
     };
-    let refine = PointToPlaneIcp {
-        config: IcpConfig {
-            kernel: IcpKernel::Tukey { k: 0.10 },
-            max_correspondence_distance: 1.0,
-            ..IcpConfig::default()
-        },
-    };
+    let refine = PointToPlaneIcp { config: refine };
     Ok(GraphSlam::try_new(
         slam_config(),
         CountingIcp::new(point_to_plane_tracker()),

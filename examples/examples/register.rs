@@ -3,14 +3,16 @@
 //! ```sh
 //! cargo run --release --example register -- SOURCE TARGET [--method p2p|p2plane|loam] \
 //!     [--voxel M] [--init x,y,z,roll,pitch,yaw] [--layout vlp16|hdl32e|os1-128] [--reference FILE] \
-//!     [--repeat N]
+//!     [--repeat N] [--config FILE] [--print-config]
 //! ```
 //!
 //! Files are PCD, PLY or KITTI `.bin`. `--voxel` sets the ICP voxel (default 0.25 m); `--init`
 //! is the initial guess (metres, degrees); `--layout` gives LOAM the ring layout of clouds
 //! without a ring field (default VLP-16); `--reference` reads a 4x4 row-major `target_T_source`
 //! and prints the result's distance to it; `--repeat N` runs preparation and alignment N times
-//! (after one untimed run) and prints the best and median times. With no files it registers the bundled HDL-32E pair
+//! (after one untimed run) and prints the best and median times; `--config FILE` reads the ICP
+//! (`[icp]`, an `IcpConfig`) and LOAM settings (`[loam]`, a `LoamConfig`) from a TOML file, the
+//! options given winning over it, and `--print-config` prints them. With no files it registers the bundled HDL-32E pair
 //! (`small_gicp`'s data, MIT) against its reference pose. Exits with status 1 when the alignment
 //! stopped at its iteration cap (after printing the result).
 
@@ -25,10 +27,13 @@ use nalgebra::{Matrix4, UnitQuaternion};
 use registration::{
     IcpConfig, LidarLayout, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
 };
+use serde::{Deserialize, Serialize};
 use slam_core::io::read_cloud;
 use slam_core::{Alignment, PointCloud, Pose3, Registrator, pose3_from_xyz_rpy};
 use spot_adapter::record::ReturnFilter;
-use spot_nav_examples::{Timings, data, out, parse_numbers, value_name};
+use spot_nav_examples::{
+    SettingsArgs, Timings, data, out, parse_numbers, print_settings, value_name,
+};
 
 /// Register two LiDAR scans and print `target_T_source`.
 ///
@@ -48,14 +53,10 @@ struct Args {
     /// The registration method.
     #[arg(long, value_enum, default_value_t = Method::PointToPlane)]
     method: Method,
-    /// Voxel size of both clouds for ICP (metres).
-    #[arg(
-        long,
-        value_name = "M",
-        allow_negative_numbers = true,
-        default_value_t = 0.25
-    )]
-    voxel: f32,
+    /// Voxel size of both clouds for ICP (metres) [default: the settings' `icp.source_voxel`
+    /// and `icp.target_voxel`, 0.25].
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    voxel: Option<f32>,
     /// Initial guess of `target_T_source`: metres and degrees (roll, pitch, yaw).
     #[arg(
         long,
@@ -64,8 +65,8 @@ struct Args {
         value_parser = parse_numbers::<6>
     )]
     init: Option<[f64; 6]>,
-    /// Ring layout for LOAM when a cloud has no ring field [default: vlp16; hdl32e for the
-    /// bundled pair].
+    /// Ring layout for LOAM when a cloud has no ring field [default: the settings'
+    /// `loam.features.layout`, vlp16; hdl32e for the bundled pair].
     #[arg(long, value_enum)]
     layout: Option<Layout>,
     /// A 4x4 row-major `target_T_source` to compare the result with [default: the bundled
@@ -81,6 +82,32 @@ struct Args {
         default_value = "1"
     )]
     repeat: NonZeroUsize,
+    /// The ICP (`[icp]`) and LOAM (`[loam]`) settings: `--config FILE`, `--print-config`.
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+/// The settings file of `register` (`--config`, `--print-config`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct Settings {
+    /// Point-to-point and point-to-plane ICP.
+    icp: IcpConfig,
+    /// LOAM; by default with a wide first robust threshold (1 m: a pair may start far from its
+    /// answer) and the pair's ring layout.
+    loam: LoamConfig,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            icp: IcpConfig::default(),
+            loam: LoamConfig {
+                initial_tukey_threshold: 1.0,
+                ..LoamConfig::default()
+            },
+        }
+    }
 }
 
 /// `--method`.
@@ -125,6 +152,7 @@ impl Layout {
 struct Job {
     source: PathBuf,
     target: PathBuf,
+    /// The ring layout of the pair, unless the settings or `--layout` give one.
     layout: LidarLayout,
     reference: Option<PathBuf>,
     init: Pose3,
@@ -137,19 +165,18 @@ impl Job {
             .map_or_else(Pose3::identity, |[x, y, z, r, p, w]| {
                 pose3_from_xyz_rpy(x, y, z, r.to_radians(), p.to_radians(), w.to_radians())
             });
-        let layout = |default: Layout| args.layout.unwrap_or(default).lidar_layout();
         match (&args.source, &args.target) {
             (Some(source), Some(target)) => Self {
                 source: source.clone(),
                 target: target.clone(),
-                layout: layout(Layout::Vlp16),
+                layout: LidarLayout::VLP16,
                 reference: args.reference.clone(),
                 init,
             },
             _ => Self {
                 source: data::pair_source(),
                 target: data::pair_target(),
-                layout: layout(Layout::Hdl32e),
+                layout: LidarLayout::HDL32E,
                 reference: Some(args.reference.clone().unwrap_or_else(data::pair_reference)),
                 init,
             },
@@ -266,18 +293,23 @@ fn read_returns(path: &Path, which: &str) -> Result<PointCloud> {
 
 fn register(args: &Args) -> Result<()> {
     let job = Job::new(args);
+    let mut defaults = Settings::default();
+    defaults.loam.features.layout = job.layout;
+    let mut settings = args.settings.load(defaults)?;
+    if let Some(voxel) = args.voxel {
+        settings.icp.source_voxel = voxel;
+        settings.icp.target_voxel = voxel;
+    }
+    if let Some(layout) = args.layout {
+        settings.loam.features.layout = layout.lidar_layout();
+    }
+    if args.settings.print_config {
+        return print_settings(&settings);
+    }
+    let Settings { icp, loam } = settings;
     let repeat = args.repeat.get();
     let source = read_returns(&job.source, "source")?;
     let target = read_returns(&job.target, "target")?;
-    let icp = IcpConfig {
-        source_voxel: args.voxel,
-        target_voxel: args.voxel,
-        ..IcpConfig::default()
-    };
-    let mut loam = LoamConfig::default();
-    loam.features.layout = job.layout;
-    // A pair may start far from its answer: begin with a wide robust threshold.
-    loam.initial_tukey_threshold = 1.0;
     let timed = match args.method {
         Method::PointToPoint => run(
             &PointToPointIcp { config: icp },

@@ -2,7 +2,7 @@
 //! choices, `X,Y` goals, the simulator's sensor and motion), standard output that ends quietly
 //! on a closed pipe, progress on stderr, timing summaries, the map-and-evaluate loop of the
 //! `slam` and `mission` examples, and what `slam` adds to it: a ground-truth file, tracking
-//! health and `summary.json`.
+//! health and `summary.json`; and the settings files of `--config` and `--print-config`.
 //!
 //! Every example's `main` is a one-liner around [`run`], which gives each failure an exit
 //! status of 1 and a one-line reason on stderr:
@@ -30,6 +30,7 @@ pub mod mapping;
 pub mod output;
 pub mod picture;
 pub mod progress;
+pub mod settings;
 pub mod sim_options;
 pub mod stats;
 pub mod summary;
@@ -40,5 +41,6 @@ pub use health::{HealthSummary, print_tracking_health};
 pub use mapping::{MappedScans, Mapping, evaluate, map_and_evaluate, map_samples};
 pub use output::{StdoutClosed, run, write_line};
 pub use progress::Progress;
+pub use settings::{SettingsArgs, load_settings, print_settings};
 pub use sim_options::{Motion, Sensor};
 pub use stats::{Timings, quantile};

@@ -53,6 +53,8 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "--registration",
             "--planner",
             "--out",
+            "--config",
+            "--print-config",
             "p2plane",
             "loam",
             "cost-aware",
@@ -61,7 +63,7 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
         ],
     ),
     ("movingai", &["MAP", "SCEN", "--planner", "jps-plus", "all"]),
-    ("own_backends", &["--seed", "--max-ate"]),
+    ("own_backends", &["--seed", "--max-ate", "--config"]),
     (
         "register",
         &[
@@ -73,6 +75,8 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "--layout",
             "--reference",
             "--repeat",
+            "--config",
+            "--print-config",
             "os1-128",
         ],
     ),
@@ -120,6 +124,8 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "--out",
             "--ground-truth",
             "--summary",
+            "--config",
+            "--print-config",
         ],
     ),
 ];

@@ -1,11 +1,14 @@
 //! The `own_backends` example: a registrator, an optimizer and a planner written outside the
 //! library map a simulated building and walk Spot to its farthest room. The run is checked
 //! against the simulator's ground truth: the mapping's ATE, every backend called, the own
-//! planner's path followed to the goal.
+//! planner's path followed to the goal; the settings of the bundled TOML file (an `IcpConfig`
+//! and a `NavigatorConfig`, each different from its default) in the backends built.
 
 #![allow(clippy::expect_used, clippy::panic)]
 
 use std::process::Command;
+
+use spot_adapter::prelude::{IcpConfig, IcpKernel, NavigatorConfig};
 
 mod common;
 use common::example;
@@ -57,4 +60,34 @@ fn own_backends_map_the_building_and_the_own_planner_walks_spot_to_the_goal() {
     assert!(number_after(navigation, "queries,") > 0.0, "{navigation}");
     let error = number_after(navigation, "cycles,");
     assert!(error <= 0.10, "{navigation}");
+    // The file's settings, read back from the backends, and not the defaults.
+    let settings = line(&stdout, "settings");
+    assert!(settings.contains("own_backends.toml"), "{settings}");
+    assert!(settings.contains("kernel Tukey { k: 0.1 }"), "{settings}");
+    assert!(settings.contains("replans every 20 cycles"), "{settings}");
+    assert!(!matches!(
+        IcpConfig::default().kernel,
+        IcpKernel::Tukey { .. }
+    ));
+    assert_ne!(NavigatorConfig::default().replan_every, 20);
+}
+
+#[test]
+fn own_backends_names_the_file_and_the_field_of_a_bad_setting() {
+    let dir = std::env::temp_dir().join(format!("own_backends_settings_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, "[navigator]\nreplan_evry = 20\n").expect("the file is written");
+    let run = Command::new(example("own_backends"))
+        .arg("--config")
+        .arg(&path)
+        .output()
+        .expect("own_backends runs");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("bad.toml") && stderr.contains("replan_evry"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

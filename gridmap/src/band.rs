@@ -14,6 +14,11 @@ use crate::rays::{below_top, clip_to_box, traverse};
 /// to `up_to` are obstacles. Spot: the body frame is 0.50 m above the ground, the LiDAR 0.30 m
 /// above the body, the robot 0.84 m tall with it.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct ObstacleBandConfig {
     /// Lowest obstacle height above the floor, 0.08 m: floor points with their noise and the
     /// floor estimate's error stay below it; anything taller (a cable duct, a crate, a desk's

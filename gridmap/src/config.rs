@@ -2,6 +2,11 @@
 
 /// Settings of [`OccupancyGridBuilder`](crate::OccupancyGridBuilder). Lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct OccupancyGridConfig {
     /// Cell side (thesis: 0.15 m chosen; 0.10 m default here).
     pub resolution: f64,

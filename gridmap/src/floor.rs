@@ -10,6 +10,11 @@ use crate::error::{GridMapError, check};
 
 /// Settings of [`FloorMap::estimate`]. Lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct FloorConfig {
     /// Side of a floor tile, 1.0 m: one floor height per tile.
     pub tile: f64,

@@ -82,6 +82,7 @@ impl LocalGrid {
 
 /// What a fusion changed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FusionReport {
     /// Global cells that became occupied.
     pub added: usize,

@@ -19,6 +19,11 @@ use crate::rays::{below_top, clip_to_box, traverse};
 
 /// Settings of [`LiveLayer`]. Lengths in metres, times in seconds.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LiveLayerConfig {
     /// Side of the square local window centred on the sensor, 8.0 m (80 x 80 cells at 0.10 m):
     /// points and beams beyond it are cut at its edge.
@@ -85,6 +90,7 @@ impl LiveLayerConfig {
 
 /// What one [`LiveLayer::update`] changed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct LiveUpdate {
     /// Cells that became occupied.
     pub added: usize,

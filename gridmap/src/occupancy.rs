@@ -6,6 +6,7 @@ use crate::error::GridMapError;
 
 /// What is known of a cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum CellState {
     /// Seen empty (a ray passed through), or assumed free when no ray casting was done.
     Free,
@@ -17,6 +18,7 @@ pub enum CellState {
 
 /// How a planner should treat unknown cells.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum UnknownCells {
     /// Unknown cells are obstacles (safe: the robot stays in mapped space).
     #[default]

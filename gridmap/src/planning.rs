@@ -14,6 +14,11 @@ use crate::occupancy::{OccupancyGrid, UnknownCells};
 /// 1 at `full_within` and closer, falling to 0 at `zero_beyond` and beyond. Multipliers are at
 /// least 1, so a planner's octile heuristic stays admissible (pathfind's `CellCostAStar`).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct ClearanceCostConfig {
     /// Weight of the penalty (dimensionless), 2.0: a cell at `full_within` costs 3 times its
     /// length; 0 turns the cost off (every multiplier 1: shortest paths).
@@ -89,6 +94,11 @@ pub fn clearance_step_costs(
 
 /// Settings of [`PlanningGrid`]. Lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct PlanningGridConfig {
     /// How unknown cells count: [`UnknownCells::Blocked`] (default: the robot stays in observed
     /// space; unknown cells are obstacles for the inflation and the clearance too) or
@@ -175,6 +185,7 @@ fn obstacles(
 
 /// A rectangle of cells, `x0..x1` by `y0..y1` (ends excluded).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CellRect {
     /// First column.
     pub x0: u32,

@@ -23,6 +23,7 @@ const RING_UP_TO: f32 = 64.0;
 
 /// A least-cost path found by [`CellCostAStar`].
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CostedPath {
     /// The cells (dense: every cell from start to goal), their geometric length in cells
     /// (straight 1, diagonal sqrt(2)) and the expansions.

@@ -59,6 +59,7 @@ pub fn path_cost(cells: &[Cell]) -> f64 {
 
 /// Why a path is not valid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum PathViolation {
     /// The path is empty.
     Empty,

@@ -146,6 +146,7 @@ pub fn map_text(map: &MovingAiMap) -> String {
 
 /// One benchmark query.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Scenario {
     /// Difficulty bucket (about a quarter of the optimal length).
     pub bucket: u32,

@@ -6,6 +6,7 @@ use crate::line_of_sight::line_of_sight;
 
 /// A path reduced to the waypoints a robot must turn at.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FilteredPath {
     /// Start, turning points, goal.
     pub waypoints: Vec<Cell>,

@@ -21,6 +21,11 @@ use slam_core::InvalidSetting;
 /// Which edges graduated non-convexity takes as inliers without testing them (weight 1 always):
 /// odometry, whose errors are small and which keeps the graph connected.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", content = "flags", deny_unknown_fields)
+)]
 pub enum KnownInliers {
     /// Edges between nodes whose ids differ by one (odometry, when nodes are numbered in the
     /// order they were made, as g2o files and the SLAM engine number them).
@@ -51,6 +56,11 @@ impl KnownInliers {
 
 /// Settings of [`GraduatedNonConvexity`].
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct GncConfig {
     /// The robust loss; default truncated least squares (the paper's and GTSAM's choice for pose
     /// graphs).
@@ -144,6 +154,7 @@ impl GncConfig {
 
 /// What a run of [`GraduatedNonConvexity`] did, with every edge's final weight.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct GncReport {
     /// Iterations (every Levenberg-Marquardt iteration of every solve), the robust cost before
     /// and after (`sum e^T Omega e` over known inliers plus the loss over candidates, at `mu`'s

@@ -7,6 +7,7 @@
 
 /// The robust loss graduated non-convexity minimises in the end.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum GncLoss {
     /// Truncated least squares, `min(s, c2)`: an edge beyond the threshold costs a constant and
     /// pulls on nothing. Its surrogate is convex for a small `mu`, which grows by

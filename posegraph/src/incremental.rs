@@ -15,6 +15,11 @@ use slam_core::InvalidSetting;
 
 /// Settings of an [`IncrementalSmoother`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct IncrementalConfig {
     /// A node is relinearised when its pending step's largest component exceeds this (metres or
     /// radians); default 0.05 (iSAM2's default is 0.1). Smaller follows the optimum more closely

@@ -21,6 +21,11 @@ pub const DEFAULT_MIN_EIGENVALUE_RATIO: f64 = 1e-6;
 
 /// What a reader does with an edge whose information matrix is not positive definite.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum InformationRepair {
     /// Refuse the file ([`GraphFileError::InformationNotPositiveDefinite`], which names the
     /// repair option).
@@ -48,6 +53,7 @@ impl InformationRepair {
 
 /// An edge whose information matrix a reader replaced.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RepairedEdge {
     /// 1-based line of the file.
     pub line: usize,

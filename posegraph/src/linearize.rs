@@ -16,6 +16,7 @@ use slam_core::{
 
 /// Which edge error the optimisers minimise (`sum e^T Omega e`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ErrorModel {
     /// `e = log(z^-1 a^-1 b)`, GTSAM's `BetweenFactor` convention (and the one of
     /// [`PoseGraph::cost`](slam_core::PoseGraph::cost)).

@@ -13,6 +13,11 @@ use slam_core::InvalidSetting;
 
 /// Stopping and damping settings shared by both optimisers.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct SolverConfig {
     /// Stop after this many iterations (accepted or rejected steps).
     pub max_iterations: usize,

@@ -7,6 +7,11 @@ use crate::kernel::IcpKernel;
 /// Settings of [`PointToPointIcp`](crate::PointToPointIcp) and
 /// [`PointToPlaneIcp`](crate::PointToPlaneIcp). Lengths in metres, angles in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct IcpConfig {
     /// Voxel size of the source cloud (0 keeps every point).
     pub source_voxel: f32,

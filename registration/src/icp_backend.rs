@@ -66,6 +66,11 @@ macro_rules! icp_backend {
                 $crate::icp_target::target_from_sources::<$step>(&self.config, parts)
             }
 
+            /// The source as it is: its voxel centroids are already as thin as a map takes them.
+            fn keyframe_source(&self, source: Self::Source) -> Self::Source {
+                source
+            }
+
             /// [`IcpConfig::source_voxel`](crate::IcpConfig::source_voxel) when above zero: the
             /// source is the scan's voxel centroids.
             fn source_voxel(&self) -> Option<f32> {

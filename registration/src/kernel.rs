@@ -2,6 +2,11 @@
 
 /// The weight of a residual `r` (metres) in iteratively reweighted least squares.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum IcpKernel {
     /// Every correspondence weighs 1.
     None,

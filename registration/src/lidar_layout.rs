@@ -8,6 +8,11 @@ use crate::config::check;
 /// Rings evenly spread between two elevations: enough to recover a point's ring (laser) from its
 /// vertical angle when the cloud has no ring field.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LidarLayout {
     /// Number of rings (lasers).
     pub rings: u16,

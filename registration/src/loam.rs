@@ -16,6 +16,11 @@ use crate::voxel_hash_map::VoxelHashMap;
 
 /// Settings of [`LoamRegistrator`]. Lengths in metres, angles in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LoamConfig {
     /// Feature extraction.
     pub features: LoamFeatureConfig,
@@ -395,6 +400,12 @@ impl MapRegistrator for LoamRegistrator {
         source.edge_map = voxel_thin(source.edge_map, c.local_map_edge_voxel);
         source.plane_map = voxel_thin(source.plane_map, c.local_map_plane_voxel);
         source
+    }
+
+    /// `None`: the features run along each ring in firing order, so a scan must come as the
+    /// sensor gave it.
+    fn source_voxel(&self) -> Option<f32> {
+        None
     }
 
     /// A local map with the local-map voxels, updated in place as keyframes enter and leave.

@@ -9,6 +9,11 @@ use crate::lidar_layout::LidarLayout;
 
 /// Settings of [`LoamFeatures::extract`]. Lengths in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LoamFeatureConfig {
     /// Ring layout used when the cloud has no ring field (default: VLP-16).
     pub layout: LidarLayout,

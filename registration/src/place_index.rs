@@ -8,6 +8,11 @@ use crate::scan_context::{SCAN_CONTEXT_RINGS, ScanContext, ScanContextConfig, Sc
 
 /// Settings of [`ScanContextIndex`].
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct ScanContextIndexConfig {
     /// The most recent descriptors are not searched (they are the robot's own recent past, not
     /// a revisit), 50 keyframes.

@@ -12,6 +12,11 @@ pub const SCAN_CONTEXT_RINGS: usize = 20;
 
 /// Settings of [`ScanContext`]. Lengths in metres.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct ScanContextConfig {
     /// Azimuth bins, 60 (6 degrees each, as in the paper); the heading comes out to half of that.
     pub sectors: usize,

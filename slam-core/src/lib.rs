@@ -68,4 +68,6 @@ pub use traits::optimizer::{
 };
 pub use traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 pub use traits::planner::{GridPath, Planner, validate_endpoints};
-pub use traits::registrator::{Alignment, MapRegistrator, Reach, Registrator, SweepAlignment};
+pub use traits::registrator::{
+    Alignment, MapRegistrator, Reach, Registrator, SweepAlignment, WholeMapRegistrator,
+};

@@ -92,6 +92,7 @@ impl GraphPose for Pose2 {
 
 /// A node: a user-chosen id, its pose (`world_T_node`) and whether the optimiser must keep it.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Node<P> {
     /// The caller's id (g2o vertex id, keyframe number); unique within a graph.
     pub id: u64,
@@ -103,6 +104,14 @@ pub struct Node<P> {
 
 /// A between-edge: `measurement` of `from^-1 * to`, with its information matrix.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(bound(
+        serialize = "P: serde::Serialize, P::Information: serde::Serialize",
+        deserialize = "P: serde::Deserialize<'de>, P::Information: serde::Deserialize<'de>"
+    ))
+)]
 pub struct Edge<P: GraphPose> {
     /// Index (not id) of the first node in [`PoseGraph::nodes`].
     pub from: usize,
@@ -120,6 +129,11 @@ pub struct Edge<P: GraphPose> {
 /// are only ever appended, so an optimiser can keep work from earlier calls and redo only what
 /// the new nodes and edges touch.
 ///
+/// With the `serde` feature a graph (de)serialises as its `nodes` and `edges` (edges by node
+/// index, as [`PoseGraph::edges`] gives them); a graph read back is rebuilt node by node and
+/// edge by edge, so it passes the checks of [`add_node`](Self::add_node) and
+/// [`add_edge`](Self::add_edge).
+///
 /// ```
 /// use slam_core::{GraphPose, PoseGraph, Pose2};
 /// let mut g = PoseGraph::<Pose2>::new();
@@ -132,6 +146,18 @@ pub struct Edge<P: GraphPose> {
 /// # Ok::<(), slam_core::OptimizeError>(())
 /// ```
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        try_from = "serde_form::RawGraph<P>",
+        into = "serde_form::RawGraph<P>",
+        bound(
+            serialize = "P: serde::Serialize, P::Information: serde::Serialize",
+            deserialize = "P: serde::Deserialize<'de>, P::Information: serde::Deserialize<'de>"
+        )
+    )
+)]
 pub struct PoseGraph<P: GraphPose> {
     nodes: Vec<Node<P>>,
     edges: Vec<Edge<P>>,
@@ -370,6 +396,69 @@ impl<P: GraphPose> PoseGraph<P> {
             return Err(OptimizeError::Disconnected { count, first_id });
         }
         Ok(())
+    }
+}
+
+/// The serialised form of a graph: its nodes and edges, rebuilt through `add_node`, `fix` and
+/// `add_edge` on the way back in so a bad file cannot break the graph's invariants.
+#[cfg(feature = "serde")]
+mod serde_form {
+    use super::{Edge, GraphPose, Node, PoseGraph};
+
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(bound(
+        serialize = "P: serde::Serialize, P::Information: serde::Serialize",
+        deserialize = "P: serde::Deserialize<'de>, P::Information: serde::Deserialize<'de>"
+    ))]
+    pub(super) struct RawGraph<P: GraphPose> {
+        nodes: Vec<Node<P>>,
+        edges: Vec<Edge<P>>,
+    }
+
+    impl<P: GraphPose> From<PoseGraph<P>> for RawGraph<P> {
+        fn from(g: PoseGraph<P>) -> Self {
+            Self {
+                nodes: g.nodes,
+                edges: g.edges,
+            }
+        }
+    }
+
+    impl<P: GraphPose> TryFrom<RawGraph<P>> for PoseGraph<P> {
+        /// The graph's own error (a duplicate id, a bad information matrix, ...), or an edge
+        /// whose node index is past the nodes.
+        type Error = String;
+        fn try_from(raw: RawGraph<P>) -> Result<Self, String> {
+            let mut graph = PoseGraph::new();
+            for node in &raw.nodes {
+                graph
+                    .add_node(node.id, node.pose)
+                    .map_err(|e| e.to_string())?;
+                if node.fixed {
+                    graph.fix(node.id).map_err(|e| e.to_string())?;
+                }
+            }
+            for (k, edge) in raw.edges.iter().enumerate() {
+                let id = |index: usize| {
+                    raw.nodes.get(index).map(|n| n.id).ok_or_else(|| {
+                        format!(
+                            "edge {k} joins node index {index}, but the graph has {} nodes",
+                            raw.nodes.len()
+                        )
+                    })
+                };
+                graph
+                    .add_edge(
+                        id(edge.from)?,
+                        id(edge.to)?,
+                        edge.measurement,
+                        edge.information,
+                        edge.kernel,
+                    )
+                    .map_err(|e| e.to_string())?;
+            }
+            Ok(graph)
+        }
     }
 }
 

@@ -3,7 +3,11 @@
 /// A robust kernel `rho(s)` applied to an edge's squared Mahalanobis error `s = e^T Omega e`.
 /// All three equal `s` near zero and grow slower than `s` for large errors.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum RobustKernel {
     /// Quadratic up to `delta` (in Mahalanobis units), linear beyond.
     Huber {
@@ -66,6 +70,51 @@ impl RobustKernel {
             Self::Cauchy { c } | Self::GemanMcClure { c } => c,
         };
         p.is_finite() && p > 0.0
+    }
+}
+
+/// An optional kernel in a settings file: `{ kind = "None" }` for none, else the kernel itself
+/// (`{ kind = "Cauchy", c = 1.0 }`). A plain `Option` would write none by leaving the field out,
+/// which a file with defaults reads as the default kernel.
+#[cfg(feature = "serde")]
+pub(crate) mod optional_kernel {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use super::RobustKernel;
+
+    /// [`RobustKernel`]'s variants and `None`, tagged as `RobustKernel` is.
+    #[derive(Serialize, Deserialize)]
+    #[serde(tag = "kind", deny_unknown_fields)]
+    enum Repr {
+        None,
+        Huber { delta: f64 },
+        Cauchy { c: f64 },
+        GemanMcClure { c: f64 },
+    }
+
+    #[allow(clippy::ref_option)] // serde's `with` passes the field by reference.
+    pub(crate) fn serialize<S: Serializer>(
+        kernel: &Option<RobustKernel>,
+        serializer: S,
+    ) -> Result<S::Ok, S::Error> {
+        match *kernel {
+            None => Repr::None,
+            Some(RobustKernel::Huber { delta }) => Repr::Huber { delta },
+            Some(RobustKernel::Cauchy { c }) => Repr::Cauchy { c },
+            Some(RobustKernel::GemanMcClure { c }) => Repr::GemanMcClure { c },
+        }
+        .serialize(serializer)
+    }
+
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(
+        deserializer: D,
+    ) -> Result<Option<RobustKernel>, D::Error> {
+        Ok(match Repr::deserialize(deserializer)? {
+            Repr::None => None,
+            Repr::Huber { delta } => Some(RobustKernel::Huber { delta }),
+            Repr::Cauchy { c } => Some(RobustKernel::Cauchy { c }),
+            Repr::GemanMcClure { c } => Some(RobustKernel::GemanMcClure { c }),
+        })
     }
 }
 

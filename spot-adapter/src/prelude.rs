@@ -71,7 +71,7 @@ pub use slam_core::{
     Alignment, Cell, GraphSlam, GraphSlamConfig, GridGeometry, GridPath, InvalidSetting,
     MapRegistrator, OptimizationReport, OptimizeError, Optimizer, PlaceRecognizer, PlanError,
     Planner, PointCloud, Pose2, Pose3, PoseGraph, RegistrationError, Registrator, ScanInput,
-    ScanOutcome, SlamReport,
+    ScanOutcome, SlamReport, WholeMapRegistrator,
 };
 
 pub use crate::AdapterError;

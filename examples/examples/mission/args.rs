@@ -1,10 +1,14 @@
-//! The command line: `Args` and `--planner`.
+//! The command line: `Args`, `--planner` and the settings file.
 
 use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
 use nalgebra::Vector2;
-use spot_nav_examples::{Registration, parse_goal, parse_numbers};
+use serde::{Deserialize, Serialize};
+use slam_core::GraphSlamConfig;
+use spot_adapter::nav::NavigatorConfig;
+use spot_adapter::pipelines::slam_config;
+use spot_nav_examples::{Registration, SettingsArgs, parse_goal, parse_numbers};
 
 /// The main job on a simulated Spot: map an unknown building, then walk to goals in it.
 ///
@@ -53,12 +57,36 @@ pub(crate) struct Args {
     /// Odometry and loop refinement backend of the mapping lap.
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
     pub(crate) registration: Registration,
-    /// The navigator's planner.
-    #[arg(long, value_enum, default_value_t = PlannerChoice::CostAware)]
-    pub(crate) planner: PlannerChoice,
+    /// The navigator's planner [default: the settings' `navigator.planner`, cost-aware].
+    #[arg(long, value_enum)]
+    pub(crate) planner: Option<PlannerChoice>,
     /// Where the outputs go.
     #[arg(long, value_name = "DIR", default_value = "mission-out")]
     pub(crate) out: PathBuf,
+    /// The mapping engine's (`[slam]`, a `GraphSlamConfig`) and the navigator's settings
+    /// (`[navigator]`, a `NavigatorConfig`; its grid, floor and band also make the map):
+    /// `--config FILE`, `--print-config`.
+    #[command(flatten)]
+    pub(crate) settings: SettingsArgs,
+}
+
+/// The settings file of `mission` (`--config`, `--print-config`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub(crate) struct Settings {
+    /// The mapping lap's engine; by default spot-adapter's `slam_config()`.
+    pub(crate) slam: GraphSlamConfig,
+    /// The navigator, and the map it plans on (`grid`, `floor`, `band`).
+    pub(crate) navigator: NavigatorConfig,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            slam: slam_config(),
+            navigator: NavigatorConfig::default(),
+        }
+    }
 }
 
 /// `--planner`.

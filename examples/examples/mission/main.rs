@@ -25,18 +25,18 @@ use anyhow::{Context, Result, bail};
 use clap::Parser;
 use nalgebra::{Translation3, UnitQuaternion, Vector2};
 use slam_core::Pose3;
-use spot_adapter::nav::{DriveOutcome, Navigator, NavigatorConfig, PlannerKind};
+use spot_adapter::nav::{DriveOutcome, Navigator, PlannerKind};
 use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places, slam_config,
+    loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places,
 };
 use spot_adapter::robot::Robot;
 use spot_adapter::sim::{
     CommandedSpot, RouteConfig, SimulatedSpot, SimulationConfig, shortest_length,
 };
 use spot_nav_examples::picture::Overlay;
-use spot_nav_examples::{Registration, Timings, out, value_name};
+use spot_nav_examples::{Registration, Timings, out, print_settings, value_name};
 
-use args::{Args, PlannerChoice};
+use args::{Args, PlannerChoice, Settings};
 use legs::{Frames, leg, random_goals};
 use mapping::map_building;
 use report::{LegSummary, Summary, write_outputs};
@@ -51,6 +51,27 @@ fn main() -> ExitCode {
 #[allow(clippy::too_many_lines)] // The mission reads top to bottom: map, goals, legs, outputs.
 fn mission(args: &Args) -> Result<()> {
     let seed = args.seed;
+    let mut settings = args.settings.load(Settings::default())?;
+    if let Some(planner) = args.planner {
+        settings.navigator.planner = match planner {
+            PlannerChoice::CostAware => PlannerKind::CellCostAStar,
+            PlannerChoice::Jps => PlannerKind::JumpPointSearch,
+            PlannerChoice::Astar => PlannerKind::AStar,
+        };
+    }
+    if args.settings.print_config {
+        return print_settings(&settings);
+    }
+    let Settings {
+        slam: slam_settings,
+        navigator: nav_config,
+    } = settings;
+    let planner_name = match nav_config.planner {
+        PlannerKind::CellCostAStar => value_name(&PlannerChoice::CostAware),
+        PlannerKind::JumpPointSearch => value_name(&PlannerChoice::Jps),
+        PlannerKind::AStar => value_name(&PlannerChoice::Astar),
+        other => format!("{other:?}"),
+    };
     if args.goal.is_empty() && args.goals == 0 {
         bail!("--goals 0 and no --goal: nothing to visit");
     }
@@ -71,12 +92,14 @@ fn mission(args: &Args) -> Result<()> {
     let mapped = match args.registration {
         // Loops by position and by appearance, as the slam example seeks them.
         Registration::PointToPlane => map_building(
-            point_to_plane_slam(slam_config())?.with_place_recognizer(scan_context_places()),
+            point_to_plane_slam(slam_settings)?.with_place_recognizer(scan_context_places()),
             sim,
+            &nav_config.map_config(),
         )?,
         Registration::Loam => map_building(
-            loam_slam(slam_config())?.with_place_recognizer(scan_context_places()),
+            loam_slam(slam_settings)?.with_place_recognizer(scan_context_places()),
             sim,
+            &nav_config.map_config(),
         )?,
     };
 
@@ -89,14 +112,6 @@ fn mission(args: &Args) -> Result<()> {
     )?;
     // The map frame's origin is the body at the lap's start: the LiDAR sits its mounting height
     // above it.
-    let nav_config = NavigatorConfig {
-        planner: match args.planner {
-            PlannerChoice::CostAware => PlannerKind::CellCostAStar,
-            PlannerChoice::Jps => PlannerKind::JumpPointSearch,
-            PlannerChoice::Astar => PlannerKind::AStar,
-        },
-        ..NavigatorConfig::default()
-    };
     // What the legs' shortest ways are measured at: the navigator's inflation and cells.
     let (inflation, resolution) = (nav_config.planning.inflation, nav_config.grid.resolution);
     let started = Instant::now();
@@ -240,7 +255,7 @@ fn mission(args: &Args) -> Result<()> {
     let summary = Summary {
         seed,
         registration: value_name(&args.registration),
-        planner: value_name(&args.planner),
+        planner: planner_name,
         kidnap: args.kidnap,
         mapping: mapped.summary.clone(),
         obstacles,

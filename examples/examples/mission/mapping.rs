@@ -18,10 +18,12 @@ pub(crate) struct Mapped {
     pub(crate) summary: MappingSummary,
 }
 
-/// Walks one lap of `sim` through `slam`, prints the mapping figures, returns the map.
+/// Walks one lap of `sim` through `slam`, prints the mapping figures, returns the map (its
+/// occupancy made with `map_config`).
 pub(crate) fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     mut slam: GraphSlam<R, C, O>,
     sim: SimulatedSpot,
+    map_config: &NavigationMapConfig,
 ) -> Result<Mapped> {
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
@@ -53,8 +55,7 @@ pub(crate) fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Po
     let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
     let sim_config = SimulationConfig::default();
     let lidar_height = sim_config.spot.body_height + sim_config.spot.body_t_lidar.translation.z;
-    let navigation =
-        NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default())?;
+    let navigation = NavigationMap::from_scans(&scans, lidar_height, map_config)?;
     Ok(Mapped {
         map: slam.map(0.05)?,
         navigation,

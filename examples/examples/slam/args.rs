@@ -5,11 +5,14 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Parser, ValueEnum};
 use nalgebra::Translation3;
+use serde::{Deserialize, Serialize};
+use slam_core::GraphSlamConfig;
 use slam_core::{Pose3, quaternion_from_xyzw};
+use spot_adapter::pipelines::slam_config;
 use spot_adapter::record::{
     BagConfig, ImuSource, OdometrySource, PointCloud2Config, ReturnFilter, SourceConfig, TimeUnit,
 };
-use spot_nav_examples::{Motion, Registration, Sensor, parse_numbers};
+use spot_nav_examples::{Motion, Registration, Sensor, SettingsArgs, parse_numbers};
 
 /// A per-point time unit, as `--time-unit` gives it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -144,10 +147,11 @@ pub(crate) struct Args {
         allow_negative_numbers = true
     )]
     pub(crate) gyro_drift: Option<f64>,
-    /// How stiff the odometry edges are: fixed sigmas (the default), or fixed sigmas softened
-    /// where the registration was weak (see `EdgeInformation::FixedAndRegistration`).
-    #[arg(long, value_enum, value_name = "KIND", default_value_t = OdometryInformation::Fixed)]
-    pub(crate) odometry_information: OdometryInformation,
+    /// How stiff the odometry edges are: fixed sigmas, or fixed sigmas softened where the
+    /// registration was weak (see `EdgeInformation::FixedAndRegistration`) [default: the
+    /// settings' `slam.odometry_information`, fixed].
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub(crate) odometry_information: Option<OdometryInformation>,
     /// The drift a loop may correct, as a fraction of the distance walked between its two
     /// keyframes (default 0.02; raise it for a front end that drifts more).
     #[arg(long, value_name = "RATE", allow_negative_numbers = true)]
@@ -178,6 +182,25 @@ pub(crate) struct Args {
     /// Write summary.json (what `--out` writes) to this file too, or alone.
     #[arg(long, value_name = "FILE")]
     pub(crate) summary: Option<PathBuf>,
+    /// The engine's settings (`[slam]`, a `GraphSlamConfig`): `--config FILE`, `--print-config`.
+    #[command(flatten)]
+    pub(crate) settings: SettingsArgs,
+}
+
+/// The settings file of `slam` (`--config`, `--print-config`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub(crate) struct Settings {
+    /// The engine's settings; by default spot-adapter's `slam_config()`.
+    pub(crate) slam: GraphSlamConfig,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            slam: slam_config(),
+        }
+    }
 }
 
 /// `tx,ty,tz,qx,qy,qz,qw` as a pose.

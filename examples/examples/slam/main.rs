@@ -9,7 +9,7 @@
 //! (PLY, PCD), the trajectory (TUM), the pose graph (g2o), the occupancy grid (PNG, ROS map) and
 //! `summary.json` with `--out`.
 //!
-//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR] [--ground-truth FILE] [--summary FILE]`
+//! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR] [--ground-truth FILE] [--summary FILE] [--config FILE] [--print-config]`
 
 mod args;
 mod report;
@@ -22,14 +22,14 @@ use anyhow::Result;
 use clap::Parser;
 use slam_core::io::StampedPose;
 use slam_core::{EdgeInformation, GraphSlamConfig, Pose3};
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places, slam_config};
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places};
 use spot_adapter::record::{DroppedPoints, ReadAhead, SampleSource, open_recording};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 use spot_nav_examples::summary::Input;
-use spot_nav_examples::{GroundTruthFile, Registration, map_samples, out};
+use spot_nav_examples::{GroundTruthFile, Registration, map_samples, out, print_settings};
 
-use args::{Args, OdometryInformation, source_config};
+use args::{Args, OdometryInformation, Settings, source_config};
 use report::finish;
 
 fn main() -> ExitCode {
@@ -40,7 +40,7 @@ fn main() -> ExitCode {
 const READ_AHEAD: usize = 4;
 
 fn slam(args: &Args) -> Result<()> {
-    let mut config = slam_config();
+    let mut config = args.settings.load(Settings::default())?.slam;
     if args.no_deskew {
         config.deskew = false;
     }
@@ -50,20 +50,35 @@ fn slam(args: &Args) -> Result<()> {
     if let Some(rate) = args.loop_drift_rate {
         config.loop_max_drift_rate = rate;
     }
-    // The engine's own fixed sigmas, with the registration's covariance added to them.
-    if let (
-        OdometryInformation::Registration,
-        EdgeInformation::Fixed {
-            translation_sigma,
-            rotation_sigma,
-        },
-    ) = (args.odometry_information, config.odometry_information)
-    {
-        config.odometry_information = EdgeInformation::FixedAndRegistration {
+    config.odometry_information = match (args.odometry_information, config.odometry_information) {
+        // The settings' fixed sigmas, with the registration's covariance added to them ...
+        (
+            Some(OdometryInformation::Registration),
+            EdgeInformation::Fixed {
+                translation_sigma,
+                rotation_sigma,
+            },
+        ) => EdgeInformation::FixedAndRegistration {
             translation_sigma,
             rotation_sigma,
             scale: 1.0,
-        };
+        },
+        // ... or without it.
+        (
+            Some(OdometryInformation::Fixed),
+            EdgeInformation::FixedAndRegistration {
+                translation_sigma,
+                rotation_sigma,
+                ..
+            },
+        ) => EdgeInformation::Fixed {
+            translation_sigma,
+            rotation_sigma,
+        },
+        (_, information) => information,
+    };
+    if args.settings.print_config {
+        return print_settings(&Settings { slam: config });
     }
     if let Some(path) = &args.recording {
         replay(args, config, path)

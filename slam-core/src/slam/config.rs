@@ -6,7 +6,11 @@ use crate::tracking::TrackerConfig;
 
 /// How an edge's information matrix is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum EdgeInformation {
     /// A diagonal information from standard deviations per edge.
     Fixed {
@@ -40,6 +44,7 @@ pub enum EdgeInformation {
 /// Settings of [`GraphSlam`](super::GraphSlam). Distances in metres, angles in radians.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct GraphSlamConfig {
     /// A new keyframe once the LiDAR moved this far from the last one (thesis: 0.20 m).
     pub keyframe_distance: f64,
@@ -91,6 +96,10 @@ pub struct GraphSlamConfig {
     /// with one another: a robust back end is the second line, not the only one).
     pub loop_max_drift_rate: f64,
     /// Robust kernel on loop-closure edges (a wrong loop must not wreck the map).
+    #[cfg_attr(
+        feature = "serde",
+        serde(with = "crate::robust_kernel::optional_kernel")
+    )]
     pub loop_kernel: Option<RobustKernel>,
     /// Information of odometry edges: by default fixed 1 cm / 0.2° sigmas, a stiff chain that
     /// a look-alike loop cannot stretch. [`EdgeInformation::FixedAndRegistration`] lets each

@@ -9,6 +9,7 @@ use crate::geometry::Pose3;
 /// Settings of [`AdaptiveReach`]. Lengths in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct ReachConfig {
     /// The reach before any prediction has been checked, 2.0 m (KISS-ICP's initial threshold).
     pub initial: f64,

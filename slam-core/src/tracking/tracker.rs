@@ -12,6 +12,7 @@ use crate::traits::registrator::{Alignment, Reach, Registrator};
 /// Settings of a [`Tracker`]. Lengths in metres, angles in radians.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct TrackerConfig {
     /// The adaptive reach of the coarse stage.
     pub reach: ReachConfig,

@@ -8,6 +8,7 @@ use crate::geometry::Pose3;
 
 /// The outcome of one alignment.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Alignment {
     /// `target_T_source`: maps source points into the target frame.
     pub pose: Pose3,
@@ -55,6 +56,7 @@ impl Reach {
 
 /// A sweep registered with its own motion ([`Registrator::align_sweep`]).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SweepAlignment {
     /// The alignment; its pose is the sensor's at time 0 of the sweep.
     pub alignment: Alignment,
@@ -174,6 +176,14 @@ pub trait Registrator {
 /// A registrator that can build a target from prepared sources placed at poses: the local map of
 /// the last keyframes (LiDAR odometry) or the neighbourhood of a loop-closure candidate. Sources
 /// are prepared once per keyframe and reused, so the map is never re-extracted from raw clouds.
+///
+/// Every method is required: a wrapper around another backend (one that logs or counts its
+/// calls) must forward each of them, or the compiler says which it forgot. With defaults, a
+/// wrapper that forgot [`empty_map`](Self::empty_map) or [`add_to_map`](Self::add_to_map)
+/// would compile, and the engine would silently rebuild its local map whole after each keyframe
+/// instead of updating it in place. A backend that only builds maps whole implements
+/// [`WholeMapRegistrator`] instead, which gives it this trait with the plain answers (a source
+/// kept as it is, no voxel, no map updated in place).
 pub trait MapRegistrator: Registrator {
     /// A target made of `parts`: each prepared source moved by its pose (`world_T_source`). The
     /// result is in the world frame.
@@ -187,38 +197,111 @@ pub trait MapRegistrator: Registrator {
 
     /// The form in which a keyframe keeps a prepared source for the maps it will be part of: a
     /// backend may thin here what [`MapRegistrator::target_from_sources`] would thin anyway, so
-    /// that each map rebuild touches fewer points. The result must still align as a source. The
-    /// default keeps the source whole.
-    fn keyframe_source(&self, source: Self::Source) -> Self::Source {
-        source
-    }
+    /// that each map rebuild touches fewer points. The result must still align as a source.
+    /// Return `source` to keep it whole.
+    fn keyframe_source(&self, source: Self::Source) -> Self::Source;
 
     /// The voxel (metres) [`Registrator::prepare_source`] thins a scan to, when that is all it
     /// does with the scan's layout: a caller may then hand it a scan already thinned to a finer
     /// voxel (the engine thins a dense scan once, to its map voxel, and deskews, registers and
-    /// keeps that). `None`, the default, when the backend needs the scan as the sensor gave it
-    /// (LOAM's features run along each ring in firing order).
+    /// keeps that). `None` when the backend needs the scan as the sensor gave it (LOAM's
+    /// features run along each ring in firing order).
+    fn source_voxel(&self) -> Option<f32>;
+
+    /// An empty map that parts can be added to ([`MapRegistrator::add_to_map`]) and removed from
+    /// ([`MapRegistrator::remove_from_map`]) one at a time, so that a sliding window of keyframes
+    /// is updated in place; or `None` when this backend builds maps only whole with
+    /// [`MapRegistrator::target_from_sources`] (then a caller rebuilds the map instead).
+    fn empty_map(&self) -> Option<Self::Target>;
+
+    /// Adds `source` placed at `pose` (`world_T_source`) to `map`, a map from
+    /// [`MapRegistrator::empty_map`], under `key`. A backend whose `empty_map` is `None` is
+    /// never asked.
+    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3);
+
+    /// Removes from `map` what was added under `key`. A backend whose `empty_map` is `None` is
+    /// never asked.
+    fn remove_from_map(&self, map: &mut Self::Target, key: u32);
+}
+
+/// A registrator that builds maps only whole: implementing this one method gives it
+/// [`MapRegistrator`], with each source kept as it is, no [`source_voxel`](MapRegistrator::source_voxel)
+/// and no map updated in place (a caller rebuilds the local map after each keyframe).
+///
+/// ```
+/// # use slam_core::{Alignment, PointCloud, Pose3, Reach, RegistrationError, Registrator};
+/// use slam_core::{MapRegistrator, WholeMapRegistrator};
+///
+/// /// A backend whose prepared clouds are plain point lists.
+/// struct Points;
+/// # impl Registrator for Points {
+/// #     type Source = Vec<nalgebra::Point3<f64>>;
+/// #     type Target = Vec<nalgebra::Point3<f64>>;
+/// #     fn prepare_source(&self, c: &PointCloud) -> Result<Self::Source, RegistrationError> {
+/// #         Ok(c.points().iter().map(|p| p.cast()).collect())
+/// #     }
+/// #     fn prepare_target(&self, c: &PointCloud) -> Result<Self::Target, RegistrationError> {
+/// #         self.prepare_source(c)
+/// #     }
+/// #     fn align(&self, _: &Self::Source, _: &Self::Target, _: &Pose3)
+/// #         -> Result<Alignment, RegistrationError> { unimplemented!() }
+/// #     fn align_within(&self, _: &Self::Source, _: &Self::Target, _: &Pose3, _: &Reach)
+/// #         -> Result<Alignment, RegistrationError> { unimplemented!() }
+/// # }
+///
+/// impl WholeMapRegistrator for Points {
+///     fn whole_map(
+///         &self,
+///         parts: &[(&Self::Source, Pose3)],
+///     ) -> Result<Self::Target, RegistrationError> {
+///         Ok(parts.iter().flat_map(|(s, pose)| s.iter().map(move |p| pose * p)).collect())
+///     }
+/// }
+///
+/// let map = Points.target_from_sources(&[(&vec![[1.0, 0.0, 0.0].into()], Pose3::identity())])?;
+/// assert_eq!(map.len(), 1);
+/// assert!(Points.empty_map().is_none());
+/// # Ok::<(), RegistrationError>(())
+/// ```
+pub trait WholeMapRegistrator: Registrator {
+    /// A target made of `parts`, as [`MapRegistrator::target_from_sources`] (which calls this).
+    ///
+    /// # Errors
+    /// [`RegistrationError::TooFewPoints`] when the parts hold too little.
+    fn whole_map(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError>;
+}
+
+impl<R: WholeMapRegistrator> MapRegistrator for R {
+    fn target_from_sources(
+        &self,
+        parts: &[(&Self::Source, Pose3)],
+    ) -> Result<Self::Target, RegistrationError> {
+        self.whole_map(parts)
+    }
+
+    fn keyframe_source(&self, source: Self::Source) -> Self::Source {
+        source
+    }
+
     fn source_voxel(&self) -> Option<f32> {
         None
     }
 
-    /// An empty map that parts can be added to ([`MapRegistrator::add_to_map`]) and removed from
-    /// ([`MapRegistrator::remove_from_map`]) one at a time, so that a sliding window of keyframes
-    /// is updated in place; or `None`, the default, when this backend builds maps only whole with
-    /// [`MapRegistrator::target_from_sources`] (then a caller rebuilds the map instead).
     fn empty_map(&self) -> Option<Self::Target> {
         None
     }
 
-    /// Adds `source` placed at `pose` (`world_T_source`) to `map`, a map from
-    /// [`MapRegistrator::empty_map`], under `key`. The default, for backends without
-    /// `empty_map`, does nothing.
-    fn add_to_map(&self, map: &mut Self::Target, key: u32, source: &Self::Source, pose: &Pose3) {
-        let _ = (map, key, source, pose);
+    fn add_to_map(
+        &self,
+        _map: &mut Self::Target,
+        _key: u32,
+        _source: &Self::Source,
+        _pose: &Pose3,
+    ) {
     }
 
-    /// Removes from `map` what was added under `key`. The default does nothing.
-    fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
-        let _ = (map, key);
-    }
+    fn remove_from_map(&self, _map: &mut Self::Target, _key: u32) {}
 }

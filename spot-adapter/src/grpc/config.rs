@@ -48,7 +48,6 @@ impl fmt::Debug for Credentials {
 /// How time sync runs: the first rounds before anything moves, then one round now and then in
 /// the background.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub struct TimeSyncConfig {
     /// Rounds tried at connection before giving up on convergence: 20.
     pub max_initial_rounds: usize,
@@ -71,9 +70,10 @@ impl Default for TimeSyncConfig {
     }
 }
 
-/// Everything [`SpotClient::connect`](crate::grpc::SpotClient::connect) needs.
+/// Everything [`SpotClient::connect`](crate::grpc::SpotClient::connect) needs. No `Default`
+/// (there is no default robot): start from [`SpotConfig::new`] and change fields, or write
+/// `SpotConfig { port: 8443, ..SpotConfig::new(host, ca_pem, credentials) }`.
 #[derive(Clone, Debug)]
-#[non_exhaustive]
 pub struct SpotConfig {
     /// The robot's address: a host name or IP (a Spot on its own Wi-Fi: `192.168.80.3`).
     pub host: String,

@@ -9,7 +9,6 @@ use crate::grpc::session::{DIRECTORY_AUTHORITY, ROBOT_ID_AUTHORITY, Session, che
 
 /// Who the robot says it is.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-#[non_exhaustive]
 pub struct RobotIdentity {
     /// Serial number.
     pub serial_number: String,

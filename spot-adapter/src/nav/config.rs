@@ -12,6 +12,11 @@ use crate::nav::stuck::StuckConfig;
 /// [`NavigationMap`](crate::nav::NavigationMap) it plans on, see [`NavigatorConfig::map_config`]). Lengths in metres,
 /// angles in radians, speeds per second.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct NavigatorConfig {
     /// The occupancy grid's cells (0.10 m) and limits.
     pub grid: OccupancyGridConfig,
@@ -150,6 +155,7 @@ impl NavigatorConfig {
 /// The planner a [`Navigator`](crate::nav::Navigator) uses on its planning grid.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum PlannerKind {
     /// [`CellCostAStar`](pathfind::CellCostAStar): least cost under the clearance cost (paths keep to the middle of
     /// corridors, yet pass doors the hard inflation leaves open); shortest paths when the cost
@@ -166,6 +172,11 @@ pub enum PlannerKind {
 /// the obstacle band above the floor. The navigator's own [`NavigatorConfig::map_config`] gives
 /// the ones it plans with.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct NavigationMapConfig {
     /// The occupancy grid's cells (0.10 m) and limits.
     pub grid: OccupancyGridConfig,

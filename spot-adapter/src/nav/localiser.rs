@@ -13,6 +13,11 @@ use crate::robot::Sample;
 
 /// Settings of the localiser. Lengths in metres, angles in radians.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LocaliserConfig {
     /// A correction that moves the odometry's prediction farther than this is never taken from
     /// one scan, 0.3 m (a wrong match or a genuine recovery, which the next scans must

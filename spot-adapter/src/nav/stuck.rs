@@ -11,6 +11,11 @@ use crate::robot::VelocityCommand;
 
 /// Settings of the stuck monitor. Lengths in metres, speeds in m/s.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct StuckConfig {
     /// Walking cycles (commands that translate) over which progress is judged, 25 (5 s at 5 Hz).
     pub window: usize,

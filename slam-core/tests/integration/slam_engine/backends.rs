@@ -2,9 +2,9 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Point3, Vector3, Vector6};
 use slam_core::{
-    Alignment, FactorizationFailure, GraphPose, MapRegistrator, OptimizationReport, OptimizeError,
-    Optimizer, PointCloud, Pose3, PoseGraph, Reach, RegistrationError, Registrator, StopReason,
-    se3_exp, se3_left_jacobian, se3_log,
+    Alignment, FactorizationFailure, GraphPose, OptimizationReport, OptimizeError, Optimizer,
+    PointCloud, Pose3, PoseGraph, Reach, RegistrationError, Registrator, StopReason,
+    WholeMapRegistrator, se3_exp, se3_left_jacobian, se3_log,
 };
 
 /// Point-to-point ICP with brute-force nearest neighbours (Arun/Umeyama step).
@@ -129,11 +129,8 @@ impl BruteIcp {
     }
 }
 
-impl MapRegistrator for BruteIcp {
-    fn target_from_sources(
-        &self,
-        parts: &[(&Prepared, Pose3)],
-    ) -> Result<Prepared, RegistrationError> {
+impl WholeMapRegistrator for BruteIcp {
+    fn whole_map(&self, parts: &[(&Prepared, Pose3)]) -> Result<Prepared, RegistrationError> {
         let mut cloud = PointCloud::new();
         for (src, pose) in parts {
             let pts = src.0.iter().map(|p| (pose * p).cast::<f32>()).collect();

@@ -7,7 +7,7 @@ use nalgebra::Point3;
 use slam_core::tracking::FallbackReason;
 use slam_core::{
     Alignment, GraphSlam, GraphSlamConfig, MapRegistrator, PointCloud, Pose3, Reach,
-    RegistrationError, Registrator, ScanInput,
+    RegistrationError, Registrator, ScanInput, WholeMapRegistrator,
 };
 
 /// `BruteIcp` whose local map is edited in place: it keeps the parts by key and rebuilds the
@@ -75,6 +75,12 @@ impl MapRegistrator for InPlaceIcp {
             parts: std::collections::BTreeMap::new(),
             union: self.0.target_from_sources(parts)?,
         })
+    }
+    fn keyframe_source(&self, source: Prepared) -> Prepared {
+        source
+    }
+    fn source_voxel(&self) -> Option<f32> {
+        None
     }
     fn empty_map(&self) -> Option<InPlaceMap> {
         Some(InPlaceMap {
@@ -259,11 +265,8 @@ impl Registrator for NoMapIcp {
     }
 }
 
-impl MapRegistrator for NoMapIcp {
-    fn target_from_sources(
-        &self,
-        _parts: &[(&Prepared, Pose3)],
-    ) -> Result<Prepared, RegistrationError> {
+impl WholeMapRegistrator for NoMapIcp {
+    fn whole_map(&self, _parts: &[(&Prepared, Pose3)]) -> Result<Prepared, RegistrationError> {
         Err(RegistrationError::TooFewPoints {
             what: "target",
             points: 0,
