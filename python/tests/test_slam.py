@@ -80,3 +80,27 @@ def test_slam_skips_bad_input_and_refuses_bad_settings():
         spot_nav.Slam(keyframe_distance=-1.0)
     with pytest.raises(spot_nav.InvalidInputError, match="odometry"):
         spot_nav.Slam(odometry="kiss")
+
+
+def test_slam_closes_a_loop_between_places_it_revisits():
+    """A lap around the room back past the start: loops join keyframes that truly lie within
+    the search radius of each other, and every pose stays on the truth."""
+    rng = np.random.default_rng(5)
+    world = room(rng)
+    n = 80
+    truth = [pose(10 + 6 * math.cos(2 * math.pi * i / n), 6 + 3.5 * math.sin(2 * math.pi * i / n),
+                  1.0, 0, 0, 2 * math.pi * i / n + math.pi / 2) for i in range(n + 6)]
+    slam = spot_nav.Slam(keyframe_distance=0.5, local_map_keyframes=10, loop_search_radius=2.0)
+    for i, cloud in enumerate(scans(world, truth, rng)):
+        slam.register_frame(cloud, stamp=0.1 * i)
+    loops = slam.loops
+    assert loops and slam.report()["loops_closed"] == len(loops)
+    # Each keyframe's true pose: the scan whose estimated pose it is.
+    index = {tuple(np.round(p[:3, 3], 6)): i for i, p in enumerate(slam.poses)}
+    true_kf = [truth[index[tuple(np.round(k[:3, 3], 6))]] for k in slam.keyframes]
+    for a, b in loops:
+        assert b - a >= 5
+        assert np.linalg.norm(true_kf[a][:3, 3] - true_kf[b][:3, 3]) < 2.0
+    for t, p in zip(truth, slam.poses):
+        dt, dr = pose_error(np.linalg.inv(truth[0]) @ t, p)
+        assert dt < 0.05 and dr < 0.5, (dt, dr)
