@@ -148,3 +148,20 @@ def test_optimize_releases_the_gil():
     gap = max(np.diff(stamps))
     assert min(durations) > 0.02, durations
     assert gap < 0.5 * min(durations), (gap, durations)
+
+
+@pytest.mark.parametrize("name, gtsam, g2o", [
+    ("tinyGrid3D.g2o", 18.6278, 6.72788),
+    ("smallGrid3D.g2o", 1035.85, 458.154),
+    ("input_M3500_g2o.g2o", 137.915, 137.913),
+])
+def test_bundled_graphs_reach_gtsam_and_g2o_optima(name, gtsam, g2o):
+    """Oracles: GTSAM 4.3's LM optimum (our log-map cost is 2x GTSAM's error) and g2o's own
+    optimum in its error convention (posegraph/README.md, "Correctness")."""
+    for model, want in [("log_map", gtsam), ("g2o", g2o)]:
+        g = spot_nav.read_g2o(ROOT / "posegraph/tests/data" / name)
+        g.fix(g.ids[0])
+        report = spot_nav.optimize(g, "lm", error_model=model)
+        got = g.cost() if model == "log_map" else g.chi2()
+        assert report.final_cost == pytest.approx(got, rel=1e-6)
+        assert got == pytest.approx(want, rel=2e-5), (model, got, want)
