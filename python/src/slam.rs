@@ -226,10 +226,9 @@ impl Slam {
     #[getter]
     fn loops<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let pairs: Vec<(usize, usize)> = with_engine!(&*self.engine(), s => s
-            .graph()
-            .edges()
+            .loop_edges()
             .iter()
-            .filter(|e| e.from.abs_diff(e.to) != 1)
+            .filter_map(|&k| s.graph().edges().get(k))
             .map(|e| (e.from.min(e.to), e.from.max(e.to)))
             .collect());
         PyList::new(py, pairs)
