@@ -24,6 +24,9 @@ pub struct SlamSummary {
     pub scans: usize,
     /// Keyframes created.
     pub keyframes: usize,
+    /// Registered scans that rode on a keyframe already in the map instead of making one
+    /// (`SlamReport::revisits`).
+    pub revisits: usize,
     /// Loop closure.
     pub loops: Loops,
     /// Fallbacks, faults and skipped scans, by reason.

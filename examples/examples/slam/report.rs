@@ -70,9 +70,10 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let report = slam.report();
     let skipped: usize = skip_reasons(report).iter().map(|&(_, n)| n).sum();
     out!(
-        "scans       {} ({} keyframes, {skipped} skipped)",
+        "scans       {} ({} keyframes, {} riding on a keyframe already there, {skipped} skipped)",
         report.scans,
-        report.keyframes
+        report.keyframes,
+        report.revisits
     )?;
     let loops = Loops::new(report);
     let rejected = if loops.rejected.is_empty() {
@@ -124,6 +125,7 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         registration: value_name(&args.registration),
         scans: report.scans,
         keyframes: report.keyframes,
+        revisits: report.revisits,
         loops,
         tracking: health,
         time,

@@ -8,7 +8,7 @@ use nalgebra::{Matrix6, UnitQuaternion};
 
 use super::config::GraphSlamConfig;
 use super::information::edge_information;
-use super::keyframes::{Keyframe, ScanPose};
+use super::keyframes::{Keyframe, Link, ScanPose};
 use super::local_map::{LocalMap, LocalWindow};
 use super::loop_closure::LoopQueue;
 use super::node_index::NodeIndex;
@@ -518,8 +518,20 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             source: self.odometry.keyframe_source(source),
             coarse: self.loop_coarse.keyframe_source(coarse),
             cloud,
-            parent,
+            links: parent
+                .map(|keyframe| Link {
+                    keyframe,
+                    loop_edge: None,
+                })
+                .into_iter()
+                .collect(),
         });
+        if let Some(from) = parent {
+            self.keyframes[from].links.push(Link {
+                keyframe: index,
+                loop_edge: None,
+            });
+        }
         self.report.keyframes += 1;
         self.anchor = None;
         self.visit_keyframe(index);

@@ -25,9 +25,20 @@ pub(super) struct Keyframe<S, C> {
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     pub(super) walked: f64,
-    /// The keyframe its odometry edge comes from (the previous one, or on a revisit the old
-    /// keyframe the walk rode on); `None` for the first.
-    pub(super) parent: Option<usize>,
+    /// The keyframes joined to it by an edge: its odometry edge's two ends (the previous
+    /// keyframe, or on a revisit the old keyframe the walk rode on) and each accepted loop's
+    /// other end, with the loop edge's index in the graph.
+    pub(super) links: Vec<Link>,
+}
+
+/// An edge of the graph seen from one of its keyframes.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Link {
+    /// The keyframe at the other end.
+    pub(super) keyframe: usize,
+    /// The edge's index in the graph's edges when it is a loop (which an optimiser may weight
+    /// out); `None` for an odometry edge.
+    pub(super) loop_edge: Option<usize>,
 }
 
 /// An accepted scan: its stamp and LiDAR pose relative to its keyframe, so that it rides on the

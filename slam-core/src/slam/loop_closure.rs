@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use super::engine::GraphSlam;
 use super::information::edge_information;
+use super::keyframes::Link;
 use super::report::{LoopOutcome, LoopRejection, SlamReport};
 use crate::geometry::{Pose3, pose3_is_finite};
 use crate::traits::optimizer::Optimizer;
@@ -210,6 +211,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 self.loop_edges.pop();
                 LoopRejection::EdgeRefused
             })?;
+        let loop_edge = self.loop_edges.last().copied();
+        self.keyframes[cand].links.push(Link {
+            keyframe: new,
+            loop_edge,
+        });
+        self.keyframes[new].links.push(Link {
+            keyframe: cand,
+            loop_edge,
+        });
         Ok(mse)
     }
 

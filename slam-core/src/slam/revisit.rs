@@ -6,9 +6,15 @@
 //! keyframes around it into the local map.
 
 use super::engine::GraphSlam;
+use super::keyframes::Link;
 use crate::geometry::Pose3;
 use crate::traits::optimizer::Optimizer;
 use crate::traits::registrator::MapRegistrator;
+
+/// How many edges of the graph a keyframe may be from the local map to be ridden on: the
+/// relative poses along a few edges are as good as the registrations that made them, while a
+/// keyframe far along the graph may sit where drift put it.
+const VOUCHING_HOPS: usize = 10;
 
 /// What the next scan's motion is measured from: the last keyframe, or on a revisit the last
 /// scan that rode on an old one.
@@ -46,30 +52,50 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// on instead of making a new one: the newest keyframe within
     /// [`GraphSlamConfig::revisit_radius`](super::GraphSlamConfig::revisit_radius) that is old
     /// (not one of the keyframes made since the last revisit, which the walk is laying down
-    /// now) and that the local map vouches for (it, or a keyframe joined to it by an odometry
-    /// edge, is in the local map, so the registration placed the scan consistently with it).
-    /// `None` when off, when the match was too poor (a changed place gets a new keyframe), or
-    /// when no keyframe qualifies.
+    /// now) and that the local map vouches for: it is in the local map, or a few edges of the
+    /// graph from a keyframe that is ([`VOUCHING_HOPS`]; loops an optimiser weighted out do not
+    /// count), so the registration placed the scan consistently with it. `None` when off, when
+    /// the match was too poor (a changed place gets a new keyframe), or when no keyframe
+    /// qualifies.
     pub(super) fn revisited_keyframe(&self, pose: &Pose3, inlier_ratio: f64) -> Option<usize> {
         let radius = self.config.revisit_radius;
-        if radius <= 0.0 {
+        if radius <= 0.0 || inlier_ratio < self.config.revisit_min_inlier_ratio {
             return None;
         }
         let n = self.keyframes.len();
         let laid_down = self
             .chain_start
             .max(n.saturating_sub(self.config.local_map_keyframes));
-        let parent = |i: usize| self.keyframes[i].parent;
-        let vouched = |i: usize| {
-            self.window
-                .keys()
-                .any(|w| w == i || parent(w) == Some(i) || parent(i) == Some(w))
-        };
-        if inlier_ratio < self.config.revisit_min_inlier_ratio {
-            return None;
-        }
         self.node_index
-            .newest_within(pose, radius, |i| i < laid_down && vouched(i))
+            .newest_within(pose, radius, |i| i < laid_down && self.vouched_for(i))
+    }
+
+    /// Whether keyframe `i` is within [`VOUCHING_HOPS`] edges of the local map (a breadth-first
+    /// search over odometry edges and the loops the optimiser kept).
+    fn vouched_for(&self, i: usize) -> bool {
+        let weights = self.optimizer.edge_weights();
+        let kept = |link: &Link| {
+            link.loop_edge
+                .is_none_or(|k| weights.is_none_or(|w| w.get(k).is_none_or(|&w| w >= 0.5)))
+        };
+        let mut seen = vec![i];
+        let mut frontier = vec![i];
+        for _ in 0..=VOUCHING_HOPS {
+            if frontier.iter().any(|&k| self.window.contains(k)) {
+                return true;
+            }
+            let mut next = Vec::new();
+            for k in frontier {
+                for link in self.keyframes[k].links.iter().filter(|l| kept(l)) {
+                    if !seen.contains(&link.keyframe) {
+                        seen.push(link.keyframe);
+                        next.push(link.keyframe);
+                    }
+                }
+            }
+            frontier = next;
+        }
+        false
     }
 
     /// The scan registered at `keyframe_t_lidar` from keyframe `keyframe` rides on it: the
