@@ -54,6 +54,9 @@ fn slam_settings(dict: Option<&Bound<'_, PyDict>>) -> PyResult<GraphSlamConfig> 
     s.take("keyframe_distance", &mut c.keyframe_distance)?;
     s.take("keyframe_rotation", &mut c.keyframe_rotation)?;
     s.take("local_map_keyframes", &mut c.local_map_keyframes)?;
+    s.take("revisit_radius", &mut c.revisit_radius)?;
+    s.take("revisit_min_inlier_ratio", &mut c.revisit_min_inlier_ratio)?;
+    s.take("revisit_max_match_drop", &mut c.revisit_max_match_drop)?;
     s.take("loop_search_radius", &mut c.loop_search_radius)?;
     s.take("loop_neighbours", &mut c.loop_neighbours)?;
     s.take(
@@ -240,6 +243,7 @@ impl Slam {
         let d = PyDict::new(py);
         d.set_item("scans", r.scans)?;
         d.set_item("keyframes", r.keyframes)?;
+        d.set_item("revisits", r.revisits)?;
         d.set_item("loops_attempted", r.loops_attempted)?;
         d.set_item("loops_closed", r.loops_closed)?;
         d.set_item("loops_weighted_out", r.loops_weighted_out)?;

@@ -68,6 +68,12 @@ pub struct GraphSlamConfig {
     /// registration must match (0 to 1; default 0.8) to ride on an old keyframe instead of
     /// making a new one.
     pub revisit_min_inlier_ratio: f64,
+    /// With [`revisit_radius`](Self::revisit_radius): a scan that matched more than this share
+    /// of its points less than the old keyframe's scan did when it was made (0 to 1; default
+    /// 0.06) has found the place changed, and makes a new keyframe, which the map then shows.
+    /// A corridor's match varies by a few hundredths from walk to walk; a corridor lined with
+    /// crates since matches 0.80-0.88 where it matched 0.97-0.99.
+    pub revisit_max_match_drop: f64,
     /// How keyframes (and, without odometry, every scan) are registered against the local
     /// map: the adaptive reach, the checks a registration must pass, and the retries. An
     /// odometry step that ends further than [`TrackerConfig::arbitration_distance`] (0.5 m) from
@@ -177,6 +183,7 @@ impl Default for GraphSlamConfig {
             local_map_keyframes: 40,
             revisit_radius: 0.5,
             revisit_min_inlier_ratio: 0.8,
+            revisit_max_match_drop: 0.06,
             tracker: TrackerConfig::default(),
             loop_search_radius: 0.5,
             loop_neighbours: 20,
@@ -300,6 +307,12 @@ impl GraphSlamConfig {
             (0.0..=1.0).contains(&self.revisit_min_inlier_ratio),
             "GraphSlamConfig::revisit_min_inlier_ratio",
             self.revisit_min_inlier_ratio,
+            "in [0, 1]",
+        )?;
+        InvalidSetting::check(
+            (0.0..=1.0).contains(&self.revisit_max_match_drop),
+            "GraphSlamConfig::revisit_max_match_drop",
+            self.revisit_max_match_drop,
             "in [0, 1]",
         )?;
         let voxel = f64::from(self.map_voxel_size);

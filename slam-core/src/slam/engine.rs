@@ -295,7 +295,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Ok(Prediction::First { pose, velocity }) => {
                 return match self.prepare(scan, velocity) {
                     Ok(prepared) => {
-                        self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, started)
+                        self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, 1.0, started)
                     }
                     Err(reason) => self.skip(reason, started),
                 };
@@ -371,6 +371,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             odom_t_lidar,
             tracked.pose,
             tracked.information.as_ref(),
+            tracked.inlier_ratio,
             started,
         )
     }
@@ -439,7 +440,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     }
 
     /// Adds `prepared` as a keyframe at `pose` (with the registration's information `reg_info`
-    /// for its odometry edge), queues its loop candidate and runs a loop-closure step when
+    /// for its odometry edge, and the share of the scan it `matched`), queues its loop candidate and runs a loop-closure step when
     /// inline.
     pub(super) fn add_keyframe(
         &mut self,
@@ -448,6 +449,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         odom_t_lidar: Option<Pose3>,
         pose: Pose3,
         reg_info: Option<&Matrix6<f64>>,
+        matched: f64,
         started: Instant,
     ) -> ScanOutcome {
         let Prepared {
@@ -518,6 +520,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             source: self.odometry.keyframe_source(source),
             coarse: self.loop_coarse.keyframe_source(coarse),
             cloud,
+            matched,
             links: parent
                 .map(|keyframe| Link {
                     keyframe,

@@ -55,8 +55,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// now) and that the local map vouches for: it is in the local map, or a few edges of the
     /// graph from a keyframe that is ([`VOUCHING_HOPS`]; loops an optimiser weighted out do not
     /// count), so the registration placed the scan consistently with it. `None` when off, when
-    /// the match was too poor (a changed place gets a new keyframe), or when no keyframe
-    /// qualifies.
+    /// the match was too poor, or when no keyframe qualifies, or when the scan matched more than
+    /// [`GraphSlamConfig::revisit_max_match_drop`](super::GraphSlamConfig::revisit_max_match_drop)
+    /// less of itself than the keyframe did when it was made (the place changed).
     pub(super) fn revisited_keyframe(&self, pose: &Pose3, inlier_ratio: f64) -> Option<usize> {
         let radius = self.config.revisit_radius;
         if radius <= 0.0 || inlier_ratio < self.config.revisit_min_inlier_ratio {
@@ -66,8 +67,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let laid_down = self
             .chain_start
             .max(n.saturating_sub(self.config.local_map_keyframes));
-        self.node_index
-            .newest_within(pose, radius, |i| i < laid_down && self.vouched_for(i))
+        let old = self
+            .node_index
+            .newest_within(pose, radius, |i| i < laid_down && self.vouched_for(i))?;
+        // Matching much less than when the keyframe was made: the place changed.
+        let drop = self.keyframes[old].matched - inlier_ratio;
+        (drop <= self.config.revisit_max_match_drop).then_some(old)
     }
 
     /// Whether keyframe `i` is within [`VOUCHING_HOPS`] edges of the local map (a breadth-first
