@@ -295,7 +295,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Ok(Prediction::First { pose, velocity }) => {
                 return match self.prepare(scan, velocity) {
                     Ok(prepared) => {
-                        self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, 1.0, started)
+                        self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, started)
                     }
                     Err(reason) => self.skip(reason, started),
                 };
@@ -370,8 +370,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             tracked.prepared,
             odom_t_lidar,
             tracked.pose,
-            tracked.information.as_ref(),
-            tracked.inlier_ratio,
+            tracked
+                .information
+                .as_ref()
+                .map(|info| (info, tracked.inlier_ratio)),
             started,
         )
     }
@@ -439,8 +441,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Ok(())
     }
 
-    /// Adds `prepared` as a keyframe at `pose` (with the registration's information `reg_info`
-    /// for its odometry edge, and the share of the scan it `matched`), queues its loop candidate and runs a loop-closure step when
+    /// Adds `prepared` as a keyframe at `pose` (with its `registration`'s information for its
+    /// odometry edge, and the share of the scan it matched), queues its loop candidate and runs a loop-closure step when
     /// inline.
     pub(super) fn add_keyframe(
         &mut self,
@@ -448,10 +450,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         prepared: Prepared<R::Source>,
         odom_t_lidar: Option<Pose3>,
         pose: Pose3,
-        reg_info: Option<&Matrix6<f64>>,
-        matched: f64,
+        registration: Option<(&Matrix6<f64>, f64)>,
         started: Instant,
     ) -> ScanOutcome {
+        let reg_info = registration.map(|(info, _)| info);
+        // Unknown (0: no revisit counts as a drop) for the first keyframe and a fallback.
+        let matched = registration.map_or(0.0, |(_, ratio)| ratio);
         let Prepared {
             cloud,
             thinned,

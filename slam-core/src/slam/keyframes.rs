@@ -25,8 +25,8 @@ pub(super) struct Keyframe<S, C> {
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     pub(super) walked: f64,
-    /// The share of its scan its registration matched (1 for the first keyframe, 0 for one
-    /// that fell back to its prediction): a revisit that matches much less has found the place
+    /// The share of its scan its registration matched (0, unknown, for the first keyframe and
+    /// one that fell back to its prediction): a revisit that matches much less has found the place
     /// changed.
     pub(super) matched: f64,
     /// The keyframes joined to it by an edge: its odometry edge's two ends (the previous
