@@ -49,7 +49,10 @@ impl NodeIndex {
         radius: f64,
         admit: impl Fn(usize) -> bool,
     ) -> Option<usize> {
-        self.within(pose, radius).filter(|&i| admit(i)).max()
+        // Newest first, so that an expensive `admit` runs until the first it admits.
+        let mut near: Vec<usize> = self.within(pose, radius).collect();
+        near.sort_unstable_by(|a, b| b.cmp(a));
+        near.into_iter().find(|&i| admit(i))
     }
 
     /// The keyframe indices within `radius` of `pose`.
