@@ -1,11 +1,16 @@
 //! Error enums of slam-core and of the three backend traits.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use thiserror::Error;
 
 use crate::robust_kernel::RobustKernel;
+
+mod backend_error;
+mod invalid_setting;
+
+pub use backend_error::BackendError;
+pub use invalid_setting::InvalidSetting;
 
 /// `Error::backend(name, error)`, the constructor of an error's `Backend { backend, source }`
 /// variant, with the docs given.
@@ -491,62 +496,6 @@ backend_constructor! {
     /// ```
 }
 
-/// A third-party backend's own error, kept as the source of the `Backend` variants of
-/// [`RegistrationError`], [`OptimizeError`], [`PlanError`] and [`PlaceRecognitionError`].
-///
-/// It dereferences to the backend's error (`dyn Error + Send + Sync`), which is also what the
-/// variant's [`source`](std::error::Error::source) returns, so a caller downcasts it to the
-/// backend's type. It is shared, so the errors that hold it stay `Clone`; two are equal when they
-/// are the same error (one a clone of the other), as errors of unknown types cannot be compared.
-///
-/// ```
-/// use slam_core::BackendError;
-/// let e = BackendError::new(std::io::Error::other("device lost"));
-/// assert_eq!(e.to_string(), "device lost");
-/// assert!(e.downcast_ref::<std::io::Error>().is_some());
-/// assert_eq!(e.clone(), e);
-/// assert_ne!(BackendError::new("device lost"), e);
-/// ```
-#[derive(Clone)]
-pub struct BackendError(Arc<dyn std::error::Error + Send + Sync>);
-
-impl BackendError {
-    /// `error` (any error type, or a message) as a backend's error.
-    pub fn new(error: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> Self {
-        Self(Arc::from(error.into()))
-    }
-}
-
-// Deliberately not `std::error::Error` itself: thiserror then returns the backend's error (the
-// target of this `Deref`) as the source, so it downcasts to the backend's type.
-impl std::ops::Deref for BackendError {
-    type Target = dyn std::error::Error + Send + Sync;
-
-    fn deref(&self) -> &Self::Target {
-        &*self.0
-    }
-}
-
-impl std::fmt::Debug for BackendError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        std::fmt::Debug::fmt(&*self.0, f)
-    }
-}
-
-impl std::fmt::Display for BackendError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        std::fmt::Display::fmt(&*self.0, f)
-    }
-}
-
-impl PartialEq for BackendError {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
-}
-
-impl Eq for BackendError {}
-
 /// Errors of a [`PlaceRecognizer`](crate::PlaceRecognizer).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
@@ -626,67 +575,4 @@ pub enum CloudError {
         /// The voxel size given.
         size: f32,
     },
-}
-
-/// A setting or an argument is out of its valid range: which one, the value given and the range
-/// in words. Every crate of the workspace reports bad settings with it (through its own error's
-/// `InvalidConfig` variant where it has one), so a caller matches one type.
-///
-/// ```
-/// use slam_core::{GraphSlamConfig, InvalidSetting};
-/// let bad = GraphSlamConfig { keyframe_distance: -1.0, ..GraphSlamConfig::default() };
-/// let InvalidSetting { setting, value, .. } = bad.validate().unwrap_err();
-/// assert_eq!((setting, value), ("GraphSlamConfig::keyframe_distance", -1.0));
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Error)]
-#[error("{setting} = {value}: must be {expected}")]
-pub struct InvalidSetting {
-    /// The setting, as `Type::field` (`Type::function argument` for an argument).
-    pub setting: &'static str,
-    /// The value given (counts and integers converted).
-    pub value: f64,
-    /// The valid range, in words.
-    pub expected: &'static str,
-}
-
-impl InvalidSetting {
-    /// `Ok` when `ok`, else the error for `setting` at `value`.
-    ///
-    /// # Errors
-    /// [`InvalidSetting`] unless `ok`.
-    pub fn check(
-        ok: bool,
-        setting: &'static str,
-        value: f64,
-        expected: &'static str,
-    ) -> Result<(), Self> {
-        if ok {
-            Ok(())
-        } else {
-            Err(Self {
-                setting,
-                value,
-                expected,
-            })
-        }
-    }
-
-    /// [`InvalidSetting::check`] for an `f32` setting, whose value the error gives as written
-    /// (`-0.1`, not the `-0.10000000149011612` of its exact `f64` conversion).
-    ///
-    /// # Errors
-    /// [`InvalidSetting`] unless `ok`.
-    pub fn check_f32(
-        ok: bool,
-        setting: &'static str,
-        value: f32,
-        expected: &'static str,
-    ) -> Result<(), Self> {
-        if ok {
-            return Ok(());
-        }
-        // The shortest decimal that reads back as the f32 ("NaN" and "inf" included).
-        let value = value.to_string().parse().unwrap_or(f64::from(value));
-        Self::check(false, setting, value, expected)
-    }
 }
