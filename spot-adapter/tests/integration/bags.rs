@@ -6,7 +6,7 @@
 //! The bags are written at test time by `tests/bags/write_bags.py` in a virtual environment this
 //! test makes on first use under `target/` with the pinned packages of
 //! `tests/bags/requirements.txt`. Without Python or the package registry the tests fail with the
-//! reason; `SPOT_NAV_SKIP_PYTHON=1` skips them with a message (refused when `CI` is set).
+//! reason (a skipped test would pass without checking anything).
 
 #![allow(
     clippy::unwrap_used,
@@ -54,16 +54,8 @@ fn run(cmd: &mut Command, what: &str) {
     );
 }
 
-/// The venv's python, made on first use (`None` when skipped on request).
-fn python() -> Option<PathBuf> {
-    if std::env::var_os("SPOT_NAV_SKIP_PYTHON").is_some() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "SPOT_NAV_SKIP_PYTHON is not allowed in CI"
-        );
-        eprintln!("SKIPPED: SPOT_NAV_SKIP_PYTHON is set, the rosbags tests did not run");
-        return None;
-    }
+/// The venv's python, made on first use.
+fn python() -> PathBuf {
     let requirements = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bags/requirements.txt");
     let venv = target_dir().join("rosbags-venv-0.11.9");
     let python = venv.join("bin/python");
@@ -87,7 +79,7 @@ fn python() -> Option<PathBuf> {
             let _ = std::fs::remove_dir_all(&building);
         }
     }
-    Some(python)
+    python
 }
 
 /// The simulation: scans cast while walking, so every cloud carries per-point times.
@@ -105,10 +97,10 @@ fn lap() -> impl Iterator<Item = Sample> {
 
 /// The folder of bags written from the lap (once per test run; `bags/` holds the bags, see
 /// `tests/bags/write_bags.py`).
-pub(crate) fn bags() -> Option<&'static Path> {
-    static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
+pub(crate) fn bags() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let python = python()?;
+        let python = python();
         let dir = target_dir().join("tmp/bags-fixture");
         let _ = std::fs::remove_dir_all(&dir);
         let recording = dir.join("recording");
@@ -126,9 +118,9 @@ pub(crate) fn bags() -> Option<&'static Path> {
                 .arg(dir.join("bags")),
             "writing the bags with rosbags",
         );
-        Some(dir)
+        dir
     })
-    .as_deref()
+    .as_path()
 }
 
 fn mcap(dir: &Path) -> PathBuf {
@@ -173,7 +165,7 @@ fn assert_same_trajectory(got: &[StampedPose], want: &[StampedPose]) {
 
 #[test]
 fn replaying_either_bag_gives_the_simulators_trajectory() {
-    let Some(dir) = bags() else { return };
+    let dir = bags();
     let want = trajectory(lap());
     // The first skewed scan waits for a velocity to deskew with.
     assert_eq!(want.len(), SCANS - 1);
@@ -217,7 +209,7 @@ fn replaying_either_bag_gives_the_simulators_trajectory() {
 
 #[test]
 fn odometry_from_tf_equals_odometry_from_its_topic() {
-    let Some(dir) = bags() else { return };
+    let dir = bags();
     let by_topic = Bag::open(mcap(dir), &BagConfig::default()).unwrap();
     let by_tf = Bag::open(
         mcap(dir),
@@ -261,7 +253,7 @@ fn layout_bag_in(path: &Path, topic: &str) -> Result<Bag, RecordError> {
 
 #[test]
 fn every_layout_decodes_to_the_recorded_cloud() {
-    let Some(dir) = bags() else { return };
+    let dir = bags();
     let want = recorded_clouds(dir);
     let cases = [
         ("/f64_ring8_ns", TimeUnit::NanosecondsRelative, true),
@@ -345,7 +337,7 @@ fn read_all(path: &Path) -> Result<usize, RecordError> {
 
 #[test]
 fn cut_and_corrupted_bags_never_panic() {
-    let Some(dir) = bags() else { return };
+    let dir = bags();
     for (path, name) in [(mcap(dir), "mangled.mcap"), (ros1(dir), "mangled.bag")] {
         let bytes = std::fs::read(&path).unwrap();
         let out = dir.join(name);
@@ -383,7 +375,7 @@ fn cut_and_corrupted_bags_never_panic() {
 
 #[test]
 fn bad_bags_are_clear_errors() {
-    let Some(dir) = bags() else { return };
+    let dir = bags();
     // Truncated files.
     for (path, name) in [(mcap(dir), "cut.mcap"), (ros1(dir), "cut.bag")] {
         let bytes = std::fs::read(&path).unwrap();

@@ -128,10 +128,10 @@ fn setup(
     start: Vector2<f64>,
     name: &str,
     fault: Option<(usize, &'static str)>,
-) -> Option<(SpotClient, Navigator<registration::PointToPlaneIcp>, Bridge)> {
+) -> (SpotClient, Navigator<registration::PointToPlaneIcp>, Bridge) {
     let mut sim =
         CommandedSpot::new(building.clone(), start, 0.0, &SimulationConfig::default()).unwrap();
-    let mut fake = support::start(name, &["--clock-offset", "4.5"])?;
+    let mut fake = support::start(name, &["--clock-offset", "4.5"]);
     publish(&mut fake, &sim.sense(), 0);
     let mut config = fake.config();
     config.description = sim.description().clone();
@@ -148,7 +148,7 @@ fn setup(
         NavigatorConfig::default(),
     )
     .unwrap();
-    Some((spot, navigator, Bridge::start(fake, sim, fault)))
+    (spot, navigator, Bridge::start(fake, sim, fault))
 }
 
 /// A goal 4 m down the corridor from its first corner.
@@ -165,11 +165,8 @@ fn corridor_goal(building: &Building) -> (Vector2<f64>, Vector2<f64>) {
 fn the_navigator_walks_the_simulated_spot_to_a_goal_and_back_over_grpc() {
     let (building, map, navigation) = common::building_and_map(3);
     let (start, goal) = corridor_goal(&building);
-    let Some((mut spot, mut navigator, bridge)) =
-        setup(&building, &map, &navigation, start, "navigation", None)
-    else {
-        return;
-    };
+    let (mut spot, mut navigator, bridge) =
+        setup(&building, &map, &navigation, start, "navigation", None);
     let there = drive(&mut spot, &mut navigator, goal, 300, |_| {}).unwrap();
     let back = drive(&mut spot, &mut navigator, start, 300, |_| {}).unwrap();
     drop(spot);
@@ -231,16 +228,14 @@ fn faults_mid_walk_stop_the_drive_and_no_motion_follows_them() {
         ("take-lease", false),
         ("drop", false),
     ] {
-        let Some((mut spot, mut navigator, bridge)) = setup(
+        let (mut spot, mut navigator, bridge) = setup(
             &building,
             &map,
             &navigation,
             start,
             fault,
             Some((10, fault)),
-        ) else {
-            return;
-        };
+        );
         let began = Instant::now();
         let error = drive(&mut spot, &mut navigator, goal, 300, |_| {}).unwrap_err();
         let took = began.elapsed();

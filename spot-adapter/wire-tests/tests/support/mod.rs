@@ -2,9 +2,8 @@
 //! on first use under `target/tmp/py-fake-spot` with the pinned packages of
 //! `fake_spot/requirements.txt`.
 //!
-//! A missing `python3` or an unreachable package index fails the test with the reason. Only
-//! an explicit `SPOT_NAV_SKIP_PYTHON_TESTS=1` turns the tests into a printed skip (never set
-//! in CI).
+//! A missing `python3` or an unreachable package index fails the test with the reason (a
+//! skipped test would pass without checking anything).
 
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -32,29 +31,23 @@ fn fake_dir() -> PathBuf {
     }
 }
 
-/// The venv's python, made on first use; `None` when the user opted out.
-pub fn python() -> Option<PathBuf> {
-    static PYTHON: OnceLock<Result<Option<PathBuf>, String>> = OnceLock::new();
+/// The venv's python, made on first use.
+pub fn python() -> PathBuf {
+    static PYTHON: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     match PYTHON.get_or_init(make_venv) {
         Ok(p) => p.clone(),
         Err(reason) => panic!("the fake Spot cannot run: {reason}"),
     }
 }
 
-fn make_venv() -> Result<Option<PathBuf>, String> {
-    if std::env::var("SPOT_NAV_SKIP_PYTHON_TESTS").is_ok_and(|v| v == "1") {
-        eprintln!(
-            "SKIPPED: SPOT_NAV_SKIP_PYTHON_TESTS=1, the wire tests against the official SDK did not run"
-        );
-        return Ok(None);
-    }
+fn make_venv() -> Result<PathBuf, String> {
     let venv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("py-fake-spot");
     let python = venv.join("bin").join("python");
     let requirements = std::fs::read_to_string(fake_dir().join("requirements.txt"))
         .map_err(|e| format!("fake_spot/requirements.txt: {e}"))?;
     let stamp = venv.join("installed-requirements.txt");
     if python.exists() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == requirements) {
-        return Ok(Some(python));
+        return Ok(python);
     }
     let run = |command: &mut Command, what: &str| -> Result<(), String> {
         let output = command
@@ -90,7 +83,7 @@ fn make_venv() -> Result<Option<PathBuf>, String> {
         "pip install of the official Spot SDK (needs PyPI)",
     )?;
     std::fs::write(&stamp, requirements).map_err(|e| format!("{}: {e}", stamp.display()))?;
-    Ok(Some(python))
+    Ok(python)
 }
 
 /// A running fake Spot; killed on drop.
@@ -102,11 +95,10 @@ pub struct FakeSpot {
     pub dir: PathBuf,
 }
 
-/// Start a fake Spot with extra arguments (`--clock-offset 12.5`, `--token-lifetime 3`); `None`
-/// when the user opted out of the Python tests.
-pub fn start(name: &str, args: &[&str]) -> Option<FakeSpot> {
+/// Start a fake Spot with extra arguments (`--clock-offset 12.5`, `--token-lifetime 3`).
+pub fn start(name: &str, args: &[&str]) -> FakeSpot {
     static SERIAL: Mutex<u32> = Mutex::new(0);
-    let python = python()?;
+    let python = python();
     let serial = {
         let mut s = SERIAL.lock().unwrap();
         *s += 1;
@@ -143,13 +135,13 @@ pub fn start(name: &str, args: &[&str]) -> Option<FakeSpot> {
         .strip_prefix("READY ")
         .and_then(|p| p.parse().ok())
         .unwrap_or_else(|| panic!("unexpected first line from the fake: {ready:?}"));
-    Some(FakeSpot {
+    FakeSpot {
         child,
         stdin,
         lines,
         port,
         dir,
-    })
+    }
 }
 
 impl FakeSpot {
@@ -222,7 +214,7 @@ impl Drop for FakeSpot {
 /// Run the official SDK's `fake_spot/sdk_flow.py` against `fake` with `extra` arguments; its
 /// stdout, after checking it succeeded.
 pub fn run_sdk_flow(fake: &FakeSpot, extra: &[&str]) -> Vec<u8> {
-    let output = Command::new(python().unwrap())
+    let output = Command::new(python())
         .arg(fake_dir().join("sdk_flow.py"))
         .args(["--port", &fake.port.to_string(), "--ca"])
         .arg(fake.dir.join("ca.pem"))
@@ -238,17 +230,14 @@ pub fn run_sdk_flow(fake: &FakeSpot, extra: &[&str]) -> Vec<u8> {
     output.stdout
 }
 
-/// Skip the rest of a test when the user opted out (the skip is printed by `python()`).
+/// A fake Spot for a test ([`start`]), with extra arguments when given.
 #[macro_export]
 macro_rules! fake_spot {
     ($name:expr) => {
         $crate::fake_spot!($name, &[])
     };
     ($name:expr, $args:expr) => {
-        match support::start($name, $args) {
-            Some(fake) => fake,
-            None => return,
-        }
+        support::start($name, $args)
     };
 }
 
