@@ -163,8 +163,9 @@ fn print(name: &str, e: &Explored) {
 
 /// Both explorers on the same small building: each maps it to at least 97 % of the reachable
 /// floor with no collision and stops by itself; ours walks no farther than the greedy one
-/// (seed 11: 126 m against 136 m). The margin is not the same on every building: on seed 12
-/// the two walk 116 m and 117 m, on seed 13 ours walks 134 m and the greedy one 126 m.
+/// (seed 11: 126 m against 136 m). Not a general result: on seeds 12, 13 and 14
+/// ([`on_other_buildings`]) ours walks 0.99x, 1.06x and 1.24x the greedy explorer's distance,
+/// and small changes of the settings move either by 20 % or more on one building.
 #[test]
 fn explores_a_small_building_walking_no_farther_than_the_greedy_explorer() {
     let building = small_building(11);
@@ -234,5 +235,31 @@ fn bad_exploration_settings_are_refused_by_name() {
             other => panic!("{other:?}"),
         }
         assert_eq!(slam.report().scans, 0, "refused before the first scan");
+    }
+}
+
+/// The README's figures: both explorers on small buildings the other tests do not use (seeds
+/// 12-14), coverage and collisions checked, the distances printed (2026-12-05: ours 0.99x,
+/// 1.06x and 1.24x the greedy explorer's distance). About 30 s a building:
+/// `cargo test -p spot-nav-adapter --release --test integration exploration::on_other_buildings
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore = "about 30 s a building; the README's figures"]
+fn on_other_buildings() {
+    for seed in 12..=14 {
+        let building = small_building(seed);
+        let ours = explore_building(&building, FrontierChoice::default(), 3000);
+        print(&format!("seed {seed} information gain"), &ours);
+        let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
+        print(&format!("seed {seed} greedy nearest"), &greedy);
+        eprintln!(
+            "seed {seed}: ours walks {:.2}x the greedy explorer's distance",
+            ours.walked / greedy.walked
+        );
+        for e in [&ours, &greedy] {
+            assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
+            assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
+            assert_eq!(e.collisions, 0);
+        }
     }
 }
