@@ -282,3 +282,98 @@ fn nearest_free(blocked: &BitGrid, position: Vector2<f64>, reach: f64) -> Option
     }
     best.map(|(_, c)| c)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gridmap::PlanningGridConfig;
+    use slam_core::GridGeometry;
+
+    /// A corridor 4 m long and 1.9 m wide, walled on three sides and open to the east (a
+    /// frontier of 19 cells), and a patch of floor seen far off beyond unknown space (a
+    /// frontier no walk reaches).
+    fn corridor_and_patch() -> (OccupancyGrid, PlanningGrid) {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(70, 21, geometry, CellState::Unknown).unwrap();
+        for y in 0..=20 {
+            for x in 0..40 {
+                let wall = x == 0 || y == 0 || y == 20;
+                let state = if wall {
+                    CellState::Occupied
+                } else {
+                    CellState::Free
+                };
+                g.set(Cell::new(x, y), state).unwrap();
+            }
+        }
+        for y in 5..10 {
+            for x in 60..65 {
+                g.set(Cell::new(x, y), CellState::Free).unwrap();
+            }
+        }
+        let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+        (g, planning)
+    }
+
+    #[test]
+    fn the_reachable_frontier_is_chosen_and_the_other_reported_unreachable() {
+        let (g, planning) = corridor_and_patch();
+        for choice in [
+            FrontierChoice::default(),
+            FrontierChoice::GreedyNearestFrontier,
+        ] {
+            let explorer = Explorer::new(ExplorerConfig {
+                choice,
+                ..ExplorerConfig::default()
+            })
+            .unwrap();
+            let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
+            let chosen = decision.chosen.unwrap();
+            assert_eq!(chosen.frontier.size(), 19);
+            // The goal: the reachable cell nearest the frontier's middle (39, 10), beyond the
+            // 0.3 m inflation of the unknown space east of it.
+            assert!(
+                (chosen.goal - Vector2::new(3.65, 1.05)).norm() < 1e-9,
+                "{chosen:?}"
+            );
+            // Straight east from the robot's cell (10, 10) to (36, 10).
+            assert!((chosen.cost - 2.6).abs() < 1e-9, "{}", chosen.cost);
+            assert!(chosen.gain > 0.0);
+            assert_eq!(decision.reachable, 1);
+            assert_eq!(decision.unreachable.len(), 1);
+            assert_eq!(decision.unreachable[0].size(), 16, "the patch's rim");
+        }
+    }
+
+    #[test]
+    fn a_frontier_given_up_is_not_chosen_again_and_is_reported() {
+        let (g, planning) = corridor_and_patch();
+        let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        let goal = explorer
+            .decide(&g, &planning, Vector2::new(1.0, 1.0))
+            .chosen
+            .unwrap()
+            .goal;
+        explorer.give_up(goal, GiveUpReason::NoPath);
+        let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
+        assert_eq!(decision.chosen, None, "nothing left to explore");
+        assert_eq!((decision.reachable, decision.given_up), (0, 1));
+        assert_eq!(
+            explorer.given_up(),
+            [GivenUpFrontier {
+                goal,
+                reason: GiveUpReason::NoPath
+            }]
+        );
+    }
+
+    #[test]
+    fn a_robot_with_no_free_cell_near_it_reaches_nothing() {
+        let (g, planning) = corridor_and_patch();
+        let explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        // In the unknown space between the corridor and the patch.
+        let decision = explorer.decide(&g, &planning, Vector2::new(5.4, 1.5));
+        assert_eq!(decision.chosen, None);
+        assert_eq!(decision.unreachable.len(), 2);
+    }
+}
