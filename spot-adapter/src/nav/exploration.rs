@@ -39,6 +39,9 @@ pub struct ExplorationReport {
     pub cycles: usize,
     /// Frontier decisions made (each on a map rendered afresh from the keyframes).
     pub decisions: usize,
+    /// Milliseconds of each decision that started a walk: rendering the map, picking the
+    /// frontier and making the navigator on that map.
+    pub decision_ms: Vec<f64>,
     /// Length of the body's path as the engine estimated it (metres).
     pub walked: f64,
     /// The frontiers given up on the way, and why.
@@ -62,8 +65,8 @@ pub struct ExplorationCycle<'a> {
     pub step: &'a NavigationStep,
     /// The engine's estimate of the body after the scan (map frame), when it has one.
     pub map_t_body: Option<Pose3>,
-    /// Milliseconds the engine, the navigator and (this cycle's share of) the explorer took,
-    /// without the robot's own time.
+    /// Milliseconds the engine and the navigator took on the sample, without the robot's own
+    /// time (the decisions between walks are in [`ExplorationReport::decision_ms`]).
     pub compute_ms: f64,
 }
 
@@ -73,14 +76,17 @@ pub struct ExplorationCycle<'a> {
 /// occupancy grid is rendered from the keyframes at their current poses, the [`Explorer`]
 /// picks a frontier, and a [`Navigator`] on that map (localising with `localiser`, settings
 /// `navigator` with its goal tolerance set to [`ExplorerConfig::arrive_within`]) walks toward
-/// it. A walk that ends with no path, blocked or lost gives its frontier up (reported); one
-/// that arrives with the frontier still there gives it up too. Stops when no reachable
-/// frontier is left, or after `max_cycles` samples; the robot is sent a stop on every way out.
+/// it (it does not wait for what newly blocks the way: that is unknown space turning out to be
+/// wall). The second walk near the same goal that ends with no path, blocked or lost gives its
+/// frontier up, and so does standing at its goal with the frontier still there; the report
+/// lists them. Stops when no reachable frontier is left, or after `max_cycles` samples; the
+/// robot is sent a stop on every way out.
 ///
 /// # Errors
 /// [`ExplorationError::Robot`] when the robot fails, [`ExplorationError::Navigation`] for
 /// invalid settings or when the navigator or the map fails, [`ExplorationError::Map`] when the
-/// engine's map cloud cannot be made; the robot was sent a stop first.
+/// engine's map cloud cannot be made, [`ExplorationError::NoMap`] when the engine kept none of
+/// the scans within the budget; the robot was sent a stop first.
 pub fn explore<Rb, R, C, O, L>(
     robot: &mut Rb,
     slam: &mut GraphSlam<R, C, O>,
@@ -111,6 +117,7 @@ struct Exploration {
     explorer: Explorer,
     cycles: usize,
     decisions: usize,
+    decision_ms: Vec<f64>,
     walked: f64,
     last_position: Option<Vector2<f64>>,
     /// The goal of the last walk, when it ended there.
@@ -150,6 +157,7 @@ impl Exploration {
             explorer: Explorer::new(config.clone()).map_err(ExplorationError::Navigation)?,
             cycles: 0,
             decisions: 0,
+            decision_ms: Vec::new(),
             walked: 0.0,
             last_position: None,
             arrived_at: None,
@@ -188,6 +196,7 @@ impl Exploration {
             slam.process(&sample.scan_input());
         }
         loop {
+            let started = Instant::now();
             let map_t_body = slam
                 .current_lidar_pose()
                 .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
@@ -240,6 +249,7 @@ impl Exploration {
                 self.navigator.clone(),
             )
             .map_err(ExplorationError::Navigation)?;
+            self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             match self.walk(robot, slam, &mut walker, &chosen, max_cycles, observe)? {
                 WalkEnd::Decide => {}
                 WalkEnd::Arrived => self.arrived_at = Some(chosen.goal),
@@ -370,6 +380,7 @@ impl Exploration {
             outcome,
             cycles: self.cycles,
             decisions: self.decisions,
+            decision_ms: self.decision_ms.clone(),
             walked: self.walked,
             given_up: self.explorer.given_up().to_vec(),
             last_decision,

@@ -142,10 +142,12 @@ pub fn coverage(
 
 fn print(name: &str, e: &Explored) {
     eprintln!(
-        "{name}: {:?} after {} scans, {} decisions; coverage {:.1} %, walked {:.1} m (estimated {:.1} m), {} collisions, {} frontiers given up {:?}, {} unreachable left; {:.1} s",
+        "{name}: {:?} after {} scans, {} decisions ({:.0} ms mean, {:.0} ms max); coverage {:.1} %, walked {:.1} m (estimated {:.1} m), {} collisions, {} frontiers given up {:?}, {} unreachable left; {:.1} s",
         e.report.outcome,
         e.report.cycles,
         e.report.decisions,
+        e.report.decision_ms.iter().sum::<f64>() / e.report.decision_ms.len().max(1) as f64,
+        e.report.decision_ms.iter().copied().fold(0.0, f64::max),
         100.0 * e.coverage,
         e.walked,
         e.report.walked,
