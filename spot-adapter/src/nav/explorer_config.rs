@@ -12,7 +12,7 @@ pub enum FrontierChoice {
     /// within sensor range) is taken first. A scrap left behind costs a walk back later; a large
     /// unknown area will be walked into anyway, and the scraps by the way are cleared on the
     /// way to it. (Weighing the other way, the most area per walk, `gain * exp(-0.25 /m *
-    /// cost)` after González-Baños and Latombe, walked 5-55 % farther than the nearest-first
+    /// cost)` after González-Baños and Latombe, walked 1-55 % farther than the nearest-first
     /// rule on the small test building: it leaves the scraps behind.)
     InformationGain {
         /// Metres more than the nearest frontier's walk that a frontier may cost and still be
