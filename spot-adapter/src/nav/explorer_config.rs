@@ -13,7 +13,9 @@ pub enum FrontierChoice {
     /// unknown area will be walked into anyway, and the scraps by the way are cleared on the
     /// way to it. (Weighing the other way, the most area per walk, `gain * exp(-0.25 /m *
     /// cost)` after González-Baños and Latombe, walked 1-55 % farther than the nearest-first
-    /// rule on the small test building: it leaves the scraps behind.)
+    /// rule on the small test building: it leaves the scraps behind.) Measured so far, this rule
+    /// walks about as far as the nearest-first one, 0.93-1.24x on four small buildings: not
+    /// yet the better explorer the issue asks for.
     InformationGain {
         /// Metres more than the nearest frontier's walk that a frontier may cost and still be
         /// weighed, 4 m (the length of a room or two along a corridor).
