@@ -66,6 +66,28 @@ pub enum DriveError<E: std::error::Error + 'static> {
     Navigation(#[source] NavError),
 }
 
+/// Why [`explore`](super::explore) stopped early; the robot was sent a stop first.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ExplorationError<E: std::error::Error + 'static> {
+    /// The robot failed to deliver a sample or take a command.
+    #[error("the robot failed")]
+    Robot(#[source] E),
+    /// Invalid settings, or the navigator or its map failed.
+    #[error("navigation failed")]
+    Navigation(#[source] NavError),
+    /// The engine's map cloud could not be made for the navigator to localise against.
+    #[error("the map cloud cannot be made")]
+    Map(#[source] slam_core::CloudError),
+    /// The engine kept none of the first `cycles` scans (every one skipped): there is no map
+    /// to explore from.
+    #[error("the engine kept none of the first {cycles} scans: no map to explore from")]
+    NoMap {
+        /// Scans taken.
+        cycles: usize,
+    },
+}
+
 impl NavError {
     /// A [`NavError::InvalidConfig`] for `setting` = `value`.
     pub(crate) fn invalid(setting: &'static str, value: f64, expected: &'static str) -> Self {

@@ -15,6 +15,7 @@ mod cloud_folder_export;
 mod commanded;
 mod config;
 mod evaluation;
+mod exploration;
 mod lidar_models;
 mod lidar_only;
 mod motion_profiles;

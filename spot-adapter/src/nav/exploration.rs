@@ -1,0 +1,423 @@
+//! The exploration loop: a [`Robot`] with no map and no route, the Graph-SLAM engine mapping
+//! live, and the [`Explorer`] sending the [`Navigator`] to one frontier after another until no
+//! reachable frontier is left.
+
+use std::time::Instant;
+
+use gridmap::PlanningGrid;
+use nalgebra::Vector2;
+use slam_core::{CloudError, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
+
+use crate::nav::NavError;
+use crate::nav::config::NavigatorConfig;
+use crate::nav::error::ExplorationError;
+use crate::nav::explorer::{
+    Explorer, FrontierDecision, FrontierGoal, GiveUpReason, GivenUpFrontier,
+};
+use crate::nav::explorer_config::ExplorerConfig;
+use crate::nav::frontier::is_frontier_cell;
+use crate::nav::navigation_map::NavigationMap;
+use crate::nav::navigator::{NavigationStep, Navigator};
+use crate::robot::{MobilityCommand, Robot, Sample};
+
+/// How an exploration ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ExplorationOutcome {
+    /// No reachable frontier is left.
+    Complete,
+    /// The cycle budget ran out first.
+    GaveUp,
+}
+
+/// What an exploration did.
+#[derive(Clone, Debug)]
+pub struct ExplorationReport {
+    /// How it ended.
+    pub outcome: ExplorationOutcome,
+    /// Samples taken.
+    pub cycles: usize,
+    /// Frontier decisions made (each on a map rendered afresh from the keyframes).
+    pub decisions: usize,
+    /// Milliseconds of each decision that started a walk: rendering the map, picking the
+    /// frontier and making the navigator on that map.
+    pub decision_ms: Vec<f64>,
+    /// Length of the body's path as the engine estimated it (metres).
+    pub walked: f64,
+    /// The frontiers given up on the way, and why.
+    pub given_up: Vec<GivenUpFrontier>,
+    /// The last decision: the frontiers left and why none was reachable.
+    pub last_decision: FrontierDecision,
+    /// The map at the end (occupancy from every keyframe at its optimised pose).
+    pub navigation: NavigationMap,
+    /// The engine's estimate of the body at the end (map frame).
+    pub map_t_body: Pose3,
+}
+
+/// One cycle of an exploration, as [`explore`] shows it to its observer.
+#[derive(Clone, Copy, Debug)]
+pub struct ExplorationCycle<'a> {
+    /// The sample the cycle ran on.
+    pub sample: &'a Sample,
+    /// The frontier goal being walked to (metres, map frame).
+    pub goal: Vector2<f64>,
+    /// What the navigator decided.
+    pub step: &'a NavigationStep,
+    /// The engine's estimate of the body after the scan (map frame), when it has one.
+    pub map_t_body: Option<Pose3>,
+    /// Milliseconds the engine and the navigator took on the sample, without the robot's own
+    /// time (the decisions between walks are in [`ExplorationReport::decision_ms`]).
+    pub compute_ms: f64,
+}
+
+/// Explore with `robot` from where it stands: each sample goes into `slam` (a fresh engine: its
+/// map frame is the first scan's odometry frame); after every
+/// [`ExplorerConfig::decide_every`] new keyframes, a closed loop, or the end of a walk, the
+/// occupancy grid is rendered from the keyframes at their current poses, the [`Explorer`]
+/// picks a frontier, and a [`Navigator`] on that map (localising with `localiser`, settings
+/// `navigator` with its goal tolerance set to [`ExplorerConfig::arrive_within`]) walks toward
+/// it (it does not wait for what newly blocks the way: that is unknown space turning out to be
+/// wall). The second walk near the same goal that ends with no path, blocked or lost gives its
+/// frontier up, and so does standing at its goal with the frontier still there; the report
+/// lists them. Stops when no reachable frontier is left, or after `max_cycles` samples; the
+/// robot is sent a stop on every way out.
+///
+/// # Errors
+/// [`ExplorationError::Robot`] when the robot fails, [`ExplorationError::Navigation`] for
+/// invalid settings or when the navigator or the map fails, [`ExplorationError::Map`] when the
+/// engine's map cloud cannot be made, [`ExplorationError::NoMap`] when the engine kept none of
+/// the scans within the budget; the robot was sent a stop first.
+pub fn explore<Rb, R, C, O, L>(
+    robot: &mut Rb,
+    slam: &mut GraphSlam<R, C, O>,
+    localiser: &L,
+    navigator: &NavigatorConfig,
+    config: &ExplorerConfig,
+    max_cycles: usize,
+    mut observe: impl FnMut(&ExplorationCycle<'_>),
+) -> Result<ExplorationReport, ExplorationError<Rb::Error>>
+where
+    Rb: Robot,
+    R: MapRegistrator,
+    C: MapRegistrator,
+    O: Optimizer<Pose3>,
+    L: Registrator + Clone,
+{
+    let result = Exploration::new(navigator, config)
+        .and_then(|mut e| e.run(robot, slam, localiser, max_cycles, &mut observe));
+    let stopped = robot.stop().map_err(ExplorationError::Robot);
+    let report = result?;
+    stopped?;
+    Ok(report)
+}
+
+/// The loop's state between walks.
+struct Exploration {
+    navigator: NavigatorConfig,
+    explorer: Explorer,
+    cycles: usize,
+    decisions: usize,
+    decision_ms: Vec<f64>,
+    walked: f64,
+    last_position: Option<Vector2<f64>>,
+    /// The goal of the last walk, when it ended there.
+    arrived_at: Option<Vector2<f64>>,
+    /// Goals a walk failed to once.
+    failures: Vec<Vector2<f64>>,
+}
+
+/// How one walk toward a frontier ended.
+enum WalkEnd {
+    /// Time to look at the map again (new keyframes, a closed loop, or arrived with the
+    /// frontier gone).
+    Decide,
+    /// At the goal: the next decision shows whether the frontier went.
+    Arrived,
+    /// The frontier is given up.
+    GiveUp(GiveUpReason),
+    /// The cycle budget ran out.
+    OutOfCycles,
+}
+
+impl Exploration {
+    fn new<E: std::error::Error + Send + Sync + 'static>(
+        navigator: &NavigatorConfig,
+        config: &ExplorerConfig,
+    ) -> Result<Self, ExplorationError<E>> {
+        let navigator = NavigatorConfig {
+            goal_tolerance: config.arrive_within,
+            // What newly blocks the way to a frontier is unknown space turning out to be wall,
+            // not a person passing: not waited for (the next decision sees it).
+            detour_patience: 0,
+            ..navigator.clone()
+        };
+        navigator.validate().map_err(ExplorationError::Navigation)?;
+        Ok(Self {
+            navigator,
+            explorer: Explorer::new(config.clone()).map_err(ExplorationError::Navigation)?,
+            cycles: 0,
+            decisions: 0,
+            decision_ms: Vec::new(),
+            walked: 0.0,
+            last_position: None,
+            arrived_at: None,
+            failures: Vec::new(),
+        })
+    }
+
+    fn run<Rb, R, C, O, L>(
+        &mut self,
+        robot: &mut Rb,
+        slam: &mut GraphSlam<R, C, O>,
+        localiser: &L,
+        max_cycles: usize,
+        observe: &mut impl FnMut(&ExplorationCycle<'_>),
+    ) -> Result<ExplorationReport, ExplorationError<Rb::Error>>
+    where
+        Rb: Robot,
+        R: MapRegistrator,
+        C: MapRegistrator,
+        O: Optimizer<Pose3>,
+        L: Registrator + Clone,
+    {
+        let geometry = &robot.description().geometry;
+        let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
+        // The first scans, standing: the engine needs one to start its map.
+        let mut body_t_lidar = geometry.body_t_lidar;
+        while slam.current_lidar_pose().is_none() {
+            if self.cycles >= max_cycles {
+                return Err(ExplorationError::NoMap {
+                    cycles: self.cycles,
+                });
+            }
+            let sample = robot.next_sample().map_err(ExplorationError::Robot)?;
+            self.cycles += 1;
+            body_t_lidar = sample.body_t_lidar;
+            slam.process(&sample.scan_input());
+        }
+        loop {
+            let started = Instant::now();
+            let map_t_body = slam
+                .current_lidar_pose()
+                .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
+            let scans = spread_keyframes(slam, self.explorer.config().keyframe_spacing);
+            let navigation =
+                NavigationMap::from_scans(&scans, lidar_height, &self.navigator.map_config())
+                    .map_err(ExplorationError::Navigation)?;
+            let planning =
+                PlanningGrid::new(navigation.occupancy(), self.navigator.planning.clone())
+                    .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
+            let position = map_t_body.translation.vector.xy();
+            let decision = self
+                .explorer
+                .decide(navigation.occupancy(), &planning, position);
+            self.decisions += 1;
+            // The robot stood at this goal and the frontier is still there: what lies behind
+            // it cannot be seen from where the robot can stand.
+            let arrived_at = self.arrived_at.take();
+            if let (Some(at), Some(chosen)) = (arrived_at, &decision.chosen)
+                && (chosen.goal - at).norm() <= self.explorer.config().give_up_radius
+            {
+                self.explorer
+                    .give_up(chosen.goal, GiveUpReason::StillUnknownFromGoal);
+                continue;
+            }
+            let Some(chosen) = decision.chosen.clone() else {
+                return Ok(self.report(
+                    ExplorationOutcome::Complete,
+                    decision,
+                    navigation,
+                    map_t_body,
+                ));
+            };
+            if self.cycles >= max_cycles {
+                return Ok(self.report(
+                    ExplorationOutcome::GaveUp,
+                    decision,
+                    navigation,
+                    map_t_body,
+                ));
+            }
+            let cloud = map_cloud(&scans, self.explorer.config().map_voxel)
+                .map_err(ExplorationError::Map)?;
+            let mut walker = Navigator::new(
+                localiser.clone(),
+                &cloud,
+                &navigation,
+                map_t_body,
+                robot.description(),
+                self.navigator.clone(),
+            )
+            .map_err(ExplorationError::Navigation)?;
+            self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
+            match self.walk(robot, slam, &mut walker, &chosen, max_cycles, observe)? {
+                WalkEnd::Decide => {}
+                WalkEnd::Arrived => self.arrived_at = Some(chosen.goal),
+                WalkEnd::GiveUp(reason) => self.failed(chosen.goal, reason),
+                WalkEnd::OutOfCycles => {
+                    robot.stop().map_err(ExplorationError::Robot)?;
+                    return Ok(self.report(
+                        ExplorationOutcome::GaveUp,
+                        decision,
+                        navigation,
+                        map_t_body,
+                    ));
+                }
+            }
+        }
+    }
+
+    /// A walk to `goal` failed for `reason`: the second failure near the same goal gives its
+    /// frontier up. Once is not enough: the goal of a frontier sits on the edge of what is
+    /// known, and the first scans of a walk often show a wall there that makes the next
+    /// decision pick another goal anyway.
+    fn failed(&mut self, goal: Vector2<f64>, reason: GiveUpReason) {
+        let radius = self.explorer.config().give_up_radius;
+        if let Some(k) = self
+            .failures
+            .iter()
+            .position(|f| (f - goal).norm() <= radius)
+        {
+            self.failures.swap_remove(k);
+            self.explorer.give_up(goal, reason);
+        } else {
+            self.failures.push(goal);
+        }
+    }
+
+    /// Walk toward `goal` until it is time to decide again.
+    fn walk<Rb, R, C, O, L>(
+        &mut self,
+        robot: &mut Rb,
+        slam: &mut GraphSlam<R, C, O>,
+        navigator: &mut Navigator<L>,
+        target: &FrontierGoal,
+        max_cycles: usize,
+        observe: &mut impl FnMut(&ExplorationCycle<'_>),
+    ) -> Result<WalkEnd, ExplorationError<Rb::Error>>
+    where
+        Rb: Robot,
+        R: MapRegistrator,
+        C: MapRegistrator,
+        O: Optimizer<Pose3>,
+        L: Registrator,
+    {
+        let keyframes = slam.keyframe_count();
+        let loops = slam.report().loops_closed;
+        let goal = target.goal;
+        let min_cells = self.explorer.config().min_frontier_cells;
+        while self.cycles < max_cycles {
+            let sample = robot.next_sample().map_err(ExplorationError::Robot)?;
+            self.cycles += 1;
+            let started = Instant::now();
+            slam.process(&sample.scan_input());
+            let step = navigator
+                .step(&sample, goal)
+                .map_err(ExplorationError::Navigation)?;
+            let compute_ms = started.elapsed().as_secs_f64() * 1e3;
+            let map_t_body = slam
+                .current_lidar_pose()
+                .map(|p| p * sample.body_t_lidar.inverse());
+            if let Some(p) = map_t_body {
+                let here = p.translation.vector.xy();
+                self.walked += self.last_position.map_or(0.0, |l| (here - l).norm());
+                self.last_position = Some(here);
+            }
+            observe(&ExplorationCycle {
+                sample: &sample,
+                goal,
+                step: &step,
+                map_t_body,
+                compute_ms,
+            });
+            let end = match step {
+                NavigationStep::Walk(command) => {
+                    robot
+                        .send(&MobilityCommand::Velocity(command))
+                        .map_err(ExplorationError::Robot)?;
+                    None
+                }
+                NavigationStep::Hold => {
+                    robot.stop().map_err(ExplorationError::Robot)?;
+                    None
+                }
+                NavigationStep::Arrived => Some(WalkEnd::Arrived),
+                NavigationStep::NoPath => Some(WalkEnd::GiveUp(GiveUpReason::NoPath)),
+                NavigationStep::Blocked => Some(WalkEnd::GiveUp(GiveUpReason::Blocked)),
+                NavigationStep::Lost => Some(WalkEnd::GiveUp(GiveUpReason::Lost)),
+            };
+            if let Some(end) = end {
+                robot.stop().map_err(ExplorationError::Robot)?;
+                return Ok(end);
+            }
+            // The frontier seen on the way (the navigator's live layer fuses every scan): no
+            // need to walk on to it.
+            let left = target
+                .frontier
+                .cells
+                .iter()
+                .filter(|&&c| is_frontier_cell(navigator.live().combined(), c))
+                .count();
+            if left < min_cells {
+                return Ok(WalkEnd::Decide);
+            }
+            let grown = slam.keyframe_count() >= keyframes + self.explorer.config().decide_every;
+            if grown || slam.report().loops_closed != loops {
+                return Ok(WalkEnd::Decide);
+            }
+        }
+        Ok(WalkEnd::OutOfCycles)
+    }
+
+    fn report(
+        &self,
+        outcome: ExplorationOutcome,
+        last_decision: FrontierDecision,
+        navigation: NavigationMap,
+        map_t_body: Pose3,
+    ) -> ExplorationReport {
+        ExplorationReport {
+            outcome,
+            cycles: self.cycles,
+            decisions: self.decisions,
+            decision_ms: self.decision_ms.clone(),
+            walked: self.walked,
+            given_up: self.explorer.given_up().to_vec(),
+            last_decision,
+            navigation,
+            map_t_body,
+        }
+    }
+}
+
+/// The keyframes the map is rendered from: the first in each square of `spacing` metres (by
+/// LiDAR position) and the newest. A LiDAR sees all round, so one scan per square shows what
+/// the others do, and the render costs what the area explored costs, not the walk.
+fn spread_keyframes<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    spacing: f64,
+) -> Vec<(Pose3, &PointCloud)> {
+    let mut squares = std::collections::HashSet::new();
+    let count = slam.keyframe_count();
+    slam.keyframe_scans()
+        .enumerate()
+        .filter(|(k, (pose, _))| {
+            let at = pose.translation.vector / spacing;
+            let square = (at.x.floor() as i64, at.y.floor() as i64);
+            squares.insert(square) || k + 1 == count
+        })
+        .map(|(_, scan)| scan)
+        .collect()
+}
+
+/// The map cloud of `scans` (each at its `map_T_lidar`), voxel-filtered at `voxel`.
+fn map_cloud(scans: &[(Pose3, &PointCloud)], voxel: f32) -> Result<PointCloud, CloudError> {
+    let mut all = PointCloud::new();
+    for (pose, cloud) in scans {
+        // Channels may differ between scans; the map keeps positions only.
+        all.extend_from(&PointCloud::from_points(
+            cloud.transformed(pose).into_parts().0,
+        ))?;
+    }
+    all.voxel_downsample(voxel)
+}

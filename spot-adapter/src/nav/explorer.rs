@@ -1,0 +1,379 @@
+//! `Explorer`: picks the next frontier to walk to on the growing map, and remembers the ones it
+//! gave up.
+
+use gridmap::{CellState, OccupancyGrid, PlanningGrid};
+use nalgebra::Vector2;
+use slam_core::{BitGrid, Cell};
+
+use crate::nav::NavError;
+use crate::nav::explorer_config::{ExplorerConfig, FrontierChoice};
+use crate::nav::frontier::{Frontier, find_frontiers};
+use crate::nav::travel_costs::TravelCosts;
+
+/// A frontier the explorer could walk to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrontierGoal {
+    /// Where the robot would stand (metres, map frame): the reachable cell nearest the
+    /// frontier's middle.
+    pub goal: Vector2<f64>,
+    /// The frontier.
+    pub frontier: Frontier,
+    /// The walk there (metres, on the planning grid).
+    pub cost: f64,
+    /// Unknown area within sensor range of the frontier's middle (square metres).
+    pub gain: f64,
+}
+
+/// Why a frontier was given up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum GiveUpReason {
+    /// The navigator found no path to its goal on the map with the live obstacles.
+    NoPath,
+    /// The robot made no progress toward it though it tried to get free.
+    Blocked,
+    /// Localisation failed on the way.
+    Lost,
+    /// The robot stood at its goal and the frontier was still there: what lies behind it
+    /// cannot be seen from where the robot can stand.
+    StillUnknownFromGoal,
+}
+
+impl GiveUpReason {
+    /// A short name for reports: `no_path`, `blocked`, `lost`, `still_unknown_from_goal`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::NoPath => "no_path",
+            Self::Blocked => "blocked",
+            Self::Lost => "lost",
+            Self::StillUnknownFromGoal => "still_unknown_from_goal",
+        }
+    }
+}
+
+/// A frontier goal given up, and why.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GivenUpFrontier {
+    /// The goal it was walked to (metres, map frame).
+    pub goal: Vector2<f64>,
+    /// Why it was given up.
+    pub reason: GiveUpReason,
+}
+
+/// What the explorer saw on one map and what it picked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrontierDecision {
+    /// The frontier to walk to; `None` when no reachable frontier is left (exploration done).
+    pub chosen: Option<FrontierGoal>,
+    /// Frontiers with a goal the robot can reach, not given up (the chosen one included).
+    pub reachable: usize,
+    /// Frontiers with no reachable cell within [`ExplorerConfig::goal_reach`].
+    pub unreachable: Vec<Frontier>,
+    /// Frontiers whose goal lies where one was given up.
+    pub given_up: usize,
+}
+
+/// Picks frontiers (known-free cells next to unknown ones) to explore by
+/// [`ExplorerConfig::choice`]: [`FrontierChoice::InformationGain`] weighs what a frontier would
+/// reveal against the walk to it, [`FrontierChoice::GreedyNearestFrontier`] takes the nearest.
+///
+/// It keeps no map of its own: each [`Explorer::decide`] looks at the occupancy grid and the
+/// planning grid as they are (the map grows and is re-rendered when a loop closes), with one
+/// Dijkstra search from the robot for the walks to every frontier.
+#[derive(Clone, Debug)]
+pub struct Explorer {
+    config: ExplorerConfig,
+    given_up: Vec<GivenUpFrontier>,
+}
+
+impl Explorer {
+    /// An explorer with `config`.
+    ///
+    /// # Errors
+    /// [`NavError::InvalidConfig`] naming the first bad setting.
+    pub fn new(config: ExplorerConfig) -> Result<Self, NavError> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            given_up: Vec::new(),
+        })
+    }
+
+    /// The next frontier on `occupancy` for a robot at `position` (metres, map frame),
+    /// walking on `blocked` (the planning grid over `occupancy`: unknown cells and the hard
+    /// inflation blocked).
+    #[must_use]
+    pub fn decide(
+        &self,
+        occupancy: &OccupancyGrid,
+        planning: &PlanningGrid,
+        position: Vector2<f64>,
+    ) -> FrontierDecision {
+        let blocked = planning.blocked();
+        let frontiers = find_frontiers(occupancy, self.config.min_frontier_cells);
+        let start = nearest_free(blocked, position, self.config.goal_reach);
+        let costs = start.map(|s| TravelCosts::from_start(blocked, s));
+        let mut decision = FrontierDecision {
+            chosen: None,
+            reachable: 0,
+            unreachable: Vec::new(),
+            given_up: 0,
+        };
+        let mut best: Option<((f64, f64), FrontierGoal)> = None;
+        let mut candidates = Vec::new();
+        for frontier in frontiers {
+            let Some((goal, cost)) = costs
+                .as_ref()
+                .and_then(|c| self.goal_of(blocked, c, frontier.middle))
+            else {
+                decision.unreachable.push(frontier);
+                continue;
+            };
+            if self.is_given_up(goal) {
+                decision.given_up += 1;
+                continue;
+            }
+            decision.reachable += 1;
+            let gain = self.gain(occupancy, frontier.middle);
+            candidates.push(FrontierGoal {
+                goal,
+                frontier,
+                cost,
+                gain,
+            });
+        }
+        let nearest = candidates
+            .iter()
+            .map(|c| c.cost)
+            .fold(f64::INFINITY, f64::min);
+        let score = |c: &FrontierGoal| match self.config.choice {
+            FrontierChoice::InformationGain { detour } => {
+                if c.cost <= nearest + detour {
+                    // Within the detour: the least revealing first, the shorter walk on a tie.
+                    (-c.gain, -c.cost)
+                } else {
+                    (f64::NEG_INFINITY, -c.cost)
+                }
+            }
+            FrontierChoice::GreedyNearestFrontier => (0.0, -c.cost),
+        };
+        for c in candidates {
+            let s = score(&c);
+            if best.as_ref().is_none_or(|(b, _)| s > *b) {
+                best = Some((s, c));
+            }
+        }
+        decision.chosen = best.map(|(_, g)| g);
+        decision
+    }
+
+    /// Give up the frontier whose goal is `goal` (metres, map frame): frontiers with a goal
+    /// within [`ExplorerConfig::give_up_radius`] of it are not picked again.
+    pub fn give_up(&mut self, goal: Vector2<f64>, reason: GiveUpReason) {
+        self.given_up.push(GivenUpFrontier { goal, reason });
+    }
+
+    /// The frontiers given up so far, in order.
+    #[must_use]
+    pub fn given_up(&self) -> &[GivenUpFrontier] {
+        &self.given_up
+    }
+
+    /// Its settings.
+    #[must_use]
+    pub fn config(&self) -> &ExplorerConfig {
+        &self.config
+    }
+
+    fn is_given_up(&self, goal: Vector2<f64>) -> bool {
+        self.given_up
+            .iter()
+            .any(|g| (g.goal - goal).norm() <= self.config.give_up_radius)
+    }
+
+    /// The reachable cell nearest `middle` within the goal reach (ties: the shorter walk), as
+    /// its centre and the walk there. (A goal kept 0.2 m inside the free space, away from the
+    /// inflation's edge, was blocked less often by the wall found beyond, but often could not
+    /// see its frontier: more walks and more walking.)
+    fn goal_of(
+        &self,
+        blocked: &BitGrid,
+        costs: &TravelCosts,
+        middle: Cell,
+    ) -> Option<(Vector2<f64>, f64)> {
+        let geometry = blocked.geometry();
+        let r = (self.config.goal_reach / geometry.resolution).ceil() as i64;
+        let r2 = r * r;
+        let mut best: Option<(i64, f64, Cell)> = None;
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let d2 = dx * dx + dy * dy;
+                if d2 > r2 {
+                    continue;
+                }
+                let (x, y) = (i64::from(middle.x) + dx, i64::from(middle.y) + dy);
+                let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
+                    continue;
+                };
+                let cell = Cell::new(x, y);
+                if let Some(cost) = costs.to(cell)
+                    && best
+                        .as_ref()
+                        .is_none_or(|&(bd, bc, _)| (d2, cost) < (bd, bc))
+                {
+                    best = Some((d2, cost, cell));
+                }
+            }
+        }
+        best.map(|(_, cost, cell)| (geometry.cell_center(cell), cost))
+    }
+
+    /// Unknown area (square metres) a sensor at `middle` would see within sensor range: the
+    /// unknown cells along rays every 2 degrees, each ray stopped by the first occupied cell
+    /// (an unknown room behind a wall is not what this frontier reveals).
+    fn gain(&self, occupancy: &OccupancyGrid, middle: Cell) -> f64 {
+        let resolution = occupancy.geometry().resolution;
+        let r = (self.config.sensor_range / resolution).round() as i64;
+        let side = (2 * r + 1) as usize;
+        let mut counted = vec![false; side * side];
+        let mut unknown = 0usize;
+        let (mx, my) = (i64::from(middle.x), i64::from(middle.y));
+        for k in 0..180 {
+            let angle = f64::from(k) * std::f64::consts::PI / 90.0;
+            let (dx, dy) = (angle.cos(), angle.sin());
+            // Half-cell steps: no cell on the ray is skipped.
+            for step in 1..=2 * r {
+                let t = 0.5 * step as f64;
+                let (ox, oy) = ((dx * t).round() as i64, (dy * t).round() as i64);
+                let (Ok(x), Ok(y)) = (u32::try_from(mx + ox), u32::try_from(my + oy)) else {
+                    break;
+                };
+                let state = occupancy.state(Cell::new(x, y));
+                if state == CellState::Occupied {
+                    break;
+                }
+                let i = (oy + r) as usize * side + (ox + r) as usize;
+                if state == CellState::Unknown && !counted[i] {
+                    counted[i] = true;
+                    unknown += 1;
+                }
+            }
+        }
+        unknown as f64 * resolution * resolution
+    }
+}
+
+/// The free cell of `blocked` nearest `position` within `reach` metres: the robot's own cell,
+/// or the nearest one outside the hard inflation when it stands inside it (close to a wall).
+fn nearest_free(blocked: &BitGrid, position: Vector2<f64>, reach: f64) -> Option<Cell> {
+    let geometry = blocked.geometry();
+    let (cx, cy) = geometry.cell_coords(position);
+    let r = (reach / geometry.resolution).ceil() as i64;
+    let mut best: Option<(i64, Cell)> = None;
+    for dy in -r..=r {
+        for dx in -r..=r {
+            let (x, y) = (cx + dx, cy + dy);
+            let d2 = dx * dx + dy * dy;
+            if blocked.is_free_signed(x, y) && best.is_none_or(|(bd, _)| d2 < bd) {
+                best = Some((d2, Cell::new(x as u32, y as u32)));
+            }
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gridmap::PlanningGridConfig;
+    use slam_core::GridGeometry;
+
+    /// A corridor 4 m long and 1.9 m wide, walled on three sides and open to the east (a
+    /// frontier of 19 cells), and a patch of floor seen far off beyond unknown space (a
+    /// frontier no walk reaches).
+    fn corridor_and_patch() -> (OccupancyGrid, PlanningGrid) {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(70, 21, geometry, CellState::Unknown).unwrap();
+        for y in 0..=20 {
+            for x in 0..40 {
+                let wall = x == 0 || y == 0 || y == 20;
+                let state = if wall {
+                    CellState::Occupied
+                } else {
+                    CellState::Free
+                };
+                g.set(Cell::new(x, y), state).unwrap();
+            }
+        }
+        for y in 5..10 {
+            for x in 60..65 {
+                g.set(Cell::new(x, y), CellState::Free).unwrap();
+            }
+        }
+        let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+        (g, planning)
+    }
+
+    #[test]
+    fn the_reachable_frontier_is_chosen_and_the_other_reported_unreachable() {
+        let (g, planning) = corridor_and_patch();
+        for choice in [
+            FrontierChoice::default(),
+            FrontierChoice::GreedyNearestFrontier,
+        ] {
+            let explorer = Explorer::new(ExplorerConfig {
+                choice,
+                ..ExplorerConfig::default()
+            })
+            .unwrap();
+            let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
+            let chosen = decision.chosen.unwrap();
+            assert_eq!(chosen.frontier.size(), 19);
+            // The goal: the reachable cell nearest the frontier's middle (39, 10), beyond the
+            // 0.3 m inflation of the unknown space east of it.
+            assert!(
+                (chosen.goal - Vector2::new(3.65, 1.05)).norm() < 1e-9,
+                "{chosen:?}"
+            );
+            // Straight east from the robot's cell (10, 10) to (36, 10).
+            assert!((chosen.cost - 2.6).abs() < 1e-9, "{}", chosen.cost);
+            assert!(chosen.gain > 0.0);
+            assert_eq!(decision.reachable, 1);
+            assert_eq!(decision.unreachable.len(), 1);
+            assert_eq!(decision.unreachable[0].size(), 16, "the patch's rim");
+        }
+    }
+
+    #[test]
+    fn a_frontier_given_up_is_not_chosen_again_and_is_reported() {
+        let (g, planning) = corridor_and_patch();
+        let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        let goal = explorer
+            .decide(&g, &planning, Vector2::new(1.0, 1.0))
+            .chosen
+            .unwrap()
+            .goal;
+        explorer.give_up(goal, GiveUpReason::NoPath);
+        let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
+        assert_eq!(decision.chosen, None, "nothing left to explore");
+        assert_eq!((decision.reachable, decision.given_up), (0, 1));
+        assert_eq!(
+            explorer.given_up(),
+            [GivenUpFrontier {
+                goal,
+                reason: GiveUpReason::NoPath
+            }]
+        );
+    }
+
+    #[test]
+    fn a_robot_with_no_free_cell_near_it_reaches_nothing() {
+        let (g, planning) = corridor_and_patch();
+        let explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        // In the unknown space between the corridor and the patch.
+        let decision = explorer.decide(&g, &planning, Vector2::new(5.4, 1.5));
+        assert_eq!(decision.chosen, None);
+        assert_eq!(decision.unreachable.len(), 2);
+    }
+}

@@ -1,0 +1,255 @@
+//! Frontiers: known-free cells next to unknown ones, clustered into the edges of what is mapped
+//! (Yamauchi, "A frontier-based approach for autonomous exploration", CIRA 1997).
+
+use gridmap::{CellState, OccupancyGrid};
+use nalgebra::Vector2;
+use slam_core::Cell;
+
+/// One frontier: a connected run of frontier cells (8-connected).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frontier {
+    /// Its cells, in scan order (row by row).
+    pub cells: Vec<Cell>,
+    /// The mean of its cell centres (metres, map frame).
+    pub centroid: Vector2<f64>,
+    /// Its cell nearest the centroid: where it is, for a frontier that bends round a corner.
+    pub middle: Cell,
+}
+
+impl Frontier {
+    /// Its length in cells.
+    #[must_use]
+    pub fn size(&self) -> usize {
+        self.cells.len()
+    }
+}
+
+/// Whether `cell` is a frontier cell of `grid`: known free with an unknown 4-neighbour (off the
+/// grid counts as unknown: nothing was seen there).
+#[must_use]
+pub fn is_frontier_cell(grid: &OccupancyGrid, cell: Cell) -> bool {
+    if grid.state(cell) != CellState::Free {
+        return false;
+    }
+    let (x, y) = (i64::from(cell.x), i64::from(cell.y));
+    [(1, 0), (-1, 0), (0, 1), (0, -1)]
+        .into_iter()
+        .any(|(dx, dy)| state_signed(grid, x + dx, y + dy) == CellState::Unknown)
+}
+
+/// The frontiers of `grid` with at least `min_cells` cells, largest first (ties in scan order
+/// of their first cell). One pass over the grid, then a flood fill per frontier.
+#[must_use]
+pub fn find_frontiers(grid: &OccupancyGrid, min_cells: usize) -> Vec<Frontier> {
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let mut marked = vec![false; w * h];
+    for y in 0..grid.height() {
+        for x in 0..grid.width() {
+            marked[y as usize * w + x as usize] = is_frontier_cell(grid, Cell::new(x, y));
+        }
+    }
+    let mut frontiers = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..marked.len() {
+        if !marked[start] {
+            continue;
+        }
+        marked[start] = false;
+        stack.push(start);
+        let mut cells = Vec::new();
+        while let Some(k) = stack.pop() {
+            let (x, y) = ((k % w) as i64, (k / w) as i64);
+            cells.push(Cell::new(x as u32, y as u32));
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
+                        continue;
+                    }
+                    let n = ny as usize * w + nx as usize;
+                    if marked[n] {
+                        marked[n] = false;
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+        if cells.len() >= min_cells {
+            cells.sort_unstable_by_key(|c| (c.y, c.x));
+            frontiers.push(frontier_of(grid, cells));
+        }
+    }
+    // A stable sort: equal sizes stay in the scan order of their first cell.
+    frontiers.sort_by_key(|f| std::cmp::Reverse(f.size()));
+    frontiers
+}
+
+fn frontier_of(grid: &OccupancyGrid, cells: Vec<Cell>) -> Frontier {
+    let geometry = grid.geometry();
+    let sum: Vector2<f64> = cells.iter().map(|&c| geometry.cell_center(c)).sum();
+    let centroid = sum / cells.len() as f64;
+    let middle = cells
+        .iter()
+        .copied()
+        .min_by(|&a, &b| {
+            let da = (geometry.cell_center(a) - centroid).norm_squared();
+            let db = (geometry.cell_center(b) - centroid).norm_squared();
+            da.total_cmp(&db)
+        })
+        .unwrap_or(Cell::new(0, 0));
+    Frontier {
+        cells,
+        centroid,
+        middle,
+    }
+}
+
+fn state_signed(grid: &OccupancyGrid, x: i64, y: i64) -> CellState {
+    match (u32::try_from(x), u32::try_from(y)) {
+        (Ok(x), Ok(y)) => grid.state(Cell::new(x, y)),
+        _ => CellState::Unknown,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use slam_core::GridGeometry;
+    use std::collections::{BTreeMap, BTreeSet};
+
+    /// A grid from rows of `.` (free), `#` (occupied) and `?` (unknown), the first row at the
+    /// top (largest y).
+    fn grid(rows: &[&str]) -> OccupancyGrid {
+        let h = rows.len() as u32;
+        let w = rows[0].len() as u32;
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(w, h, geometry, CellState::Unknown).unwrap();
+        for (r, row) in rows.iter().enumerate() {
+            for (x, ch) in row.chars().enumerate() {
+                let state = match ch {
+                    '.' => CellState::Free,
+                    '#' => CellState::Occupied,
+                    _ => CellState::Unknown,
+                };
+                g.set(Cell::new(x as u32, h - 1 - r as u32), state).unwrap();
+            }
+        }
+        g
+    }
+
+    /// The oracle: every pair of frontier cells tested for adjacency, components by repeated
+    /// relabelling until nothing changes.
+    fn brute_force(g: &OccupancyGrid) -> BTreeSet<BTreeSet<(u32, u32)>> {
+        let mut cells = Vec::new();
+        for y in 0..g.height() {
+            for x in 0..g.width() {
+                let free = g.state(Cell::new(x, y)) == CellState::Free;
+                let unknown_next =
+                    [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)]
+                        .iter()
+                        .any(|(dx, dy)| {
+                            let (nx, ny) = (i64::from(x) + dx, i64::from(y) + dy);
+                            nx < 0
+                                || ny < 0
+                                || nx >= i64::from(g.width())
+                                || ny >= i64::from(g.height())
+                                || g.state(Cell::new(nx as u32, ny as u32)) == CellState::Unknown
+                        });
+                if free && unknown_next {
+                    cells.push((x, y));
+                }
+            }
+        }
+        let mut label: Vec<usize> = (0..cells.len()).collect();
+        loop {
+            let mut changed = false;
+            for i in 0..cells.len() {
+                for j in 0..cells.len() {
+                    let (a, b) = (cells[i], cells[j]);
+                    if a.0.abs_diff(b.0) <= 1 && a.1.abs_diff(b.1) <= 1 && label[j] < label[i] {
+                        label[i] = label[j];
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        let mut groups: BTreeMap<usize, BTreeSet<(u32, u32)>> = BTreeMap::new();
+        for (k, &c) in cells.iter().enumerate() {
+            groups.entry(label[k]).or_default().insert(c);
+        }
+        groups.into_values().collect()
+    }
+
+    fn found(g: &OccupancyGrid) -> BTreeSet<BTreeSet<(u32, u32)>> {
+        find_frontiers(g, 1)
+            .into_iter()
+            .map(|f| f.cells.iter().map(|c| (c.x, c.y)).collect())
+            .collect()
+    }
+
+    #[test]
+    fn a_room_seen_through_its_door_has_one_frontier_per_open_edge() {
+        let g = grid(&[
+            "??????????",
+            "??######??",
+            "??#....#??",
+            "??#.....??",
+            "??#....#??",
+            "??##.###??",
+            "????.?????",
+            "????.?????",
+        ]);
+        let frontiers = find_frontiers(&g, 1);
+        assert_eq!(found(&g), brute_force(&g));
+        // The corridor's two cells below the door (unknown on both sides), then the open east
+        // side (one cell): largest first.
+        assert_eq!(frontiers.len(), 2, "{frontiers:?}");
+        assert_eq!(frontiers[0].size(), 2);
+        assert_eq!(frontiers[1].cells, [Cell::new(7, 4)]);
+        let large = find_frontiers(&g, 2);
+        assert_eq!(large, frontiers[..1]);
+    }
+
+    #[test]
+    fn frontiers_match_the_brute_force_oracle_on_random_grids() {
+        // A small LCG: the same grids every run.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        for _ in 0..200 {
+            let (w, h) = (1 + next() % 12, 1 + next() % 12);
+            let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.2).unwrap();
+            let mut g = OccupancyGrid::new(w, h, geometry, CellState::Unknown).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let state = match next() % 5 {
+                        0 => CellState::Occupied,
+                        1 => CellState::Unknown,
+                        _ => CellState::Free,
+                    };
+                    g.set(Cell::new(x, y), state).unwrap();
+                }
+            }
+            assert_eq!(found(&g), brute_force(&g));
+            let frontiers = find_frontiers(&g, 1);
+            for f in &frontiers {
+                let mean = f
+                    .cells
+                    .iter()
+                    .map(|&c| geometry.cell_center(c))
+                    .sum::<Vector2<f64>>()
+                    / f.size() as f64;
+                assert!((mean - f.centroid).norm() < 1e-9);
+                assert!(f.cells.contains(&f.middle));
+            }
+            assert!(frontiers.windows(2).all(|p| p[0].size() >= p[1].size()));
+        }
+    }
+}

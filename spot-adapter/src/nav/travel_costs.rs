@@ -1,0 +1,156 @@
+//! `TravelCosts`: the length of the shortest walk from the robot to every cell of the planning
+//! grid, one Dijkstra search for all the frontiers an explorer weighs (a plan per frontier would
+//! repeat the same search from the same start).
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use slam_core::{BitGrid, Cell};
+
+/// Shortest walking distances (metres) from one start cell over a grid's free cells, under the
+/// grid rules the planners follow: 8-connected, diagonal steps sqrt(2) long, no corner cutting.
+#[derive(Clone, Debug)]
+pub struct TravelCosts {
+    width: u32,
+    /// Metres per cell side.
+    resolution: f64,
+    /// Metres from the start per cell, row-major; infinite where it cannot be reached.
+    metres: Vec<f64>,
+}
+
+impl TravelCosts {
+    /// The distances from `start` over the free cells of `blocked` (empty when `start` is off
+    /// the grid or blocked: nothing is reachable).
+    #[must_use]
+    pub fn from_start(blocked: &BitGrid, start: Cell) -> Self {
+        let (w, h) = (blocked.width(), blocked.height());
+        let resolution = blocked.geometry().resolution;
+        let mut metres = vec![f64::INFINITY; w as usize * h as usize];
+        let index = |c: Cell| c.y as usize * w as usize + c.x as usize;
+        let free = |x: i64, y: i64| blocked.is_free_signed(x, y);
+        if blocked.get(start) != Some(false) {
+            return Self {
+                width: w,
+                resolution,
+                metres,
+            };
+        }
+        // Distances in cell sides; non-negative floats order as their bits do.
+        let mut queue = BinaryHeap::new();
+        metres[index(start)] = 0.0;
+        queue.push(Reverse((0f64.to_bits(), start.x, start.y)));
+        while let Some(Reverse((bits, x, y))) = queue.pop() {
+            let d = f64::from_bits(bits);
+            if d > metres[index(Cell::new(x, y))] {
+                continue;
+            }
+            let (xi, yi) = (i64::from(x), i64::from(y));
+            for (dx, dy) in [
+                (1, 0),
+                (-1, 0),
+                (0, 1),
+                (0, -1),
+                (1, 1),
+                (1, -1),
+                (-1, 1),
+                (-1, -1),
+            ] {
+                let (nx, ny) = (xi + dx, yi + dy);
+                if !free(nx, ny) {
+                    continue;
+                }
+                let diagonal = dx != 0 && dy != 0;
+                // No corner cutting: a diagonal step needs both orthogonal neighbours free.
+                if diagonal && !(free(xi + dx, yi) && free(xi, yi + dy)) {
+                    continue;
+                }
+                let step = if diagonal {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
+                let next = Cell::new(nx as u32, ny as u32);
+                let nd = d + step;
+                if nd < metres[index(next)] {
+                    metres[index(next)] = nd;
+                    queue.push(Reverse((nd.to_bits(), next.x, next.y)));
+                }
+            }
+        }
+        for m in &mut metres {
+            *m *= resolution;
+        }
+        Self {
+            width: w,
+            resolution,
+            metres,
+        }
+    }
+
+    /// The walking distance (metres) to `cell`; `None` when it cannot be reached or is off the
+    /// grid.
+    #[must_use]
+    pub fn to(&self, cell: Cell) -> Option<f64> {
+        if cell.x >= self.width {
+            return None;
+        }
+        let k = cell.y as usize * self.width as usize + cell.x as usize;
+        self.metres.get(k).copied().filter(|m| m.is_finite())
+    }
+
+    /// Metres per cell side of the grid it was computed on.
+    #[must_use]
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use slam_core::Planner;
+
+    /// Every reachable cell's distance is Dijkstra's path cost to it (pathfind's, one search per
+    /// cell), and no other cell is reachable.
+    #[test]
+    fn distances_equal_dijkstras_path_costs() {
+        let mut state = 7u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        for _ in 0..20 {
+            let (w, h) = (2 + next() % 10, 2 + next() % 10);
+            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
+            let costs = TravelCosts::from_start(&grid, Cell::new(0, 0));
+            let mut dijkstra = pathfind::Dijkstra::new(&grid);
+            for y in 0..h {
+                for x in 0..w {
+                    let goal = Cell::new(x, y);
+                    let expected = if grid.is_blocked(goal) {
+                        None
+                    } else {
+                        dijkstra
+                            .plan(Cell::new(0, 0), goal)
+                            .unwrap()
+                            .map(|p| p.length * grid.geometry().resolution)
+                    };
+                    match (costs.to(goal), expected) {
+                        (Some(a), Some(b)) => assert!((a - b).abs() < 1e-9, "{a} vs {b}"),
+                        (a, b) => assert_eq!(a, b, "cell ({x}, {y})"),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_blocked_start_reaches_nothing() {
+        let grid = BitGrid::from_fn(3, 3, |x, y| (x, y) == (1, 1)).unwrap();
+        let costs = TravelCosts::from_start(&grid, Cell::new(1, 1));
+        assert_eq!(costs.to(Cell::new(0, 0)), None);
+        assert_eq!(costs.to(Cell::new(5, 0)), None);
+    }
+}

@@ -1,0 +1,267 @@
+//! Autonomous exploration of a small simulated building with no map and no route: the
+//! Graph-SLAM engine maps live, the explorer picks frontiers, the navigator walks to them.
+//! Coverage is measured against the simulator's floor plan (the floor free at the robot's
+//! inflation and reachable from the start), collisions and distance on its ground truth; the
+//! greedy nearest-frontier baseline runs on the same building in the same test.
+#![allow(clippy::unwrap_used)]
+
+use std::collections::VecDeque;
+
+use gridmap::CellState;
+use nalgebra::Vector2;
+use slam_core::Pose3;
+use spot_adapter::nav::{
+    ExplorationError, ExplorationOutcome, ExplorationReport, ExplorerConfig, FrontierChoice,
+    NavError, NavigatorConfig, explore,
+};
+use spot_adapter::pipelines::{
+    point_to_plane_localiser, point_to_plane_slam, point_to_plane_tracker, slam_config,
+};
+use spot_adapter::sim::{Building, BuildingConfig, CommandedSpot, SimulationConfig};
+
+/// About the smallest building the generator makes: a 10 m x 10 m corridor loop with shallow
+/// rooms round it and a core of rooms inside (about 17 m x 17 m, 14-16 rooms).
+pub fn small_building(seed: u64) -> Building {
+    let config = BuildingConfig {
+        loop_length_x: (10.0, 10.0),
+        loop_length_y: (10.0, 10.0),
+        outer_room_depth: (2.5, 3.0),
+        corridor_width: (1.8, 2.0),
+        room_width: (4.5, 6.0),
+        furniture_per_room: (1, 1),
+        ..BuildingConfig::default()
+    };
+    Building::generate(seed, &config).unwrap()
+}
+
+/// An exploration's figures on the ground truth.
+#[derive(Debug)]
+pub struct Explored {
+    pub report: ExplorationReport,
+    /// Share of the reachable floor that is known free in the final grid.
+    pub coverage: f64,
+    /// True distance walked (metres).
+    pub walked: f64,
+    pub collisions: usize,
+    pub seconds: f64,
+}
+
+/// Explores `building` from its first corridor corner facing east with `choice`, at most
+/// `max_cycles` scans, and measures it.
+pub fn explore_building(
+    building: &Building,
+    choice: FrontierChoice,
+    max_cycles: usize,
+) -> Explored {
+    let mut sim = SimulationConfig::default();
+    // A quarter of the VLP-16's columns (0.8 degrees): rooms of a few metres are seen as well,
+    // and the simulator and the engine take a quarter of the time.
+    sim.lidar.columns = 450;
+    let start = building.corridor_loop()[0];
+    let mut spot = CommandedSpot::new(building.clone(), start, 0.0, &sim).unwrap();
+    // The engine's map frame is the odometry frame, which starts at the body's start pose.
+    let world_t_map = spot.body_pose();
+    let mut slam = point_to_plane_slam(slam_config()).unwrap();
+    let config = ExplorerConfig {
+        choice,
+        ..ExplorerConfig::default()
+    };
+    let (mut walked, mut last) = (0.0, None::<Vector2<f64>>);
+    let started = std::time::Instant::now();
+    // The tracker's settings (a 0.2 m map, normals when first needed): the navigator is made
+    // afresh on each decision's map, and the localiser's normals up front on a 0.1 m map took
+    // as long as the rest of the decision.
+    let localiser = point_to_plane_tracker();
+    let report = explore(
+        &mut spot,
+        &mut slam,
+        &localiser,
+        &NavigatorConfig::default(),
+        &config,
+        max_cycles,
+        |cycle| {
+            let truth = cycle.sample.ground_truth.unwrap().translation.vector.xy();
+            walked += last.map_or(0.0, |p| (truth - p).norm());
+            last = Some(truth);
+        },
+    )
+    .unwrap();
+    let seconds = started.elapsed().as_secs_f64();
+    let coverage = coverage(building, start, &world_t_map, &report);
+    Explored {
+        report,
+        coverage,
+        walked,
+        collisions: spot.collisions(),
+        seconds,
+    }
+}
+
+/// The share of `building`'s floor free at the planning inflation (cell centres that far from
+/// every obstacle) and 4-connected to `start` that the final grid knows free.
+pub fn coverage(
+    building: &Building,
+    start: Vector2<f64>,
+    world_t_map: &Pose3,
+    report: &ExplorationReport,
+) -> f64 {
+    let inflation = NavigatorConfig::default().planning.inflation;
+    let resolution = 0.1;
+    let size = building.size();
+    let (w, h) = ((size.x / resolution) as i64, (size.y / resolution) as i64);
+    let centre = |x: i64, y: i64| Vector2::new(x as f64 + 0.5, y as f64 + 0.5) * resolution;
+    let free = |x: i64, y: i64| {
+        x >= 0 && y >= 0 && x < w && y < h && building.clearance(centre(x, y)) >= inflation
+    };
+    let first = ((start.x / resolution) as i64, (start.y / resolution) as i64);
+    let mut seen = vec![false; (w * h) as usize];
+    let mut queue = VecDeque::from([first]);
+    seen[(first.1 * w + first.0) as usize] = true;
+    let occupancy = report.navigation.occupancy();
+    let map_t_world = world_t_map.inverse();
+    let (mut reachable, mut known) = (0usize, 0usize);
+    while let Some((x, y)) = queue.pop_front() {
+        reachable += 1;
+        let p = map_t_world * nalgebra::Point3::new(centre(x, y).x, centre(x, y).y, 0.0);
+        let (cx, cy) = occupancy.geometry().cell_coords(p.coords.xy());
+        if let (Ok(cx), Ok(cy)) = (u32::try_from(cx), u32::try_from(cy))
+            && occupancy.state(slam_core::Cell::new(cx, cy)) == CellState::Free
+        {
+            known += 1;
+        }
+        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+            let (nx, ny) = (x + dx, y + dy);
+            if free(nx, ny) && !seen[(ny * w + nx) as usize] {
+                seen[(ny * w + nx) as usize] = true;
+                queue.push_back((nx, ny));
+            }
+        }
+    }
+    known as f64 / reachable as f64
+}
+
+fn print(name: &str, e: &Explored) {
+    eprintln!(
+        "{name}: {:?} after {} scans, {} decisions ({:.0} ms mean, {:.0} ms max); coverage {:.1} %, walked {:.1} m (estimated {:.1} m), {} collisions, {} frontiers given up {:?}, {} unreachable left; {:.1} s",
+        e.report.outcome,
+        e.report.cycles,
+        e.report.decisions,
+        e.report.decision_ms.iter().sum::<f64>() / e.report.decision_ms.len().max(1) as f64,
+        e.report.decision_ms.iter().copied().fold(0.0, f64::max),
+        100.0 * e.coverage,
+        e.walked,
+        e.report.walked,
+        e.collisions,
+        e.report.given_up.len(),
+        e.report
+            .given_up
+            .iter()
+            .map(|g| g.reason.name())
+            .collect::<Vec<_>>(),
+        e.report.last_decision.unreachable.len(),
+        e.seconds
+    );
+}
+
+/// Both explorers on the same small building: each maps it to at least 97 % of the reachable
+/// floor with no collision and stops by itself; ours walks no farther than the greedy one
+/// (seed 11: 126 m against 136 m). Not a general result: on seeds 12, 13 and 14
+/// ([`on_other_buildings`]) ours walks 0.99x, 1.06x and 1.24x the greedy explorer's distance,
+/// and small changes of the settings move either by 20 % or more on one building.
+#[test]
+fn explores_a_small_building_walking_no_farther_than_the_greedy_explorer() {
+    let building = small_building(11);
+    let ours = explore_building(&building, FrontierChoice::default(), 3000);
+    print("information gain", &ours);
+    let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
+    print("greedy nearest", &greedy);
+    for e in [&ours, &greedy] {
+        assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
+        assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
+        assert_eq!(e.collisions, 0);
+        assert!(e.report.last_decision.chosen.is_none());
+    }
+    assert!(
+        ours.walked <= greedy.walked,
+        "ours {:.1} m, greedy {:.1} m",
+        ours.walked,
+        greedy.walked
+    );
+}
+
+/// Bad explorer settings are refused by name before the robot moves.
+#[test]
+fn bad_exploration_settings_are_refused_by_name() {
+    let building = small_building(11);
+    let sim = SimulationConfig::default();
+    let start = building.corridor_loop()[0];
+    for (config, name) in [
+        (
+            ExplorerConfig {
+                sensor_range: f64::NAN,
+                ..ExplorerConfig::default()
+            },
+            "ExplorerConfig::sensor_range",
+        ),
+        (
+            ExplorerConfig {
+                decide_every: 0,
+                ..ExplorerConfig::default()
+            },
+            "ExplorerConfig::decide_every",
+        ),
+        (
+            ExplorerConfig {
+                choice: FrontierChoice::InformationGain { detour: -1.0 },
+                ..ExplorerConfig::default()
+            },
+            "FrontierChoice::InformationGain::detour",
+        ),
+    ] {
+        let mut spot = CommandedSpot::new(building.clone(), start, 0.0, &sim).unwrap();
+        let mut slam = point_to_plane_slam(slam_config()).unwrap();
+        let error = explore(
+            &mut spot,
+            &mut slam,
+            &point_to_plane_localiser(),
+            &NavigatorConfig::default(),
+            &config,
+            10,
+            |_| {},
+        )
+        .unwrap_err();
+        match error {
+            ExplorationError::Navigation(NavError::InvalidConfig(setting)) => {
+                assert_eq!(setting.setting, name);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(slam.report().scans, 0, "refused before the first scan");
+    }
+}
+
+/// The README's figures: both explorers on small buildings the other tests do not use (seeds
+/// 12-14), coverage and collisions checked, the distances printed (2026-12-05: ours 0.99x,
+/// 1.06x and 1.24x the greedy explorer's distance). About 30 s a building:
+/// `cargo test -p spot-nav-adapter --release --test integration exploration::on_other_buildings
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore = "about 30 s a building; the README's figures"]
+fn on_other_buildings() {
+    for seed in 12..=14 {
+        let building = small_building(seed);
+        let ours = explore_building(&building, FrontierChoice::default(), 3000);
+        print(&format!("seed {seed} information gain"), &ours);
+        let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
+        print(&format!("seed {seed} greedy nearest"), &greedy);
+        eprintln!(
+            "seed {seed}: ours walks {:.2}x the greedy explorer's distance",
+            ours.walked / greedy.walked
+        );
+        for e in [&ours, &greedy] {
+            assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
+            assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
+            assert_eq!(e.collisions, 0);
+        }
+    }
+}
