@@ -2,7 +2,8 @@
 //! Graph-SLAM engine maps live, the explorer picks frontiers, the navigator walks to them.
 //! Coverage is measured against the simulator's floor plan (the floor free at the robot's
 //! inflation and reachable from the start), collisions and distance on its ground truth; the
-//! greedy nearest-frontier baseline runs on the same building in the same test.
+//! greedy nearest-frontier baseline runs beside it on the same buildings in an ignored test
+//! that gives the README's figures.
 #![allow(clippy::unwrap_used)]
 
 use std::collections::VecDeque;
@@ -163,30 +164,20 @@ fn print(name: &str, e: &Explored) {
     );
 }
 
-/// Both explorers on the same small building: each maps it to at least 97 % of the reachable
-/// floor with no collision and stops by itself; ours walks no farther than the greedy one
-/// (seed 11: 126 m against 136 m). Not a general result: on seeds 12, 13 and 14
-/// ([`on_other_buildings`]) ours walks 0.99x, 1.06x and 1.24x the greedy explorer's distance,
-/// and small changes of the settings move either by 20 % or more on one building.
+/// Our explorer maps a small building to at least 97 % of the reachable floor with no collision
+/// and stops by itself, with no frontier left. How far it walks against the greedy
+/// nearest-frontier explorer is measured by [`against_the_greedy_explorer`], not here: ours is
+/// not reliably better yet (0.93-1.24x its distance on seeds 11-14), and on one building small
+/// changes of the settings move either by 20 % or more.
 #[test]
-fn explores_a_small_building_walking_no_farther_than_the_greedy_explorer() {
+fn explores_a_small_building_to_full_coverage() {
     let building = small_building(11);
     let ours = explore_building(&building, FrontierChoice::default(), 3000);
     print("information gain", &ours);
-    let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
-    print("greedy nearest", &greedy);
-    for e in [&ours, &greedy] {
-        assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
-        assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
-        assert_eq!(e.collisions, 0);
-        assert!(e.report.last_decision.chosen.is_none());
-    }
-    assert!(
-        ours.walked <= greedy.walked,
-        "ours {:.1} m, greedy {:.1} m",
-        ours.walked,
-        greedy.walked
-    );
+    assert_eq!(ours.report.outcome, ExplorationOutcome::Complete);
+    assert!(ours.coverage >= 0.97, "coverage {:.3}", ours.coverage);
+    assert_eq!(ours.collisions, 0);
+    assert!(ours.report.last_decision.chosen.is_none());
 }
 
 /// Bad explorer settings are refused by name before the robot moves.
@@ -240,15 +231,15 @@ fn bad_exploration_settings_are_refused_by_name() {
     }
 }
 
-/// The README's figures: both explorers on small buildings the other tests do not use (seeds
-/// 12-14), coverage and collisions checked, the distances printed (2026-12-05: ours 0.99x,
-/// 1.06x and 1.24x the greedy explorer's distance). About 30 s a building:
-/// `cargo test -p spot-nav-adapter --release --test integration exploration::on_other_buildings
-/// -- --ignored --nocapture`.
+/// The README's figures: both explorers on small buildings (seeds 11-14), coverage and
+/// collisions checked, the distances printed (2026-12-05: ours 0.93x, 0.99x, 1.06x and 1.24x the
+/// greedy explorer's distance). About 30 s a building:
+/// `cargo test -p spot-nav-adapter --release --test integration
+/// exploration::against_the_greedy_explorer -- --ignored --nocapture`.
 #[test]
 #[ignore = "about 30 s a building; the README's figures"]
-fn on_other_buildings() {
-    for seed in 12..=14 {
+fn against_the_greedy_explorer() {
+    for seed in 11..=14 {
         let building = small_building(seed);
         let ours = explore_building(&building, FrontierChoice::default(), 3000);
         print(&format!("seed {seed} information gain"), &ours);
