@@ -303,8 +303,8 @@ fn register(args: &Args) -> Result<()> {
     if let Some(layout) = args.layout {
         settings.loam.features.layout = layout.lidar_layout();
     }
-    if args.settings.print_config {
-        return print_settings(&settings);
+    if let Some(format) = args.settings.print_config {
+        return print_settings(&settings, format);
     }
     let Settings { icp, loam } = settings;
     let repeat = args.repeat.get();

@@ -41,6 +41,6 @@ pub use health::{HealthSummary, print_tracking_health};
 pub use mapping::{MappedScans, Mapping, evaluate, map_and_evaluate, map_samples};
 pub use output::{StdoutClosed, run, write_line};
 pub use progress::Progress;
-pub use settings::{SettingsArgs, load_settings, print_settings};
+pub use settings::{SettingsArgs, SettingsFormat, load_settings, print_settings};
 pub use sim_options::{Motion, Sensor};
 pub use stats::{Timings, quantile};

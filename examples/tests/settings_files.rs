@@ -260,3 +260,55 @@ fn mission_settings_round_trip_take_effect_and_yield_to_options() {
         "[navigator]\nplanner = 3\n",
     );
 }
+
+/// YAML beside TOML, for the three examples: the defaults printed as YAML read back to the same
+/// settings as the TOML defaults; a YAML file changes what the same TOML file changes (the TOML
+/// reading is the oracle); a misspelt field fails naming the file and the field.
+#[test]
+fn yaml_settings_read_as_the_same_toml_settings() {
+    let dir = scratch("yaml");
+    for name in ["slam", "mission", "register"] {
+        let toml_defaults = stdout_of(name, &["--print-config"]);
+        let yaml_defaults = stdout_of(name, &["--print-config", "yaml"]);
+        assert_ne!(yaml_defaults, toml_defaults, "{name}: YAML is printed");
+        let path = write(&dir, &format!("{name}.yaml"), &yaml_defaults);
+        assert_eq!(
+            stdout_of(name, &["--config", &path, "--print-config"]),
+            toml_defaults,
+            "{name}: the YAML defaults read back differently"
+        );
+    }
+    for (name, toml_text, yaml_text) in [
+        (
+            "slam",
+            "[slam]\nkeyframe_distance = 0.5\nloop_kernel = { kind = \"Huber\", delta = 0.5 }\n\
+             [slam.tracker.reach]\nmax = 4.0\n",
+            "slam:\n  keyframe_distance: 0.5\n  loop_kernel:\n    kind: Huber\n    delta: 0.5\n  \
+             tracker:\n    reach:\n      max: 4.0\n",
+        ),
+        (
+            "register",
+            "[icp]\nmax_iterations = 7\nsource_voxel = 0.3\n",
+            "icp:\n  max_iterations: 7\n  source_voxel: 0.3\n",
+        ),
+    ] {
+        let toml_path = write(&dir, &format!("{name}-part.toml"), toml_text);
+        let yaml_path = write(&dir, &format!("{name}-part.yml"), yaml_text);
+        let from_toml = stdout_of(name, &["--config", &toml_path, "--print-config"]);
+        assert_ne!(from_toml, stdout_of(name, &["--print-config"]), "{name}");
+        assert_eq!(
+            stdout_of(name, &["--config", &yaml_path, "--print-config"]),
+            from_toml,
+            "{name}: YAML and TOML differ"
+        );
+    }
+    let path = write(&dir, "misspelt.yaml", "slam:\n  keyframe_distanc: 1.0\n");
+    let out = run("slam", &["--config", &path, "--print-config"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("misspelt.yaml") && stderr.contains("keyframe_distanc"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

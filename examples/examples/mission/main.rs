@@ -59,8 +59,8 @@ fn mission(args: &Args) -> Result<()> {
             PlannerChoice::Astar => PlannerKind::AStar,
         };
     }
-    if args.settings.print_config {
-        return print_settings(&settings);
+    if let Some(format) = args.settings.print_config {
+        return print_settings(&settings, format);
     }
     let Settings {
         slam: slam_settings,

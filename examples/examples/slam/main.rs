@@ -77,8 +77,8 @@ fn slam(args: &Args) -> Result<()> {
         },
         (_, information) => information,
     };
-    if args.settings.print_config {
-        return print_settings(&Settings { slam: config });
+    if let Some(format) = args.settings.print_config {
+        return print_settings(&Settings { slam: config }, format);
     }
     if let Some(path) = &args.recording {
         replay(args, config, path)
