@@ -127,3 +127,48 @@ fn results_write_and_read_back() {
     let e = serde_json::from_str::<PoseGraph<Pose3>>(&broken).unwrap_err();
     assert!(e.to_string().contains("node index 7"), "{e}");
 }
+
+/// The simulator's settings: read from partial TOML (the motion profile by its `kind`, the
+/// rest at the defaults), round-tripped with every motion profile and sensor, a misspelt field
+/// refused by name.
+#[test]
+fn simulation_settings_read_from_partial_toml_and_round_trip() {
+    use spot_adapter::sim::{HandheldConfig, LidarConfig, MotionProfile, SimulationConfig};
+    let read: SimulationConfig = toml::from_str(
+        "seed = 3\nmotion_distortion = true\nmotion = { kind = \"Handheld\", speed = 1.2 }\n\
+         [lidar]\nrings = 128\n[building]\nloop_length_x = [30.0, 40.0]\n",
+    )
+    .unwrap();
+    let mut want = SimulationConfig {
+        seed: 3,
+        motion_distortion: true,
+        motion: MotionProfile::Handheld(HandheldConfig {
+            speed: 1.2,
+            ..HandheldConfig::default()
+        }),
+        ..SimulationConfig::default()
+    };
+    want.lidar.rings = 128;
+    want.building.loop_length_x = (30.0, 40.0);
+    assert_eq!(read, want);
+    for (motion, lidar) in [
+        (MotionProfile::default(), LidarConfig::vlp16()),
+        (MotionProfile::fast_turns(), LidarConfig::vlp16()),
+        (MotionProfile::handheld(), LidarConfig::os1_128()),
+    ] {
+        let config = SimulationConfig {
+            motion,
+            lidar,
+            gyro_drift: Some(0.01),
+            ..SimulationConfig::default()
+        };
+        let text = toml::to_string(&config).unwrap();
+        assert_eq!(
+            toml::from_str::<SimulationConfig>(&text).unwrap(),
+            config,
+            "{text}"
+        );
+    }
+    let e = toml::from_str::<SimulationConfig>("[lidar]\nring = 128\n").unwrap_err();
+    assert!(e.to_string().contains("ring"), "{e}");
+}

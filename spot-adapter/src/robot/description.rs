@@ -5,6 +5,11 @@ use slam_core::InvalidSetting;
 
 /// How fast the robot may be commanded to move; commands beyond these are clamped to them.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct MotionLimits {
     /// Largest forward or backward speed, m/s: 1.6 m/s, Spot's top walking speed.
     pub max_forward_speed: f64,

@@ -12,6 +12,11 @@ use slam_core::Pose3;
 /// above the ground and the top of the puck (72 mm tall) near 0.84 m, the robot's height with
 /// the sensor.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct SpotGeometry {
     /// Height of the body frame above the ground when standing, 0.50 m.
     pub body_height: f64,

@@ -4,6 +4,11 @@ use crate::sim::SimError;
 
 /// Ranges the generator draws from (metres). Defaults give realistic office scales.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct BuildingConfig {
     /// Corridor width between wall centre lines, e.g. 1.8..2.6 m (1.6..2.4 m free).
     pub corridor_width: (f64, f64),

@@ -7,6 +7,11 @@ use slam_core::Pose3;
 /// frequency, added to the level ground-truth pose. Off by default (all amplitudes zero); about
 /// 0.01 m and 0.01 rad (0.6°) at 1.8 Hz resemble a walking Spot.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct GaitSway {
     /// Vertical bob amplitude (metres), 0 by default.
     pub height: f64,

@@ -22,6 +22,11 @@ const FADE: f64 = 1.0;
 /// the pose it started from. The phases are fixed, so the ground truth does not depend on the
 /// seed.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct HandShake {
     /// Height bob amplitude (metres), 0.02 m.
     pub height: f64,

@@ -15,6 +15,11 @@ use crate::sim::rng::SimRng;
 /// once, columns evenly spaced in azimuth (counter-clockwise from the LiDAR's x axis) over one
 /// turn. [`Default`] is [`LidarConfig::vlp16`]; [`LidarConfig::os1_128`] is an Ouster OS1-128.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct LidarConfig {
     /// Elevation of the lowest ring (radians): -15° for the VLP-16.
     pub lowest_elevation: f64,

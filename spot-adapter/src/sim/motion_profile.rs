@@ -7,6 +7,11 @@ use crate::sim::setting_checks::require_positive;
 
 /// How a [`SimulatedSpot`](crate::sim::SimulatedSpot) moves along its route.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind")
+)]
 #[non_exhaustive]
 pub enum MotionProfile {
     /// Spot walks at a constant [`SimulationConfig::speed`](crate::sim::SimulationConfig::speed)
@@ -47,6 +52,11 @@ impl MotionProfile {
 /// its walking speed and yaw rate are [`SimulationConfig::speed`](crate::sim::SimulationConfig::speed)
 /// and [`MotionLimits::max_yaw_rate`](crate::robot::MotionLimits::max_yaw_rate).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct FastTurnsConfig {
     /// Speeding up and slowing down along a leg (m/s²), 1.0: 0.6 m/s reached in 0.6 s.
     pub acceleration: f64,
@@ -96,6 +106,11 @@ impl FastTurnsConfig {
 ///
 /// [`SimulationConfig::spot`]: crate::sim::SimulationConfig::spot
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct HandheldConfig {
     /// Walking speed along a leg (m/s), 1.2.
     pub speed: f64,

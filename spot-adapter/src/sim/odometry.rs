@@ -22,6 +22,11 @@ use crate::sim::setting_checks::require_non_negative;
 /// With the defaults the relative drift (end-point error over distance) is 1.9 % plus a few
 /// tenths of a percent of noise.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct OdometryDriftConfig {
     /// Bias drift per metre walked, 0.019 (1.9 %).
     pub drift_rate: f64,

@@ -22,6 +22,11 @@ use crate::sim::timed_walk::{TimedWalk, WalkLimits};
 
 /// Settings of a simulated run.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct SimulationConfig {
     /// Seeds the sensor noise and the odometry drift, and the building in
     /// [`SimulatedSpot::corridor_loop`] (a building made with [`Building::generate`] has its
