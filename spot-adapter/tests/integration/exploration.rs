@@ -237,19 +237,36 @@ fn bad_exploration_settings_are_refused_by_name() {
 /// `cargo test -p spot-nav-adapter --release --test integration
 /// exploration::against_the_greedy_explorer -- --ignored --nocapture`.
 #[test]
-#[ignore = "about 30 s a building; the README's figures"]
+#[ignore = "about 90 s a building; the README's figures"]
 fn against_the_greedy_explorer() {
-    for seed in 11..=14 {
+    let seeds = std::env::var("EXPLORATION_SEEDS")
+        .ok()
+        .and_then(|s| {
+            let (a, b) = s.split_once('-')?;
+            Some(a.parse().ok()?..=b.parse().ok()?)
+        })
+        .unwrap_or(11..=14);
+    for seed in seeds {
         let building = small_building(seed);
-        let ours = explore_building(&building, FrontierChoice::default(), 3000);
-        print(&format!("seed {seed} information gain"), &ours);
         let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
         print(&format!("seed {seed} greedy nearest"), &greedy);
-        eprintln!(
-            "seed {seed}: ours walks {:.2}x the greedy explorer's distance",
-            ours.walked / greedy.walked
-        );
-        for e in [&ours, &greedy] {
+        let mut runs = vec![greedy];
+        for (name, choice) in [
+            ("tour", FrontierChoice::Tour { keep_margin: 2.0 }),
+            (
+                "information gain",
+                FrontierChoice::InformationGain { detour: 4.0 },
+            ),
+        ] {
+            let e = explore_building(&building, choice, 3000);
+            print(&format!("seed {seed} {name}"), &e);
+            eprintln!(
+                "seed {seed}: {name} walks {:.2}x the greedy explorer's distance",
+                e.walked / runs[0].walked
+            );
+            runs.push(e);
+        }
+        for e in &runs {
             assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
             assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
             assert_eq!(e.collisions, 0);
