@@ -231,13 +231,15 @@ fn bad_exploration_settings_are_refused_by_name() {
     }
 }
 
-/// The README's figures: both explorers on small buildings (seeds 11-14), coverage and
-/// collisions checked, the distances printed (2026-12-05: ours 0.93x, 0.99x, 1.06x and 1.24x the
-/// greedy explorer's distance). About 30 s a building:
+/// The README's figures: the greedy explorer, the tour (`FrontierChoice::Tour`, 2 m margin) and
+/// ours (the default) on small buildings, seeds 11-14 or `EXPLORATION_SEEDS=15-16`; coverage and
+/// collisions checked for greedy and ours, the distances printed (2026-12-05, against greedy:
+/// tour 1.02x, 1.26x, 0.96x, 1.15x with 94.8 % coverage on 14; ours 0.93x, 0.99x, 1.06x,
+/// 1.24x). About a minute a building:
 /// `cargo test -p spot-nav-adapter --release --test integration
 /// exploration::against_the_greedy_explorer -- --ignored --nocapture`.
 #[test]
-#[ignore = "about 90 s a building; the README's figures"]
+#[ignore = "about a minute a building; the README's figures"]
 fn against_the_greedy_explorer() {
     let seeds = std::env::var("EXPLORATION_SEEDS")
         .ok()
@@ -250,7 +252,7 @@ fn against_the_greedy_explorer() {
         let building = small_building(seed);
         let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
         print(&format!("seed {seed} greedy nearest"), &greedy);
-        let mut runs = vec![greedy];
+        let mut runs = vec![("greedy", greedy)];
         for (name, choice) in [
             ("tour", FrontierChoice::Tour { keep_margin: 2.0 }),
             (
@@ -262,11 +264,12 @@ fn against_the_greedy_explorer() {
             print(&format!("seed {seed} {name}"), &e);
             eprintln!(
                 "seed {seed}: {name} walks {:.2}x the greedy explorer's distance",
-                e.walked / runs[0].walked
+                e.walked / runs[0].1.walked
             );
-            runs.push(e);
+            runs.push((name, e));
         }
-        for e in &runs {
+        // The tour is not checked: it left 5 % of seed 14 unseen (see the README).
+        for (_, e) in runs.iter().filter(|(name, _)| *name != "tour") {
             assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
             assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
             assert_eq!(e.collisions, 0);
