@@ -208,6 +208,15 @@ fn bad_exploration_settings_are_refused_by_name() {
             },
             "FrontierChoice::InformationGain::detour",
         ),
+        (
+            ExplorerConfig {
+                choice: FrontierChoice::Tour {
+                    keep_margin: f64::INFINITY,
+                },
+                ..ExplorerConfig::default()
+            },
+            "FrontierChoice::Tour::keep_margin",
+        ),
     ] {
         let mut spot = CommandedSpot::new(building.clone(), start, 0.0, &sim).unwrap();
         let mut slam = point_to_plane_slam(slam_config()).unwrap();
