@@ -287,7 +287,8 @@ impl Explorer {
 const KEPT_GOAL_MOVES: f64 = 1.0;
 
 /// The index in `candidates` of the first goal of the shortest open tour from the robot through
-/// all of them (goals at `goal_cells`), the walks between goals by one Dijkstra search from each;
+/// all of them (goals at `goal_cells`), the walks between goals by one Dijkstra search from each
+/// (stopped once it has reached the others);
 /// `kept` instead, when the shortest tour starting there is at most `keep_margin` metres longer.
 fn tour_first(
     blocked: &BitGrid,
@@ -299,10 +300,9 @@ fn tour_first(
     let from_goal: Vec<Vec<f64>> = goal_cells
         .iter()
         .map(|&from| {
-            let costs = TravelCosts::from_start(blocked, from);
-            goal_cells
-                .iter()
-                .map(|&to| costs.to(to).unwrap_or(f64::INFINITY))
+            TravelCosts::between(blocked, from, goal_cells)
+                .into_iter()
+                .map(|walk| walk.unwrap_or(f64::INFINITY))
                 .collect()
         })
         .collect();
