@@ -8,6 +8,7 @@ use slam_core::{BitGrid, Cell};
 use crate::nav::NavError;
 use crate::nav::explorer_config::{ExplorerConfig, FrontierChoice};
 use crate::nav::frontier::{Frontier, find_frontiers};
+use crate::nav::frontier_tour::{FrontierTour, TourCosts};
 use crate::nav::travel_costs::TravelCosts;
 
 /// A frontier the explorer could walk to.
@@ -76,15 +77,19 @@ pub struct FrontierDecision {
 
 /// Picks frontiers (known-free cells next to unknown ones) to explore by
 /// [`ExplorerConfig::choice`]: [`FrontierChoice::InformationGain`] weighs what a frontier would
-/// reveal against the walk to it, [`FrontierChoice::GreedyNearestFrontier`] takes the nearest.
+/// reveal against the walk to it, [`FrontierChoice::GreedyNearestFrontier`] takes the nearest,
+/// [`FrontierChoice::Tour`] the first of the shortest walk through them all.
 ///
 /// It keeps no map of its own: each [`Explorer::decide`] looks at the occupancy grid and the
 /// planning grid as they are (the map grows and is re-rendered when a loop closes), with one
-/// Dijkstra search from the robot for the walks to every frontier.
+/// Dijkstra search from the robot for the walks to every frontier (and, for the tour, one from
+/// each frontier goal for the walks between them).
 #[derive(Clone, Debug)]
 pub struct Explorer {
     config: ExplorerConfig,
     given_up: Vec<GivenUpFrontier>,
+    /// The goal of the last decision (metres, map frame), kept by [`FrontierChoice::Tour`].
+    heading_for: Option<Vector2<f64>>,
 }
 
 impl Explorer {
@@ -97,15 +102,16 @@ impl Explorer {
         Ok(Self {
             config,
             given_up: Vec::new(),
+            heading_for: None,
         })
     }
 
     /// The next frontier on `occupancy` for a robot at `position` (metres, map frame),
     /// walking on `blocked` (the planning grid over `occupancy`: unknown cells and the hard
-    /// inflation blocked).
+    /// inflation blocked). The tour rule remembers the goal it picked.
     #[must_use]
     pub fn decide(
-        &self,
+        &mut self,
         occupancy: &OccupancyGrid,
         planning: &PlanningGrid,
         position: Vector2<f64>,
@@ -122,20 +128,23 @@ impl Explorer {
         };
         let mut best: Option<((f64, f64), FrontierGoal)> = None;
         let mut candidates = Vec::new();
+        let mut goal_cells = Vec::new();
         for frontier in frontiers {
-            let Some((goal, cost)) = costs
+            let Some((goal_cell, cost)) = costs
                 .as_ref()
                 .and_then(|c| self.goal_of(blocked, c, frontier.middle))
             else {
                 decision.unreachable.push(frontier);
                 continue;
             };
+            let goal = blocked.geometry().cell_center(goal_cell);
             if self.is_given_up(goal) {
                 decision.given_up += 1;
                 continue;
             }
             decision.reachable += 1;
             let gain = self.gain(occupancy, frontier.middle);
+            goal_cells.push(goal_cell);
             candidates.push(FrontierGoal {
                 goal,
                 frontier,
@@ -156,8 +165,23 @@ impl Explorer {
                     (f64::NEG_INFINITY, -c.cost)
                 }
             }
-            FrontierChoice::GreedyNearestFrontier => (0.0, -c.cost),
+            FrontierChoice::GreedyNearestFrontier | FrontierChoice::Tour { .. } => (0.0, -c.cost),
         };
+        if let FrontierChoice::Tour { keep_margin } = self.config.choice
+            && candidates.len() > 1
+        {
+            // The frontier walked to shrinks as it is seen: its goal moves, a little.
+            let kept = self.heading_for.and_then(|h| {
+                candidates
+                    .iter()
+                    .position(|c| (c.goal - h).norm() <= KEPT_GOAL_MOVES)
+            });
+            let first = tour_first(blocked, &candidates, &goal_cells, kept, keep_margin);
+            let chosen = candidates.swap_remove(first);
+            self.heading_for = Some(chosen.goal);
+            decision.chosen = Some(chosen);
+            return decision;
+        }
         for c in candidates {
             let s = score(&c);
             if best.as_ref().is_none_or(|(b, _)| s > *b) {
@@ -192,18 +216,12 @@ impl Explorer {
             .any(|g| (g.goal - goal).norm() <= self.config.give_up_radius)
     }
 
-    /// The reachable cell nearest `middle` within the goal reach (ties: the shorter walk), as
-    /// its centre and the walk there. (A goal kept 0.2 m inside the free space, away from the
+    /// The reachable cell nearest `middle` within the goal reach (ties: the shorter walk), and
+    /// the walk there. (A goal kept 0.2 m inside the free space, away from the
     /// inflation's edge, was blocked less often by the wall found beyond, but often could not
     /// see its frontier: more walks and more walking.)
-    fn goal_of(
-        &self,
-        blocked: &BitGrid,
-        costs: &TravelCosts,
-        middle: Cell,
-    ) -> Option<(Vector2<f64>, f64)> {
-        let geometry = blocked.geometry();
-        let r = (self.config.goal_reach / geometry.resolution).ceil() as i64;
+    fn goal_of(&self, blocked: &BitGrid, costs: &TravelCosts, middle: Cell) -> Option<(Cell, f64)> {
+        let r = (self.config.goal_reach / blocked.geometry().resolution).ceil() as i64;
         let r2 = r * r;
         let mut best: Option<(i64, f64, Cell)> = None;
         for dy in -r..=r {
@@ -226,7 +244,7 @@ impl Explorer {
                 }
             }
         }
-        best.map(|(_, cost, cell)| (geometry.cell_center(cell), cost))
+        best.map(|(_, cost, cell)| (cell, cost))
     }
 
     /// Unknown area (square metres) a sensor at `middle` would see within sensor range: the
@@ -261,6 +279,53 @@ impl Explorer {
             }
         }
         unknown as f64 * resolution * resolution
+    }
+}
+
+/// How far (metres) the goal of the frontier walked to may move between decisions and still be
+/// taken for the same frontier: a frontier seen from nearer shrinks, and its middle moves.
+const KEPT_GOAL_MOVES: f64 = 1.0;
+
+/// The index in `candidates` of the first goal of the shortest open tour from the robot through
+/// all of them (goals at `goal_cells`), the walks between goals by one Dijkstra search from each
+/// (stopped once it has reached the others);
+/// `kept` instead, when the shortest tour starting there is at most `keep_margin` metres longer.
+fn tour_first(
+    blocked: &BitGrid,
+    candidates: &[FrontierGoal],
+    goal_cells: &[Cell],
+    kept: Option<usize>,
+    keep_margin: f64,
+) -> usize {
+    let from_goal: Vec<Vec<f64>> = goal_cells
+        .iter()
+        .map(|&from| {
+            TravelCosts::between(blocked, from, goal_cells)
+                .into_iter()
+                .map(|walk| walk.unwrap_or(f64::INFINITY))
+                .collect()
+        })
+        .collect();
+    let costs = TourCosts::new(candidates.iter().map(|c| c.cost).collect(), |i, j| {
+        from_goal[i][j]
+    });
+    let best = FrontierTour::plan(&costs);
+    let first = best.order.first().copied().unwrap_or(0);
+    let Some(k) = kept.filter(|&k| k != first) else {
+        return first;
+    };
+    let from_kept = TourCosts::new(
+        candidates
+            .iter()
+            .enumerate()
+            .map(|(j, c)| if j == k { c.cost } else { f64::INFINITY })
+            .collect(),
+        |i, j| from_goal[i][j],
+    );
+    if FrontierTour::plan(&from_kept).length <= best.length + keep_margin {
+        k
+    } else {
+        first
     }
 }
 
@@ -321,8 +386,9 @@ mod tests {
         for choice in [
             FrontierChoice::default(),
             FrontierChoice::GreedyNearestFrontier,
+            FrontierChoice::Tour { keep_margin: 2.0 },
         ] {
-            let explorer = Explorer::new(ExplorerConfig {
+            let mut explorer = Explorer::new(ExplorerConfig {
                 choice,
                 ..ExplorerConfig::default()
             })
@@ -370,7 +436,7 @@ mod tests {
     #[test]
     fn a_robot_with_no_free_cell_near_it_reaches_nothing() {
         let (g, planning) = corridor_and_patch();
-        let explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
         // In the unknown space between the corridor and the patch.
         let decision = explorer.decide(&g, &planning, Vector2::new(5.4, 1.5));
         assert_eq!(decision.chosen, None);

@@ -24,6 +24,17 @@ pub enum FrontierChoice {
     /// `explore_lite`'s rule, the baseline: the frontier with the shortest walk, whatever it
     /// reveals.
     GreedyNearestFrontier,
+    /// The first frontier of the shortest walk from the robot through every reachable frontier
+    /// goal (an open travelling-salesman path over the walks between goals; FUEL, Zhou et al.,
+    /// RA-L 2021): a dead end passed on the way is cleared then, not walked back to later, as
+    /// nearest-first does. The frontier already walked to is kept unless a tour starting
+    /// elsewhere is shorter by more than `keep_margin`: the map grows between decisions and a
+    /// tour that flips between two frontiers walks to neither.
+    Tour {
+        /// Metres a tour must save over the one through the frontier already walked to before
+        /// the explorer turns to another, 2 m.
+        keep_margin: f64,
+    },
 }
 
 impl Default for FrontierChoice {
@@ -86,7 +97,7 @@ impl Default for ExplorerConfig {
 }
 
 impl ExplorerConfig {
-    /// Every length finite and positive (the choice's detour not negative), the counts at
+    /// Every length finite and positive (the choice's detour or margin not negative), the counts at
     /// least 1.
     ///
     /// # Errors
@@ -115,12 +126,21 @@ impl ExplorerConfig {
                 return Err(NavError::invalid(setting, 0.0, "at least 1"));
             }
         }
-        if let FrontierChoice::InformationGain { detour } = self.choice
-            && !(detour.is_finite() && detour >= 0.0)
+        let margin = match self.choice {
+            FrontierChoice::InformationGain { detour } => {
+                Some(("FrontierChoice::InformationGain::detour", detour))
+            }
+            FrontierChoice::Tour { keep_margin } => {
+                Some(("FrontierChoice::Tour::keep_margin", keep_margin))
+            }
+            FrontierChoice::GreedyNearestFrontier => None,
+        };
+        if let Some((setting, value)) = margin
+            && !(value.is_finite() && value >= 0.0)
         {
             return Err(NavError::invalid(
-                "FrontierChoice::InformationGain::detour",
-                detour,
+                setting,
+                value,
                 "finite and not negative (metres)",
             ));
         }

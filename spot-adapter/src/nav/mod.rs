@@ -16,6 +16,7 @@ mod exploration;
 mod explorer;
 mod explorer_config;
 mod frontier;
+mod frontier_tour;
 mod localiser;
 mod navigation_map;
 mod navigator;

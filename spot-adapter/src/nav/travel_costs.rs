@@ -23,6 +23,21 @@ impl TravelCosts {
     /// the grid or blocked: nothing is reachable).
     #[must_use]
     pub fn from_start(blocked: &BitGrid, start: Cell) -> Self {
+        Self::search(blocked, start, &[])
+    }
+
+    /// The walking distances (metres) from `start` to each of `targets` (`None` where it
+    /// cannot be reached or is off the grid), the search stopped once every reachable target
+    /// is settled: the tour between frontier goals needs a handful of cells, not the grid.
+    #[must_use]
+    pub fn between(blocked: &BitGrid, start: Cell, targets: &[Cell]) -> Vec<Option<f64>> {
+        let costs = Self::search(blocked, start, targets);
+        targets.iter().map(|&t| costs.to(t)).collect()
+    }
+
+    /// Dijkstra from `start`; with `targets`, stopped once all of them reachable are settled
+    /// (the other cells' distances are then not final).
+    fn search(blocked: &BitGrid, start: Cell, targets: &[Cell]) -> Self {
         let (w, h) = (blocked.width(), blocked.height());
         let resolution = blocked.geometry().resolution;
         let mut metres = vec![f64::INFINITY; w as usize * h as usize];
@@ -35,6 +50,14 @@ impl TravelCosts {
                 metres,
             };
         }
+        let mut is_target = vec![false; metres.len()];
+        let mut unsettled = 0usize;
+        for &t in targets {
+            if blocked.get(t) == Some(false) && !is_target[index(t)] {
+                is_target[index(t)] = true;
+                unsettled += 1;
+            }
+        }
         // Distances in cell sides; non-negative floats order as their bits do.
         let mut queue = BinaryHeap::new();
         metres[index(start)] = 0.0;
@@ -43,6 +66,12 @@ impl TravelCosts {
             let d = f64::from_bits(bits);
             if d > metres[index(Cell::new(x, y))] {
                 continue;
+            }
+            if is_target[index(Cell::new(x, y))] {
+                unsettled -= 1;
+                if unsettled == 0 {
+                    break;
+                }
             }
             let (xi, yi) = (i64::from(x), i64::from(y));
             for (dx, dy) in [
@@ -143,6 +172,31 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Stopped at its targets, the search gives them the whole search's distances, to the bit.
+    #[test]
+    fn distances_between_targets_equal_the_whole_search() {
+        let mut state = 11u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        for _ in 0..50 {
+            let (w, h) = (2 + next() % 20, 2 + next() % 20);
+            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
+            let targets: Vec<Cell> = (0..=next() % 5)
+                .map(|_| Cell::new(next() % (w + 2), next() % h))
+                .collect();
+            let whole = TravelCosts::from_start(&grid, Cell::new(0, 0));
+            let expected: Vec<Option<f64>> = targets.iter().map(|&t| whole.to(t)).collect();
+            assert_eq!(
+                TravelCosts::between(&grid, Cell::new(0, 0), &targets),
+                expected
+            );
         }
     }
 

@@ -208,6 +208,15 @@ fn bad_exploration_settings_are_refused_by_name() {
             },
             "FrontierChoice::InformationGain::detour",
         ),
+        (
+            ExplorerConfig {
+                choice: FrontierChoice::Tour {
+                    keep_margin: f64::INFINITY,
+                },
+                ..ExplorerConfig::default()
+            },
+            "FrontierChoice::Tour::keep_margin",
+        ),
     ] {
         let mut spot = CommandedSpot::new(building.clone(), start, 0.0, &sim).unwrap();
         let mut slam = point_to_plane_slam(slam_config()).unwrap();
@@ -231,25 +240,45 @@ fn bad_exploration_settings_are_refused_by_name() {
     }
 }
 
-/// The README's figures: both explorers on small buildings (seeds 11-14), coverage and
-/// collisions checked, the distances printed (2026-12-05: ours 0.93x, 0.99x, 1.06x and 1.24x the
-/// greedy explorer's distance). About 30 s a building:
+/// The README's figures: the greedy explorer, the tour (`FrontierChoice::Tour`, 2 m margin) and
+/// ours (the default) on small buildings, seeds 11-14 or `EXPLORATION_SEEDS=15-16`; coverage and
+/// collisions checked for greedy and ours, the distances printed (2026-12-05, against greedy:
+/// tour 1.02x, 1.26x, 0.96x, 1.15x with 94.8 % coverage on 14; ours 0.93x, 0.99x, 1.06x,
+/// 1.24x). About a minute a building:
 /// `cargo test -p spot-nav-adapter --release --test integration
 /// exploration::against_the_greedy_explorer -- --ignored --nocapture`.
 #[test]
-#[ignore = "about 30 s a building; the README's figures"]
+#[ignore = "about a minute a building; the README's figures"]
 fn against_the_greedy_explorer() {
-    for seed in 11..=14 {
+    let seeds = std::env::var("EXPLORATION_SEEDS")
+        .ok()
+        .and_then(|s| {
+            let (a, b) = s.split_once('-')?;
+            Some(a.parse().ok()?..=b.parse().ok()?)
+        })
+        .unwrap_or(11..=14);
+    for seed in seeds {
         let building = small_building(seed);
-        let ours = explore_building(&building, FrontierChoice::default(), 3000);
-        print(&format!("seed {seed} information gain"), &ours);
         let greedy = explore_building(&building, FrontierChoice::GreedyNearestFrontier, 3000);
         print(&format!("seed {seed} greedy nearest"), &greedy);
-        eprintln!(
-            "seed {seed}: ours walks {:.2}x the greedy explorer's distance",
-            ours.walked / greedy.walked
-        );
-        for e in [&ours, &greedy] {
+        let mut runs = vec![("greedy", greedy)];
+        for (name, choice) in [
+            ("tour", FrontierChoice::Tour { keep_margin: 2.0 }),
+            (
+                "information gain",
+                FrontierChoice::InformationGain { detour: 4.0 },
+            ),
+        ] {
+            let e = explore_building(&building, choice, 3000);
+            print(&format!("seed {seed} {name}"), &e);
+            eprintln!(
+                "seed {seed}: {name} walks {:.2}x the greedy explorer's distance",
+                e.walked / runs[0].1.walked
+            );
+            runs.push((name, e));
+        }
+        // The tour is not checked: it left 5 % of seed 14 unseen (see the README).
+        for (_, e) in runs.iter().filter(|(name, _)| *name != "tour") {
             assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
             assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
             assert_eq!(e.collisions, 0);
