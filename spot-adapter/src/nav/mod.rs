@@ -10,6 +10,7 @@ mod controller;
 mod detour;
 mod drive;
 mod error;
+mod floor_levelling;
 mod localiser;
 mod navigation_map;
 mod navigator;

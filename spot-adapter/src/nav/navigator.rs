@@ -10,6 +10,7 @@ use crate::nav::NavError;
 use crate::nav::config::{NavigatorConfig, PlannerKind};
 use crate::nav::controller::Controller;
 use crate::nav::detour::{DetourPolicy, Wait};
+use crate::nav::floor_levelling::level_on_floor;
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::path::Plan;
@@ -449,7 +450,13 @@ impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
     /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
     /// where it changed.
     fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), NavError> {
-        let map_t_lidar = pose * sample.body_t_lidar;
+        // Levelled on the map's floor: the estimate's height and tilt are its weakest part, and
+        // the live layer tells obstacles from floor by height.
+        let map_t_lidar = level_on_floor(
+            &sample.cloud,
+            &(pose * sample.body_t_lidar),
+            self.map.floor(),
+        );
         let update = self
             .live
             .update(&sample.cloud, &map_t_lidar, self.map.floor(), sample.stamp)

@@ -26,4 +26,5 @@ mod recording;
 mod simulator;
 mod slam_loop;
 mod slam_revisits;
+mod tilted_estimate;
 mod tracking;
