@@ -16,6 +16,7 @@ mod navigation_map;
 mod navigator;
 mod path;
 mod planner;
+mod step;
 mod stuck;
 mod unseen;
 
@@ -24,6 +25,7 @@ pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use error::{DriveError, NavError};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};
 pub use navigation_map::NavigationMap;
-pub use navigator::{Goal, NavigationStep, Navigator};
+pub use navigator::Navigator;
 pub use planner::{NavPlanner, PlannerMemory};
+pub use step::{Goal, NavigationStep};
 pub use stuck::StuckConfig;

@@ -15,46 +15,10 @@ use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::path::Plan;
 use crate::nav::planner::{NavPlanner, PlannerMemory};
+use crate::nav::step::{Goal, NavigationStep};
 use crate::nav::stuck::{StuckMonitor, StuckState};
 use crate::nav::unseen::unseen_blockers;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
-
-/// A goal: a plan-view position (map frame, metres) and, optionally, the heading to end with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Goal {
-    /// Where the body should end (metres, map frame).
-    pub position: Vector2<f64>,
-    /// The heading it should end with (radians, map frame), if any.
-    pub heading: Option<f64>,
-}
-
-impl From<Vector2<f64>> for Goal {
-    fn from(position: Vector2<f64>) -> Self {
-        Self {
-            position,
-            heading: None,
-        }
-    }
-}
-
-/// What the navigator decided this cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum NavigationStep {
-    /// Walk: hold this command until the next scan.
-    Walk(VelocityCommand),
-    /// Stand still this cycle (searching for the robot's place on the map).
-    Hold,
-    /// The body is within the goal tolerance (and faces the goal's heading): stop.
-    Arrived,
-    /// No collision-free path joins the robot and the goal on the map (an answer, not a
-    /// failure): stop.
-    NoPath,
-    /// The robot made no progress though it tried to get free several times: stop.
-    Blocked,
-    /// Localisation failed and the wide searches did not find the robot on the map: stop.
-    Lost,
-}
 
 /// Walks the robot to goals in a mapped building (map frame = the map cloud's frame).
 ///
