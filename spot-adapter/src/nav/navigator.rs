@@ -27,7 +27,8 @@ use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 ///    registering the scan against the map (prepared once; the localiser tracks its health,
 ///    takes a large correction only once consecutive scans confirm it, and searches wide when
 ///    the robot seems lost);
-/// 2. fuses the scan's obstacle band into a live layer over the map's occupancy (fresh
+/// 2. levels the scan on the map's floor (its floor returns correct the estimate's height and
+///    tilt), fuses its obstacle band into a live layer over the map's occupancy (fresh
 ///    obstacles in, cells seen clear taken out, unseen changes decaying back to the map) and
 ///    brings the planning grid (hard inflation, clearance cost) up to date where it changed;
 /// 3. replans when there is no path yet, the path crosses a newly blocked cell, or every few
