@@ -8,8 +8,9 @@ use nalgebra::Vector2;
 use slam_core::{Pose3, Registrator};
 
 use crate::nav::DriveError;
-use crate::nav::navigator::{Goal, NavigationStep, Navigator};
+use crate::nav::navigator::Navigator;
 use crate::nav::planner::NavPlanner;
+use crate::nav::step::{Goal, NavigationStep};
 use crate::robot::{MobilityCommand, Robot, Sample};
 
 /// How a drive ended.

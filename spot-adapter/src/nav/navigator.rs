@@ -10,50 +10,15 @@ use crate::nav::NavError;
 use crate::nav::config::{NavigatorConfig, PlannerKind};
 use crate::nav::controller::Controller;
 use crate::nav::detour::{DetourPolicy, Wait};
+use crate::nav::floor_levelling::level_on_floor;
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::path::Plan;
 use crate::nav::planner::{NavPlanner, PlannerMemory};
+use crate::nav::step::{Goal, NavigationStep};
 use crate::nav::stuck::{StuckMonitor, StuckState};
 use crate::nav::unseen::unseen_blockers;
 use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
-
-/// A goal: a plan-view position (map frame, metres) and, optionally, the heading to end with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Goal {
-    /// Where the body should end (metres, map frame).
-    pub position: Vector2<f64>,
-    /// The heading it should end with (radians, map frame), if any.
-    pub heading: Option<f64>,
-}
-
-impl From<Vector2<f64>> for Goal {
-    fn from(position: Vector2<f64>) -> Self {
-        Self {
-            position,
-            heading: None,
-        }
-    }
-}
-
-/// What the navigator decided this cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum NavigationStep {
-    /// Walk: hold this command until the next scan.
-    Walk(VelocityCommand),
-    /// Stand still this cycle (searching for the robot's place on the map).
-    Hold,
-    /// The body is within the goal tolerance (and faces the goal's heading): stop.
-    Arrived,
-    /// No collision-free path joins the robot and the goal on the map (an answer, not a
-    /// failure): stop.
-    NoPath,
-    /// The robot made no progress though it tried to get free several times: stop.
-    Blocked,
-    /// Localisation failed and the wide searches did not find the robot on the map: stop.
-    Lost,
-}
 
 /// Walks the robot to goals in a mapped building (map frame = the map cloud's frame).
 ///
@@ -62,7 +27,8 @@ pub enum NavigationStep {
 ///    registering the scan against the map (prepared once; the localiser tracks its health,
 ///    takes a large correction only once consecutive scans confirm it, and searches wide when
 ///    the robot seems lost);
-/// 2. fuses the scan's obstacle band into a live layer over the map's occupancy (fresh
+/// 2. levels the scan on the map's floor (its floor returns correct the estimate's height and
+///    tilt), fuses its obstacle band into a live layer over the map's occupancy (fresh
 ///    obstacles in, cells seen clear taken out, unseen changes decaying back to the map) and
 ///    brings the planning grid (hard inflation, clearance cost) up to date where it changed;
 /// 3. replans when there is no path yet, the path crosses a newly blocked cell, or every few
@@ -449,7 +415,13 @@ impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
     /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
     /// where it changed.
     fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), NavError> {
-        let map_t_lidar = pose * sample.body_t_lidar;
+        // Levelled on the map's floor: the estimate's height and tilt are its weakest part, and
+        // the live layer tells obstacles from floor by height.
+        let map_t_lidar = level_on_floor(
+            &sample.cloud,
+            &(pose * sample.body_t_lidar),
+            self.map.floor(),
+        );
         let update = self
             .live
             .update(&sample.cloud, &map_t_lidar, self.map.floor(), sample.stamp)

@@ -27,4 +27,5 @@ mod recording;
 mod simulator;
 mod slam_loop;
 mod slam_revisits;
+mod tilted_estimate;
 mod tracking;
