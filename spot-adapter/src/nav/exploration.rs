@@ -17,7 +17,8 @@ use crate::nav::explorer::{
 use crate::nav::explorer_config::ExplorerConfig;
 use crate::nav::frontier::is_frontier_cell;
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::navigator::{NavigationStep, Navigator};
+use crate::nav::navigator::Navigator;
+use crate::nav::step::NavigationStep;
 use crate::robot::{MobilityCommand, Robot, Sample};
 
 /// How an exploration ended.
