@@ -5,6 +5,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+use pathfind::movement::DIRECTIONS;
 use slam_core::{BitGrid, Cell};
 
 /// Shortest walking distances (metres) from one start cell over a grid's free cells, under the
@@ -74,16 +75,7 @@ impl TravelCosts {
                 }
             }
             let (xi, yi) = (i64::from(x), i64::from(y));
-            for (dx, dy) in [
-                (1, 0),
-                (-1, 0),
-                (0, 1),
-                (0, -1),
-                (1, 1),
-                (1, -1),
-                (-1, 1),
-                (-1, -1),
-            ] {
+            for (dx, dy) in DIRECTIONS.map(|(dx, dy)| (i64::from(dx), i64::from(dy))) {
                 let (nx, ny) = (xi + dx, yi + dy);
                 if !free(nx, ny) {
                     continue;
