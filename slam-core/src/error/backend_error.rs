@@ -3,7 +3,8 @@
 use std::sync::Arc;
 
 /// A third-party backend's own error, kept as the source of the `Backend` variants of
-/// [`RegistrationError`], [`OptimizeError`], [`PlanError`] and [`PlaceRecognitionError`].
+/// [`RegistrationError`](super::RegistrationError), [`OptimizeError`](super::OptimizeError),
+/// [`PlanError`](super::PlanError) and [`PlaceRecognitionError`](super::PlaceRecognitionError).
 ///
 /// It dereferences to the backend's error (`dyn Error + Send + Sync`), which is also what the
 /// variant's [`source`](std::error::Error::source) returns, so a caller downcasts it to the
