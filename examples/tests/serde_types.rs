@@ -172,3 +172,78 @@ fn simulation_settings_read_from_partial_toml_and_round_trip() {
     let e = toml::from_str::<SimulationConfig>("[lidar]\nring = 128\n").unwrap_err();
     assert!(e.to_string().contains("ring"), "{e}");
 }
+
+#[test]
+fn recording_settings_read_from_partial_toml_and_round_trip() {
+    use spot_adapter::record::{
+        BagConfig, CloudFolderConfig, ImuSource, OdometrySource, SourceConfig, TimeUnit,
+    };
+    use spot_adapter::slam_core::Pose3;
+    let read: SourceConfig = toml::from_str(
+        "odometry = \"odom.tum\"\n\
+         [bag]\ncloud_topic = \"/points\"\nodometry = { kind = \"Topic\", topic = \"/odom\" }\n\
+         imu = { kind = \"None\" }\n\
+         [bag.cloud]\ntime_unit = \"NanosecondsRelative\"\nreturns = { min_range = 0.3 }\n",
+    )
+    .unwrap();
+    let mut want = SourceConfig {
+        odometry: Some("odom.tum".into()),
+        bag: BagConfig {
+            cloud_topic: Some("/points".into()),
+            odometry: OdometrySource::Topic("/odom".into()),
+            imu: ImuSource::None,
+            ..BagConfig::default()
+        },
+        ..SourceConfig::default()
+    };
+    want.bag.cloud.time_unit = Some(TimeUnit::NanosecondsRelative);
+    want.bag.cloud.returns.min_range = 0.3;
+    assert_eq!(read, want);
+    // Every form of the two tagged sources, a mounting and a folder's settings round-trip.
+    for (odometry, imu) in [
+        (OdometrySource::Auto, ImuSource::Auto),
+        (
+            OdometrySource::Tf {
+                odom_frame: "vision".into(),
+            },
+            ImuSource::Topic("/imu/data".into()),
+        ),
+        (OdometrySource::None, ImuSource::None),
+    ] {
+        let config = SourceConfig {
+            bag: BagConfig {
+                odometry,
+                imu,
+                base_frame: Some("body".into()),
+                ..BagConfig::default()
+            },
+            body_t_lidar: Some(Pose3::translation(0.1, 0.0, 0.4)),
+            ..SourceConfig::default()
+        };
+        let text = toml::to_string(&config).unwrap();
+        assert_eq!(
+            toml::from_str::<SourceConfig>(&text).unwrap(),
+            config,
+            "{text}"
+        );
+    }
+    let folder = CloudFolderConfig {
+        body_t_lidar: Some(Pose3::translation(0.0, 0.0, 1.3)),
+        ..CloudFolderConfig::default()
+    };
+    let text = toml::to_string(&folder).unwrap();
+    assert_eq!(toml::from_str::<CloudFolderConfig>(&text).unwrap(), folder);
+    // A misspelt field, a source of no known kind and a topic field on the wrong kind are
+    // refused by name.
+    for (bad, named) in [
+        ("[bag]\ncloud_topc = \"/x\"\n", "cloud_topc"),
+        ("[bag]\nodometry = { kind = \"Bag\" }\n", "Bag"),
+        (
+            "[bag]\nimu = { kind = \"None\", topic = \"/imu\" }\n",
+            "topic",
+        ),
+    ] {
+        let e = toml::from_str::<SourceConfig>(bad).unwrap_err();
+        assert!(e.to_string().contains(named), "{bad}: {e}");
+    }
+}

@@ -34,8 +34,18 @@ use crate::record::point_cloud2::{CloudLayout, PointCloud2Config, PointCloud2Dec
 use crate::record::ros_messages::RosMessageType;
 use crate::record::{BodyFrameSource, MessageError, RecordError};
 
-/// Where the odometry of a bag comes from.
+/// Where the odometry of a bag comes from. In a settings file (feature `serde`), tagged by
+/// `kind`: `{ kind = "Topic", topic = "/odom" }`, `{ kind = "Tf", odom_frame = "odom" }`,
+/// `{ kind = "Auto" }`, `{ kind = "None" }`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        from = "crate::record::source_forms::OdometrySourceForm",
+        into = "crate::record::source_forms::OdometrySourceForm"
+    )
+)]
 pub enum OdometrySource {
     /// The only `nav_msgs/Odometry` topic, else the `/tf` transform from `odom` to its moving
     /// child, else none. An odometry whose body frame (the topic's child frame, the moving
@@ -57,6 +67,11 @@ pub enum OdometrySource {
 
 /// How to read a bag.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct BagConfig {
     /// The cloud topic; `None` takes the only `sensor_msgs/PointCloud2` topic.
     pub cloud_topic: Option<String>,

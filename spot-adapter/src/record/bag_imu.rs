@@ -19,8 +19,17 @@ use crate::record::frame_tree::FrameTree;
 use crate::record::imu::{GyroCounts, GyroIntegrator, MAX_GYRO_GAP};
 use crate::record::ros_messages::RosMessageType;
 
-/// Where the samples' gyro orientation comes from.
+/// Where the samples' gyro orientation comes from. In a settings file (feature `serde`), tagged
+/// by `kind`: `{ kind = "Topic", topic = "/imu" }`, `{ kind = "Auto" }`, `{ kind = "None" }`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        from = "crate::record::source_forms::ImuSourceForm",
+        into = "crate::record::source_forms::ImuSourceForm"
+    )
+)]
 pub enum ImuSource {
     /// The only `sensor_msgs/Imu` topic, when its frame is joined to the body frame by fixed
     /// transforms; else none, and the summary's notes say why.

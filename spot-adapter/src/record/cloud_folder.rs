@@ -34,6 +34,11 @@ const DEFAULT_PERIOD: f64 = 0.1;
 
 /// How to read a cloud folder.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct CloudFolderConfig {
     /// The LiDAR mounting (`body_T_lidar`); identity when the scans are the body's.
     pub body_t_lidar: Option<Pose3>,

@@ -78,6 +78,8 @@ mod recording;
 mod recording_writer;
 mod ros_messages;
 mod source;
+#[cfg(feature = "serde")]
+mod source_forms;
 mod time_unit;
 mod wire;
 

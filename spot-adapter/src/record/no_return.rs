@@ -26,6 +26,11 @@ impl DroppedPoints {
 
 /// Which points count as returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct ReturnFilter {
     /// Points closer than this to the sensor (metres) are no-returns; usual value 0.1 m (the
     /// housing of a VLP-16 or an OS1 is about 0.05 m from its optical centre). Exact zeros are

@@ -156,6 +156,11 @@ pub fn detect(path: &Path) -> Result<(RecordingKind, PathBuf), RecordError> {
 
 /// How to open a recording; each field applies to the kinds that name it.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct SourceConfig {
     /// Bags: topics, frames and cloud decoding (its return filter is used by every kind).
     pub bag: BagConfig,

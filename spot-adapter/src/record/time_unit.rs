@@ -23,6 +23,7 @@ pub(super) const DEFAULT_MAX_SCAN_PERIOD: f64 = 0.25;
 
 /// The unit of a per-point time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum TimeUnit {
     /// Seconds since the header stamp (Velodyne).
     SecondsRelative,

@@ -47,6 +47,11 @@ fn checked_row_bytes(msg: &PointCloud2<'_>) -> Result<u64, MessageError> {
 
 /// Settings of [`PointCloud2Decoder`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct PointCloud2Config {
     /// Which points are returns.
     pub returns: ReturnFilter,
