@@ -144,6 +144,7 @@ pub mod mapped_building {
     use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
 
     /// The mapped building.
+    #[derive(Debug)]
     pub struct MappedBuilding {
         /// Kept scans (LiDAR frame) with their true `world_T_lidar`.
         pub scans: Vec<(Pose3, PointCloud)>,
