@@ -1,6 +1,38 @@
 //! The Graph-SLAM engine put together with this workspace's backends, configured as the
 //! simulated and recorded runs use it: one place for the settings that the example, the tests
 //! and the benches share.
+//!
+//! Mapping the first 10 s of a simulated Spot's lap, LiDAR-only, and reading the body's pose
+//! back from the engine's LiDAR poses (frames as in the workspace README: `a_T_b` maps points
+//! in `b` into `a`):
+//!
+//! ```
+//! use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
+//! use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
+//!
+//! let sim = SimulatedSpot::corridor_loop(&SimulationConfig::with_seed(3))?;
+//! let truth = sim.ground_truth(); // world_T_body per scan
+//! let mut slam = point_to_plane_slam(slam_config())?;
+//! let mut body_t_lidar = None;
+//! for sample in sim.take(50) {
+//!     // Points in the LiDAR frame; without odometry each scan is registered against the
+//!     // local map from a constant-velocity prediction.
+//!     slam.process(&sample.lidar_only_input());
+//!     body_t_lidar = Some(sample.body_t_lidar);
+//! }
+//! let lidar_t_body = body_t_lidar.expect("scans").inverse();
+//! // The engine keeps map_T_lidar per scan; the map frame is the first scan's LiDAR frame.
+//! let scans = slam.scan_trajectory();
+//! let map_t_body = |k: usize| scans[k].pose * lidar_t_body;
+//! // The walk from the first scan to the last, as the engine saw it and as it was.
+//! let seen = map_t_body(0).inverse() * map_t_body(49);
+//! let walked = truth[0].pose.inverse() * truth[49].pose;
+//! let error = (seen.translation.vector - walked.translation.vector).norm();
+//! assert!(walked.translation.vector.norm() > 4.0, "Spot walked some metres");
+//! assert!(error < 0.05, "{error} m off after {:.1} m", walked.translation.vector.norm());
+//! assert!(slam.keyframe_count() > 10 && slam.report().fallbacks() == 0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use posegraph::{GncConfig, GraduatedNonConvexity, KnownInliers};
 use registration::{
