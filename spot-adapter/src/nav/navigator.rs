@@ -45,54 +45,7 @@ use crate::robot::{MotionLimits, RobotDescription, Sample, VelocityCommand};
 /// one of ours, chosen by [`NavigatorConfig::planner`]; your own through
 /// [`Navigator::with_planner`].
 ///
-/// A simulated Spot walked 4 m down a corridor it has a map of (here built from the first
-/// scans of a lap at their true poses, so that the map frame is the world's):
-///
-/// ```
-/// use spot_adapter::nav::{DriveOutcome, NavigationMap, Navigator, NavigatorConfig, drive};
-/// use spot_adapter::pipelines::point_to_plane_localiser;
-/// use spot_adapter::robot::Robot;
-/// use spot_adapter::sim::{CommandedSpot, SimulatedSpot, SimulationConfig};
-/// use spot_adapter::slam_core::{PointCloud, Pose3};
-///
-/// let config = SimulationConfig::with_seed(3);
-/// let lap = SimulatedSpot::corridor_loop(&config)?;
-/// let building = lap.building().clone();
-/// let truth = lap.ground_truth(); // world_T_body per scan
-/// // Scans in the LiDAR frame, placed by world_T_lidar = world_T_body * body_T_lidar.
-/// let posed: Vec<(Pose3, PointCloud)> = lap
-///     .take(40)
-///     .zip(&truth)
-///     .map(|(sample, t)| (t.pose * sample.body_t_lidar, sample.cloud))
-///     .collect();
-/// let scans: Vec<(Pose3, &PointCloud)> = posed.iter().map(|(p, c)| (*p, c)).collect();
-/// let mut map = PointCloud::default();
-/// for (pose, cloud) in &scans {
-///     map.extend_from(&cloud.transformed(pose))?;
-/// }
-/// let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
-/// let nav_config = NavigatorConfig::default();
-/// let navigation = NavigationMap::from_scans(&scans, lidar_height, &nav_config.map_config())?;
-///
-/// // Spot stands where the lap started and walks to a point 4 m further along it.
-/// let start = truth[0].pose;
-/// let goal = truth[0].pose.translation.vector.xy() + (truth[39].pose.translation.vector.xy()
-///     - truth[0].pose.translation.vector.xy()).normalize() * 4.0;
-/// let yaw = start.rotation.euler_angles().2;
-/// let mut spot = CommandedSpot::new(building, start.translation.vector.xy(), yaw, &config)?;
-/// let mut navigator = Navigator::new(
-///     point_to_plane_localiser(),
-///     &map,
-///     &navigation,
-///     start,
-///     spot.description(),
-///     nav_config,
-/// )?;
-/// let walk = drive(&mut spot, &mut navigator, goal, 300, |_| {})?;
-/// assert_eq!(walk.outcome, DriveOutcome::Arrived);
-/// assert!((spot.position() - goal).norm() < 0.1, "the true body ends within 10 cm");
-/// # Ok::<(), Box<dyn std::error::Error>>(())
-/// ```
+/// A runnable example is in the [module docs](crate::nav).
 pub struct Navigator<R: Registrator, P: NavPlanner = PlannerKind> {
     config: NavigatorConfig,
     limits: MotionLimits,
