@@ -3,6 +3,7 @@
 use std::fmt;
 use std::time::Duration;
 
+use crate::grpc::ConfigProblem;
 use crate::grpc::error::SpotError;
 use crate::robot::RobotDescription;
 
@@ -161,17 +162,14 @@ impl SpotConfig {
     /// # Errors
     /// [`SpotError::InvalidConfig`] naming the first bad setting.
     pub fn validate(&self) -> Result<(), SpotError> {
-        let bad = |setting: &'static str, problem: &str| {
-            Err(SpotError::InvalidConfig {
-                setting,
-                problem: problem.to_owned(),
-            })
+        let bad = |setting: &'static str, problem: ConfigProblem| {
+            Err(SpotError::InvalidConfig { setting, problem })
         };
         if self.host.is_empty() {
-            return bad("host", "empty");
+            return bad("host", ConfigProblem::Empty);
         }
         if self.ca_pem.is_empty() {
-            return bad("ca_pem", "empty: the robot's CA certificate is needed");
+            return bad("ca_pem", ConfigProblem::NoCaCertificate);
         }
         for (setting, value) in [
             ("call_timeout", self.call_timeout),
@@ -186,14 +184,14 @@ impl SpotConfig {
             ),
         ] {
             if value.is_zero() {
-                return bad(setting, "must be longer than zero");
+                return bad(setting, ConfigProblem::ZeroDuration);
             }
         }
         if self.time_sync.max_initial_rounds == 0 {
-            return bad("time_sync.max_initial_rounds", "at least one round");
+            return bad("time_sync.max_initial_rounds", ConfigProblem::NoRounds);
         }
         if let Err(error) = self.description.limits.validate() {
-            return bad("description.limits", &error.to_string());
+            return bad("description.limits", ConfigProblem::Limits(error));
         }
         Ok(())
     }

@@ -1,6 +1,7 @@
 //! The error enum of the gRPC client. No variant holds a password or a token: errors are safe
 //! to log.
 
+use crate::grpc::{CloudProblem, ConfigProblem, GridProblem};
 use thiserror::Error;
 
 /// Why a call to a Spot failed, or why the client refused to make it.
@@ -8,12 +9,13 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum SpotError {
     /// A setting of [`SpotConfig`](crate::grpc::SpotConfig) is unusable.
-    #[error("setting {setting}: {problem}")]
+    #[error("setting {setting}")]
     InvalidConfig {
         /// The setting, as its field is named.
         setting: &'static str,
         /// What is wrong with it.
-        problem: String,
+        #[source]
+        problem: ConfigProblem,
     },
     /// The robot's CA certificate or address cannot be used for a TLS channel.
     #[error("cannot set up a TLS channel to {address} as {authority}")]
@@ -127,20 +129,22 @@ pub enum SpotError {
     #[error(transparent)]
     Frame(#[from] crate::grpc::FrameError),
     /// A point cloud could not be decoded.
-    #[error("point cloud from {source_name:?}: {problem}")]
+    #[error("point cloud from {source_name:?}")]
     MalformedCloud {
         /// The point cloud source.
         source_name: String,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: CloudProblem,
     },
     /// A local grid could not be decoded.
-    #[error("local grid {grid:?}: {problem}")]
+    #[error("local grid {grid:?}")]
     MalformedGrid {
         /// The grid type name.
         grid: String,
         /// What is wrong.
-        problem: String,
+        #[source]
+        problem: GridProblem,
     },
     /// The robot has no data for a request (an unknown source or grid, data unavailable).
     #[error("{what:?}: the robot answered {status}")]

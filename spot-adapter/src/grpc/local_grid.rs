@@ -3,6 +3,7 @@
 
 use slam_core::{BitGrid, GridError, GridGeometry};
 
+use crate::grpc::GridProblem;
 use crate::grpc::api;
 use crate::grpc::api::local_grid_service_client::LocalGridServiceClient;
 use crate::grpc::error::SpotError;
@@ -37,7 +38,7 @@ impl Session {
                     .find(|r| r.local_grid_type_name == name)
                     .ok_or_else(|| SpotError::MalformedGrid {
                         grid: name.to_owned(),
-                        problem: "missing from the response".to_owned(),
+                        problem: GridProblem::Missing,
                     })?;
                 if reply.status != api::local_grid_response::Status::Ok as i32 {
                     return Err(SpotError::NoData {
@@ -51,7 +52,7 @@ impl Session {
                     .as_ref()
                     .ok_or_else(|| SpotError::MalformedGrid {
                         grid: name.to_owned(),
-                        problem: "status OK without a grid".to_owned(),
+                        problem: GridProblem::OkWithoutGrid,
                     })?;
                 decode_grid(grid)
             })
@@ -106,36 +107,33 @@ impl LocalGrid {
 /// [`SpotError::MalformedGrid`] for a bad extent, an unknown format or encoding, RLE counts that
 /// do not sum to the cell count, or data of the wrong size.
 pub(crate) fn decode_grid(grid: &api::LocalGrid) -> Result<LocalGrid, SpotError> {
-    let bad = |problem: String| SpotError::MalformedGrid {
+    let bad = |problem: GridProblem| SpotError::MalformedGrid {
         grid: grid.local_grid_type_name.clone(),
         problem,
     };
     let extent = grid
         .extent
         .as_ref()
-        .ok_or_else(|| bad("no extent".into()))?;
+        .ok_or_else(|| bad(GridProblem::NoExtent))?;
     let (nx, ny) = (extent.num_cells_x, extent.num_cells_y);
     let (Ok(num_cells_x), Ok(num_cells_y)) = (u32::try_from(nx), u32::try_from(ny)) else {
-        return Err(bad(format!("extent {nx} x {ny} cells has a negative side")));
+        return Err(bad(GridProblem::NegativeSide { x: nx, y: ny }));
     };
     if !(extent.cell_size.is_finite() && extent.cell_size > 0.0) {
-        return Err(bad(format!(
-            "cell size {} m is not positive",
-            extent.cell_size
-        )));
+        return Err(bad(GridProblem::CellSize(extent.cell_size)));
     }
     let cells = (num_cells_x as usize)
         .checked_mul(num_cells_y as usize)
         .filter(|&n| n as u64 <= slam_core::MAX_GRID_CELLS)
-        .ok_or_else(|| bad(format!("extent {nx} x {ny} cells is too large")))?;
+        .ok_or_else(|| bad(GridProblem::TooLarge { x: nx, y: ny }))?;
     let format = api::local_grid::CellFormat::try_from(grid.cell_format)
-        .map_err(|_| bad(format!("cell format {} is unknown", grid.cell_format)))?;
-    let width = cell_bytes(format).ok_or_else(|| bad("cell format unknown (0)".into()))?;
+        .map_err(|_| bad(GridProblem::UnknownFormat(grid.cell_format)))?;
+    let width = cell_bytes(format).ok_or_else(|| bad(GridProblem::UnknownFormat(0)))?;
     if !grid.data.len().is_multiple_of(width) {
-        return Err(bad(format!(
-            "{} bytes is not a whole number of {width}-byte cells",
-            grid.data.len()
-        )));
+        return Err(bad(GridProblem::PartialCell {
+            bytes: grid.data.len(),
+            cell_bytes: width,
+        }));
     }
     let stored: Vec<f64> = grid
         .data
@@ -145,10 +143,10 @@ pub(crate) fn decode_grid(grid: &api::LocalGrid) -> Result<LocalGrid, SpotError>
     let raw = match api::local_grid::Encoding::try_from(grid.encoding) {
         Ok(api::local_grid::Encoding::Raw) => {
             if stored.len() != cells {
-                return Err(bad(format!(
-                    "{} cells of data for {nx} x {ny} = {cells}",
-                    stored.len()
-                )));
+                return Err(bad(GridProblem::RawSize {
+                    stored: stored.len(),
+                    cells,
+                }));
             }
             stored
         }
@@ -156,10 +154,7 @@ pub(crate) fn decode_grid(grid: &api::LocalGrid) -> Result<LocalGrid, SpotError>
             run_length_decode(&stored, &grid.rle_counts, cells).map_err(bad)?
         }
         _ => {
-            return Err(bad(format!(
-                "encoding {} is neither RAW nor RLE",
-                grid.encoding
-            )));
+            return Err(bad(GridProblem::Encoding(grid.encoding)));
         }
     };
     // A scale of 0 is the message's default: the values are then stored unscaled.
@@ -170,7 +165,7 @@ pub(crate) fn decode_grid(grid: &api::LocalGrid) -> Result<LocalGrid, SpotError>
     };
     let offset = grid.cell_value_offset;
     if !(scale.is_finite() && offset.is_finite()) {
-        return Err(bad("non-finite scale or offset".into()));
+        return Err(bad(GridProblem::NonFiniteScale));
     }
     Ok(LocalGrid {
         type_name: grid.local_grid_type_name.clone(),
@@ -209,24 +204,30 @@ fn cell_value(format: api::local_grid::CellFormat, c: &[u8]) -> f64 {
 }
 
 /// RLE: `values[k]` repeated `counts[k]` times, which must make exactly `cells` cells.
-fn run_length_decode(values: &[f64], counts: &[i32], cells: usize) -> Result<Vec<f64>, String> {
+fn run_length_decode(
+    values: &[f64],
+    counts: &[i32],
+    cells: usize,
+) -> Result<Vec<f64>, GridProblem> {
     if values.len() != counts.len() {
-        return Err(format!(
-            "{} run values for {} run counts",
-            values.len(),
-            counts.len()
-        ));
+        return Err(GridProblem::RunLengths {
+            values: values.len(),
+            counts: counts.len(),
+        });
     }
     let mut out = Vec::with_capacity(cells);
     for (k, (&value, &count)) in values.iter().zip(counts).enumerate() {
-        let count = usize::try_from(count).map_err(|_| format!("run {k} has a negative count"))?;
+        let count = usize::try_from(count).map_err(|_| GridProblem::NegativeRun(k))?;
         if out.len() + count > cells {
-            return Err(format!("the runs hold more than the {cells} cells"));
+            return Err(GridProblem::RunsTooLong(cells));
         }
         out.extend(std::iter::repeat_n(value, count));
     }
     if out.len() != cells {
-        return Err(format!("the runs hold {} of the {cells} cells", out.len()));
+        return Err(GridProblem::RunsTooShort {
+            held: out.len(),
+            cells,
+        });
     }
     Ok(out)
 }

@@ -44,6 +44,7 @@ mod api;
 mod auth;
 mod clock;
 mod config;
+mod decode_problem;
 mod directory;
 mod error;
 mod estop;
@@ -60,6 +61,7 @@ mod spot_client;
 mod time_sync;
 
 pub use config::{Credentials, SpotConfig, TimeSyncConfig};
+pub use decode_problem::{CloudProblem, ConfigProblem, GridProblem};
 pub use directory::RobotIdentity;
 pub use error::SpotError;
 pub use frame_tree::{FrameError, FrameTree};

@@ -4,6 +4,7 @@
 use nalgebra::Point3;
 use slam_core::PointCloud;
 
+use crate::grpc::CloudProblem;
 use crate::grpc::api;
 use crate::grpc::api::point_cloud_service_client::PointCloudServiceClient;
 use crate::grpc::clock;
@@ -47,7 +48,7 @@ impl Session {
             .next()
             .ok_or_else(|| SpotError::MalformedCloud {
                 source_name: source_name.clone(),
-                problem: "the response holds no point cloud".to_owned(),
+                problem: CloudProblem::Missing,
             })?;
         if reply.status != api::point_cloud_response::Status::Ok as i32 {
             return Err(SpotError::NoData {
@@ -59,7 +60,7 @@ impl Session {
         let Some(api::point_cloud_response::CloudData::PointCloud(cloud)) = reply.cloud_data else {
             return Err(SpotError::MalformedCloud {
                 source_name,
-                problem: "status OK without a point cloud".to_owned(),
+                problem: CloudProblem::OkWithoutCloud,
             });
         };
         let points = decode_cloud(&cloud)?;
@@ -89,28 +90,29 @@ pub(crate) fn decode_cloud(cloud: &api::PointCloud) -> Result<PointCloud, SpotEr
         .source
         .as_ref()
         .map_or_else(String::new, |s| s.name.clone());
-    let bad = |problem: String| SpotError::MalformedCloud {
+    let bad = |problem: CloudProblem| SpotError::MalformedCloud {
         source_name: source_name.clone(),
         problem,
     };
     if cloud.encoding != api::point_cloud::Encoding::Xyz32f as i32 {
         let name = api::point_cloud::Encoding::try_from(cloud.encoding)
             .map_or("an unknown encoding", |e| e.as_str_name());
-        return Err(bad(format!(
-            "encoding {} ({name}) is not ENCODING_XYZ_32F",
-            cloud.encoding
-        )));
+        return Err(bad(CloudProblem::Encoding {
+            code: cloud.encoding,
+            name,
+        }));
     }
     let count = usize::try_from(cloud.num_points)
-        .map_err(|_| bad(format!("num_points = {} is negative", cloud.num_points)))?;
+        .map_err(|_| bad(CloudProblem::NegativeCount(cloud.num_points)))?;
     let expected = count
         .checked_mul(12)
-        .ok_or_else(|| bad("num_points overflows".into()))?;
+        .ok_or_else(|| bad(CloudProblem::CountOverflows(count)))?;
     if cloud.data.len() != expected {
-        return Err(bad(format!(
-            "{} bytes of data for num_points = {count} (XYZ 32F needs {expected})",
-            cloud.data.len()
-        )));
+        return Err(bad(CloudProblem::DataSize {
+            bytes: cloud.data.len(),
+            points: count,
+            needed: expected,
+        }));
     }
     let mut points = Vec::with_capacity(count);
     for (k, chunk) in cloud.data.chunks_exact(12).enumerate() {
@@ -118,7 +120,7 @@ pub(crate) fn decode_cloud(cloud: &api::PointCloud) -> Result<PointCloud, SpotEr
             |i: usize| f32::from_le_bytes([chunk[i], chunk[i + 1], chunk[i + 2], chunk[i + 3]]);
         let p = Point3::new(coordinate(0), coordinate(4), coordinate(8));
         if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-            return Err(bad(format!("point {k} is not finite")));
+            return Err(bad(CloudProblem::NonFinitePoint(k)));
         }
         points.push(p);
     }
@@ -157,7 +159,17 @@ mod tests {
     fn a_count_that_disagrees_with_the_data_is_an_error() {
         let error = decode_cloud(&cloud(&[[1.0, 2.0, 3.0]], 2)).unwrap_err();
         assert!(
-            matches!(&error, SpotError::MalformedCloud { problem, .. } if problem.contains("12 bytes of data for num_points = 2")),
+            matches!(
+                &error,
+                SpotError::MalformedCloud {
+                    problem: CloudProblem::DataSize {
+                        bytes: 12,
+                        points: 2,
+                        needed: 24
+                    },
+                    ..
+                }
+            ),
             "{error}"
         );
         assert!(decode_cloud(&cloud(&[], -1)).is_err());

@@ -11,6 +11,7 @@ use tonic::metadata::{Ascii, MetadataValue};
 use tonic::service::{Interceptor, interceptor::InterceptedService};
 use tonic::transport::{Certificate, Channel, ClientTlsConfig, Endpoint};
 
+use crate::grpc::ConfigProblem;
 use crate::grpc::api;
 use crate::grpc::clock;
 use crate::grpc::config::SpotConfig;
@@ -122,7 +123,7 @@ impl Session {
                 .parse()
                 .map_err(|_| SpotError::InvalidConfig {
                     setting: "authority",
-                    problem: format!("{authority:?} is not a host name"),
+                    problem: ConfigProblem::NotAHostName(authority.to_owned()),
                 })?;
         let tls = ClientTlsConfig::new()
             .ca_certificate(Certificate::from_pem(&self.config.ca_pem))

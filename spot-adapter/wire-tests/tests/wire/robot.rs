@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{Vector2, Vector3};
 use serde_json::Value;
 use slam_core::{Pose2, Pose3};
-use spot_adapter::grpc::{FrameError, SpotClient, SpotError};
+use spot_adapter::grpc::{CloudProblem, FrameError, SpotClient, SpotError};
 use spot_adapter::robot::{
     MobilityCommand, Robot, Se2Trajectory, Se2TrajectoryPoint, TrajectoryFrame, VelocityCommand,
 };
@@ -73,7 +73,8 @@ fn a_point_cloud_decodes_to_the_points_the_fake_sent_and_a_sample_carries_its_fr
     let error = spot.next_sample().unwrap_err();
     assert!(
         matches!(&error, SpotError::MalformedCloud { source_name, problem }
-            if source_name == "velodyne-point-cloud" && problem.contains("1440 bytes of data for num_points = 121")),
+            if source_name == "velodyne-point-cloud"
+                && *problem == CloudProblem::DataSize { bytes: 1440, points: 121, needed: 1452 }),
         "{error:?}"
     );
 }
