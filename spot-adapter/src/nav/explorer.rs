@@ -69,7 +69,8 @@ pub struct FrontierDecision {
     pub chosen: Option<FrontierGoal>,
     /// Frontiers with a goal the robot can reach, not given up (the chosen one included).
     pub reachable: usize,
-    /// Frontiers with no reachable cell within [`ExplorerConfig::goal_reach`].
+    /// Frontiers with no reachable cell within [`ExplorerConfig::goal_reach`] of any of their
+    /// cells.
     pub unreachable: Vec<Frontier>,
     /// Frontiers whose goal lies where one was given up.
     pub given_up: usize,
@@ -130,10 +131,13 @@ impl Explorer {
         let mut candidates = Vec::new();
         let mut goal_cells = Vec::new();
         for frontier in frontiers {
-            let Some((goal_cell, cost)) = costs
-                .as_ref()
-                .and_then(|c| self.goal_of(blocked, c, frontier.middle))
-            else {
+            // A long frontier (a corridor's edge seen from its far end) may have its middle
+            // out on a strip of free cells the inflation cuts off: then the goal is the
+            // cheapest reachable cell near any of its cells, where the strip starts.
+            let Some((goal_cell, cost)) = costs.as_ref().and_then(|c| {
+                self.goal_of(blocked, c, frontier.middle)
+                    .or_else(|| self.goal_along(blocked, c, &frontier.cells))
+            }) else {
                 decision.unreachable.push(frontier);
                 continue;
             };
@@ -245,6 +249,39 @@ impl Explorer {
             }
         }
         best.map(|(_, cost, cell)| (cell, cost))
+    }
+
+    /// The reachable cell with the shortest walk within the goal reach of any of `cells` (every
+    /// third of them: the reach spans more), and the walk there.
+    fn goal_along(
+        &self,
+        blocked: &BitGrid,
+        costs: &TravelCosts,
+        cells: &[Cell],
+    ) -> Option<(Cell, f64)> {
+        let r = (self.config.goal_reach / blocked.geometry().resolution).ceil() as i64;
+        let r2 = r * r;
+        let mut best: Option<(f64, Cell)> = None;
+        for c in cells.iter().step_by(3).chain(cells.last()) {
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    if dx * dx + dy * dy > r2 {
+                        continue;
+                    }
+                    let (x, y) = (i64::from(c.x) + dx, i64::from(c.y) + dy);
+                    let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
+                        continue;
+                    };
+                    let cell = Cell::new(x, y);
+                    if let Some(cost) = costs.to(cell)
+                        && best.is_none_or(|(b, _)| cost < b)
+                    {
+                        best = Some((cost, cell));
+                    }
+                }
+            }
+        }
+        best.map(|(cost, cell)| (cell, cost))
     }
 
     /// Unknown area (square metres) a sensor at `middle` would see within sensor range: the

@@ -5,7 +5,11 @@ use crate::nav::NavError;
 /// How the explorer picks the next frontier among the reachable ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum FrontierChoice {
     /// Scraps before large areas: among the frontiers whose walk is at most `detour` metres
     /// longer than the nearest one's, the one that would reveal least (unknown area in sight
@@ -60,8 +64,10 @@ pub struct ExplorerConfig {
     /// What a frontier would reveal: the unknown cells in sight of its middle (rays stopped by
     /// the first occupied cell) within this distance, 4 m (a room, a stretch of corridor).
     pub sensor_range: f64,
-    /// A frontier's goal is the reachable cell nearest its middle within this distance, 1.5 m;
-    /// a frontier with none (beyond the hard inflation of a gap, say) is unreachable.
+    /// A frontier's goal is the reachable cell nearest its middle within this distance, 1.5 m,
+    /// or failing that the reachable cell with the shortest walk within it of any of its cells
+    /// (a long frontier's middle may lie out on a strip the inflation cuts off); a frontier
+    /// with neither (beyond the hard inflation of a gap, say) is unreachable.
     pub goal_reach: f64,
     /// The walk to a frontier is re-decided after this many new keyframes, 10 (2 m at the
     /// engine's 0.2 m gate): by then the map has grown and the frontier may be gone.
