@@ -54,6 +54,7 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "--frontier",
             "--max-scans",
             "--min-coverage",
+            "--start",
             "--building",
             "--registration",
             "--planner",
@@ -63,6 +64,8 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "information-gain",
             "greedy",
             "tour",
+            "corridor",
+            "anywhere",
             "office",
             "small",
             "p2plane",
@@ -241,6 +244,7 @@ fn mission_rejects_a_malformed_seed_and_goal() {
     rejected("mission", &["--min-coverage", "101"], "--min-coverage");
     // The exploration's options mean nothing on the scripted lap.
     rejected("mission", &["--lap", "--frontier", "greedy"], "--frontier");
+    rejected("mission", &["--lap", "--start", "anywhere"], "--start");
 }
 
 #[test]

@@ -74,10 +74,16 @@ pub(crate) struct Args {
     /// The exploration fails below this share of the reachable floor known free (percent).
     #[arg(long, value_name = "PERCENT", default_value_t = 95.0, value_parser = parse_percent, conflicts_with = "lap")]
     pub(crate) min_coverage: f64,
+    /// Where the exploration starts: a random spot of the corridor loop, or anywhere reachable
+    /// (rooms included; less reliable today: a room's scans of the corridor beyond its door
+    /// can leave phantom obstacles across it).
+    #[arg(long, value_enum, default_value_t = StartArea::Corridor, conflicts_with = "lap")]
+    pub(crate) start: StartArea,
     /// The generated building: `office` (a 34-44 m x 16-20 m corridor loop with rooms on both
-    /// sides), or `small` (a 10 m x 10 m loop, about 17 m x 17 m in all).
-    #[arg(long, value_enum, default_value_t = BuildingSize::Office)]
-    pub(crate) building: BuildingSize,
+    /// sides), or `small` (a 10 m x 10 m loop, about 17 m x 17 m in all) [default: small when
+    /// exploring, office with `--lap`].
+    #[arg(long, value_enum)]
+    pub(crate) building: Option<BuildingSize>,
     /// Odometry and loop refinement backend of the mapping.
     #[arg(long, value_enum, default_value_t = Registration::PointToPlane)]
     pub(crate) registration: Registration,
@@ -168,6 +174,15 @@ impl FrontierRule {
     }
 }
 
+/// `--start`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum StartArea {
+    /// A random spot on the corridor loop's centre line, facing a random way.
+    Corridor,
+    /// A random spot anywhere reachable, at least 0.6 m from every obstacle.
+    Anywhere,
+}
+
 /// `--building`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub(crate) enum BuildingSize {
@@ -178,6 +193,13 @@ pub(crate) enum BuildingSize {
 }
 
 impl BuildingSize {
+    /// `--building`, else the small building when exploring (the office takes the explorer over
+    /// 5 minutes and is not yet explored in full) and the office on the lap.
+    pub(crate) fn chosen(args: &Args) -> Self {
+        args.building
+            .unwrap_or(if args.lap { Self::Office } else { Self::Small })
+    }
+
     pub(crate) fn config(self) -> BuildingConfig {
         match self {
             Self::Office => BuildingConfig::default(),

@@ -13,6 +13,7 @@ use spot_adapter::pipelines::point_to_plane_tracker;
 use spot_adapter::sim::{Building, CommandedSpot, Route, RouteConfig, SimRng, floor_coverage};
 use spot_nav_examples::{Progress, evaluate, out};
 
+use crate::args::StartArea;
 use crate::legs::Frames;
 use crate::report::ExplorationSummary;
 
@@ -52,15 +53,24 @@ impl ExplorationSummary {
     }
 }
 
-/// A random spot of `building` (world frame) at least 0.6 m from every obstacle and reachable
-/// from the corridor loop's first corner (so not in a room shut off), and a random heading:
-/// drawn from a generator seeded by `seed`.
-pub(crate) fn random_start(building: &Building, seed: u64) -> Result<(Vector2<f64>, f64)> {
+/// A random spot (world frame) and heading drawn from a generator seeded by `seed`: on the
+/// corridor loop's centre line (`StartArea::Corridor`), or anywhere in `building` at least 0.6 m
+/// from every obstacle and reachable from the corridor loop's first corner
+/// (`StartArea::Anywhere`: rooms included, not a room shut off).
+pub(crate) fn random_start(
+    building: &Building,
+    area: StartArea,
+    seed: u64,
+) -> Result<(Vector2<f64>, f64)> {
     let mut rng = SimRng::new(seed, 0x57a7);
     let size = building.size();
+    let corridor = Route::corridor_loop(building);
     let corner = building.corridor_loop()[0];
     for _ in 0..100_000 {
-        let p = Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
+        let p = match area {
+            StartArea::Corridor => corridor.point_at(rng.range(0.0, corridor.length())),
+            StartArea::Anywhere => Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y)),
+        };
         if building.clearance(p) >= 0.6
             && Route::between(building, corner, p, &RouteConfig::default()).is_ok()
         {

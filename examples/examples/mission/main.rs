@@ -44,7 +44,7 @@ use spot_adapter::sim::{RouteConfig, SimulationConfig, shortest_length};
 use spot_nav_examples::picture::Overlay;
 use spot_nav_examples::{Timings, out, print_settings, value_name};
 
-use args::{Args, PlannerChoice, Settings};
+use args::{Args, BuildingSize, PlannerChoice, Settings};
 use legs::{leg, random_goals};
 use mapped::{Mapped, MappingSettings, by_exploring, by_lap};
 use reachable::ReachableCells;
@@ -94,7 +94,7 @@ fn mission(args: &Args) -> Result<()> {
         explorer_config.validate()?;
     }
     let config = SimulationConfig {
-        building: args.building.config(),
+        building: BuildingSize::chosen(args).config(),
         lidar,
         ..SimulationConfig::with_seed(seed)
     };
@@ -104,6 +104,7 @@ fn mission(args: &Args) -> Result<()> {
         navigator: &nav_config,
         explorer: &explorer_config,
         max_scans: args.max_scans,
+        start: args.start,
     };
     let Mapped {
         mut spot,
@@ -294,7 +295,7 @@ fn mission(args: &Args) -> Result<()> {
         planner: planner_name,
         kidnap: args.kidnap,
         mode: if args.lap { "lap" } else { "explore" },
-        building: value_name(&args.building),
+        building: value_name(&BuildingSize::chosen(args)),
         mapping: lap,
         exploration,
         obstacles,

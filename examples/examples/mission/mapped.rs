@@ -10,6 +10,7 @@ use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_place
 use spot_adapter::sim::{Building, CommandedSpot, SimulatedSpot, SimulationConfig};
 use spot_nav_examples::{Registration, out};
 
+use crate::args::StartArea;
 use crate::exploring::{explore_building, random_start};
 use crate::legs::Frames;
 use crate::mapping::map_building;
@@ -41,6 +42,8 @@ pub(crate) struct MappingSettings<'a> {
     pub(crate) navigator: &'a NavigatorConfig,
     pub(crate) explorer: &'a ExplorerConfig,
     pub(crate) max_scans: usize,
+    /// Where an exploration starts.
+    pub(crate) start: StartArea,
 }
 
 fn print_building(building: &Building, seed: u64) -> Result<()> {
@@ -100,7 +103,7 @@ pub(crate) fn by_exploring(
 ) -> Result<Mapped> {
     let building = Building::generate(config.seed, &config.building)?;
     print_building(&building, config.seed)?;
-    let (start, yaw) = random_start(&building, config.seed)?;
+    let (start, yaw) = random_start(&building, settings.start, config.seed)?;
     let mut spot = CommandedSpot::new(building, start, yaw, config)?;
     // The engine's map frame is the odometry frame, which starts at the body's start pose.
     let frames = Frames {
