@@ -180,24 +180,7 @@ pub(crate) fn explore_building<R: MapRegistrator, C: MapRegistrator, O: Optimize
         collisions: spot.collisions(),
         seconds,
     };
-    out!(
-        "exploration {}: {:.1} % of {:.0} m² of reachable floor known free; {:.1} m walked in {} scans, {} keyframes, {} loops closed; ATE {:.3} m; {} decisions ({:.0} ms mean), {:.1} ms mean per scan; {} frontiers given up, {} unreachable left; {} collisions; {:.1} s",
-        summary.outcome,
-        100.0 * summary.coverage,
-        summary.reachable_floor_m2,
-        summary.walked_m,
-        summary.scans,
-        summary.keyframes,
-        summary.loops_closed,
-        summary.ate_m,
-        summary.decisions,
-        summary.decision_ms_mean,
-        summary.cycle_ms_mean,
-        summary.frontiers_given_up.len(),
-        summary.frontiers_unreachable,
-        summary.collisions,
-        summary.seconds
-    )?;
+    print_exploration(&summary)?;
     Ok(Explored {
         map: slam.map(0.05)?,
         navigation: report.navigation,
@@ -206,6 +189,28 @@ pub(crate) fn explore_building<R: MapRegistrator, C: MapRegistrator, O: Optimize
         trajectories: (estimate, truth_map),
         frontiers_left,
     })
+}
+
+/// The exploration's line of figures.
+fn print_exploration(s: &ExplorationSummary) -> Result<()> {
+    out!(
+        "exploration {}: {:.1} % of {:.0} m² of reachable floor known free; {:.1} m walked in {} scans, {} keyframes, {} loops closed; ATE {:.3} m; {} decisions ({:.0} ms mean), {:.1} ms mean per scan; {} frontiers given up, {} unreachable left; {} collisions; {:.1} s",
+        s.outcome,
+        100.0 * s.coverage,
+        s.reachable_floor_m2,
+        s.walked_m,
+        s.scans,
+        s.keyframes,
+        s.loops_closed,
+        s.ate_m,
+        s.decisions,
+        s.decision_ms_mean,
+        s.cycle_ms_mean,
+        s.frontiers_given_up.len(),
+        s.frontiers_unreachable,
+        s.collisions,
+        s.seconds
+    )
 }
 
 fn mean(values: &[f64]) -> f64 {
