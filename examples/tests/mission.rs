@@ -17,9 +17,8 @@ fn run(args: &[&str]) -> Output {
         .expect("mission runs")
 }
 
-/// About 15 s in release on 2 shared cores (11 s of CPU): the exploration walks about 110 m
-/// from a room (`--start anywhere`: seed 11's start from the corridor walks farther, 125-170
-/// m).
+/// About 15 s in release on 2 cores (15 s of CPU): the exploration walks about 140 m from a
+/// room (`--start anywhere`; from seed 11's corridor start it walks 175 m, 19 s of CPU).
 #[test]
 fn explores_the_small_building_then_reaches_its_goals() {
     let dir = std::env::temp_dir().join(format!("spot_nav_mission_explore_{}", std::process::id()));

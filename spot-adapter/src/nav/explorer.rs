@@ -120,6 +120,7 @@ impl Explorer {
         let blocked = planning.blocked();
         let frontiers = find_frontiers(occupancy, self.config.min_frontier_cells);
         let start = nearest_free(blocked, position, self.config.goal_reach);
+        let resolution = blocked.geometry().resolution;
         let costs = start.map(|s| TravelCosts::from_start(blocked, s));
         let mut decision = FrontierDecision {
             chosen: None,
@@ -133,10 +134,15 @@ impl Explorer {
         for frontier in frontiers {
             // A long frontier (a corridor's edge seen from its far end) may have its middle
             // out on a strip of free cells the inflation cuts off: then the goal is the
-            // cheapest reachable cell near any of its cells, where the strip starts.
+            // cheapest reachable cell near any of its cells, where the strip starts. Not for
+            // short ones: those are gaps the robot cannot pass, and walking to them only to
+            // give them up made the small buildings' explorations 20 % longer.
+            let long = frontier.size() as f64 * resolution >= 2.0 * self.config.sensor_range;
             let Some((goal_cell, cost)) = costs.as_ref().and_then(|c| {
-                self.goal_of(blocked, c, frontier.middle)
-                    .or_else(|| self.goal_along(blocked, c, &frontier.cells))
+                self.goal_of(blocked, c, frontier.middle).or_else(|| {
+                    long.then(|| self.goal_along(blocked, c, &frontier.cells))
+                        .flatten()
+                })
             }) else {
                 decision.unreachable.push(frontier);
                 continue;
