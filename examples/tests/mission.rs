@@ -17,8 +17,8 @@ fn run(args: &[&str]) -> Output {
         .expect("mission runs")
 }
 
-/// About 15 s in release on 2 cores (15 s of CPU): the exploration walks about 140 m from a
-/// room (`--start anywhere`; from seed 11's corridor start it walks 175 m, 19 s of CPU).
+/// About 16 s in release on 2 cores (16 s of CPU): the exploration walks 140 m from a room
+/// (`--start anywhere`; from seed 11's corridor start it walks farther).
 #[test]
 fn explores_the_small_building_then_reaches_its_goals() {
     let dir = std::env::temp_dir().join(format!("spot_nav_mission_explore_{}", std::process::id()));

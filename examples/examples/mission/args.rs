@@ -193,8 +193,9 @@ pub(crate) enum BuildingSize {
 }
 
 impl BuildingSize {
-    /// `--building`, else the small building when exploring (the office takes the explorer over
-    /// 5 minutes and is not yet explored in full) and the office on the lap.
+    /// `--building`, else the small building when exploring (the explorer does not yet cover
+    /// the office: it stops at 60 % with the long edges of corridors left unreachable) and the
+    /// office on the lap.
     pub(crate) fn chosen(args: &Args) -> Self {
         args.building
             .unwrap_or(if args.lap { Self::Office } else { Self::Small })

@@ -69,8 +69,7 @@ pub struct FrontierDecision {
     pub chosen: Option<FrontierGoal>,
     /// Frontiers with a goal the robot can reach, not given up (the chosen one included).
     pub reachable: usize,
-    /// Frontiers with no reachable cell within [`ExplorerConfig::goal_reach`] of any of their
-    /// cells.
+    /// Frontiers with no reachable cell within [`ExplorerConfig::goal_reach`].
     pub unreachable: Vec<Frontier>,
     /// Frontiers whose goal lies where one was given up.
     pub given_up: usize,
@@ -120,7 +119,6 @@ impl Explorer {
         let blocked = planning.blocked();
         let frontiers = find_frontiers(occupancy, self.config.min_frontier_cells);
         let start = nearest_free(blocked, position, self.config.goal_reach);
-        let resolution = blocked.geometry().resolution;
         let costs = start.map(|s| TravelCosts::from_start(blocked, s));
         let mut decision = FrontierDecision {
             chosen: None,
@@ -132,18 +130,10 @@ impl Explorer {
         let mut candidates = Vec::new();
         let mut goal_cells = Vec::new();
         for frontier in frontiers {
-            // A long frontier (a corridor's edge seen from its far end) may have its middle
-            // out on a strip of free cells the inflation cuts off: then the goal is the
-            // cheapest reachable cell near any of its cells, where the strip starts. Not for
-            // short ones: those are gaps the robot cannot pass, and walking to them only to
-            // give them up made the small buildings' explorations 20 % longer.
-            let long = frontier.size() as f64 * resolution >= 2.0 * self.config.sensor_range;
-            let Some((goal_cell, cost)) = costs.as_ref().and_then(|c| {
-                self.goal_of(blocked, c, frontier.middle).or_else(|| {
-                    long.then(|| self.goal_along(blocked, c, &frontier.cells))
-                        .flatten()
-                })
-            }) else {
+            let Some((goal_cell, cost)) = costs
+                .as_ref()
+                .and_then(|c| self.goal_of(blocked, c, frontier.middle))
+            else {
                 decision.unreachable.push(frontier);
                 continue;
             };
@@ -255,39 +245,6 @@ impl Explorer {
             }
         }
         best.map(|(_, cost, cell)| (cell, cost))
-    }
-
-    /// The reachable cell with the shortest walk within the goal reach of any of `cells` (every
-    /// third of them: the reach spans more), and the walk there.
-    fn goal_along(
-        &self,
-        blocked: &BitGrid,
-        costs: &TravelCosts,
-        cells: &[Cell],
-    ) -> Option<(Cell, f64)> {
-        let r = (self.config.goal_reach / blocked.geometry().resolution).ceil() as i64;
-        let r2 = r * r;
-        let mut best: Option<(f64, Cell)> = None;
-        for c in cells.iter().step_by(3).chain(cells.last()) {
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx * dx + dy * dy > r2 {
-                        continue;
-                    }
-                    let (x, y) = (i64::from(c.x) + dx, i64::from(c.y) + dy);
-                    let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
-                        continue;
-                    };
-                    let cell = Cell::new(x, y);
-                    if let Some(cost) = costs.to(cell)
-                        && best.is_none_or(|(b, _)| cost < b)
-                    {
-                        best = Some((cost, cell));
-                    }
-                }
-            }
-        }
-        best.map(|(cost, cell)| (cell, cost))
     }
 
     /// Unknown area (square metres) a sensor at `middle` would see within sensor range: the
