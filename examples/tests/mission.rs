@@ -2,7 +2,8 @@
 //! exploration test (seed 11, `BuildingConfig::small`) with a quarter of the LiDAR's columns,
 //! it explores from a random spot to full coverage, then reaches its goals on the map it built;
 //! `summary.json` and the picture are written. Bad explorer settings are refused by name before
-//! anything is simulated. (`--lap` is run by no test: about 30 s on the office building.)
+//! anything is simulated. `--lap` maps the small building in its scripted lap, then reaches its
+//! goals (4 s; on the office building, the lap's default, about 30 s).
 #![allow(clippy::expect_used, clippy::panic)]
 
 use std::process::{Command, Output};
@@ -68,6 +69,40 @@ fn explores_the_small_building_then_reaches_its_goals() {
     assert_eq!(summary["reached"], 2, "{summary}");
     assert_eq!(summary["collisions"], 0, "{summary}");
     assert!(out_dir.join("grid.png").is_file());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// About 4 s in release: a 40 m lap, then two legs.
+#[test]
+fn the_lap_maps_the_small_building_then_reaches_its_goals() {
+    let dir = std::env::temp_dir().join(format!("spot_nav_mission_lap_{}", std::process::id()));
+    let out = run(&[
+        "--lap",
+        "--building",
+        "small",
+        "--goals",
+        "2",
+        "--out",
+        dir.to_str().expect("UTF-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("summary.json")).expect("summary.json"),
+    )
+    .expect("JSON");
+    assert_eq!(summary["mode"], "lap");
+    assert!(
+        summary.get("exploration").is_none(),
+        "no exploration: {summary}"
+    );
+    assert!(
+        summary["mapping"]["ate_m"].as_f64().expect("ATE") < 0.05,
+        "{summary}"
+    );
+    assert_eq!(summary["reached"], 2, "{summary}");
+    assert_eq!(summary["collisions"], 0, "{summary}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
