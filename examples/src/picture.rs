@@ -1,6 +1,6 @@
 //! The mission's picture: the occupancy grid with its inflated obstacles, the start, the goals,
-//! the planned and walked paths and the obstacles dropped after mapping, with a scale bar and a
-//! legend. Lines and boxes are drawn with `imageproc`, labels in the 8x8 bitmap font of
+//! the exploration's path and the frontiers it left, the planned and walked paths and the
+//! obstacles dropped after mapping, with a scale bar and a legend. Lines and boxes are drawn with `imageproc`, labels in the 8x8 bitmap font of
 //! `font8x8` (no font file needed).
 
 use std::path::Path;
@@ -20,13 +20,19 @@ const GOAL: Rgb<u8> = Rgb([220, 0, 0]);
 const PLANNED: Rgb<u8> = Rgb([40, 90, 255]);
 const WALKED: Rgb<u8> = Rgb([0, 170, 80]);
 const OBSTACLE: Rgb<u8> = Rgb([200, 0, 200]);
+const EXPLORED: Rgb<u8> = Rgb([150, 100, 40]);
+const FRONTIER: Rgb<u8> = Rgb([0, 190, 255]);
 const TEXT: Rgb<u8> = Rgb([0, 0, 0]);
 
 /// What is drawn over the grid, in map-frame metres.
 #[derive(Clone, Debug, Default)]
 pub struct Overlay {
-    /// Where the robot started navigating.
+    /// Where the robot started (exploring, or navigating after a lap).
     pub start: Option<Vector2<f64>>,
+    /// The exploration's path (ground truth, in the map frame); empty after a lap.
+    pub explored: Vec<Vector2<f64>>,
+    /// Centres of the frontier cells (known free next to unknown) left on the map.
+    pub frontiers: Vec<Vector2<f64>>,
     /// The goals in the order visited.
     pub goals: Vec<Vector2<f64>>,
     /// Each leg's first planned path (waypoints from the robot to the goal).
@@ -46,8 +52,8 @@ pub fn draw(grid: &OccupancyGrid, inflated: &BitGrid, overlay: &Overlay) -> RgbI
     let base = render(grid, Some(inflated), &[], &[]);
     let (w, h) = (base.width() * SCALE, base.height() * SCALE);
     let base = imageops::resize(&base, w, h, imageops::FilterType::Nearest);
-    let legend_height = 6 * 12 + 8;
-    let mut img = RgbImage::from_pixel(w.max(360), h + legend_height, Rgb([255, 255, 255]));
+    let legend_height = (LEGEND_ROWS + 1) * 12 + 8;
+    let mut img = RgbImage::from_pixel(w.max(640), h + legend_height, Rgb([255, 255, 255]));
     imageops::overlay(&mut img, &base, 0, 0);
     let geo = *grid.geometry();
     let rows = grid.height();
@@ -56,6 +62,14 @@ pub fn draw(grid: &OccupancyGrid, inflated: &BitGrid, overlay: &Overlay) -> RgbI
         let y = (f64::from(rows) - (p.y - geo.origin.y) / geo.resolution) * f64::from(SCALE);
         (x as f32, y as f32)
     };
+    for w in overlay.explored.windows(2) {
+        draw_line_segment_mut(&mut img, px(w[0]), px(w[1]), EXPLORED);
+    }
+    for &f in &overlay.frontiers {
+        let (x, y) = px(f);
+        let rect = Rect::at(x as i32 - 1, y as i32 - 1).of_size(SCALE, SCALE);
+        draw_filled_rect_mut(&mut img, rect, FRONTIER);
+    }
     for path in &overlay.planned {
         for w in path.windows(2) {
             draw_line_segment_mut(&mut img, px(w[0]), px(w[1]), PLANNED);
@@ -109,9 +123,12 @@ pub fn write_png(
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// Rows of the legend's columns.
+const LEGEND_ROWS: u32 = 6;
+
 /// The legend (a swatch and a label per entry) and a 5 m scale bar, from row `top`.
 fn legend(img: &mut RgbImage, top: u32, resolution: f64) {
-    let entries: [(Rgb<u8>, &str); 9] = [
+    let entries: [(Rgb<u8>, &str); 11] = [
         (Rgb(gridmap::colours::FREE), "free"),
         (Rgb(gridmap::colours::OCCUPIED), "occupied"),
         (
@@ -119,6 +136,8 @@ fn legend(img: &mut RgbImage, top: u32, resolution: f64) {
             "inflated (robot does not fit)",
         ),
         (Rgb(gridmap::colours::UNKNOWN), "unknown"),
+        (EXPLORED, "explored path (ground truth)"),
+        (FRONTIER, "frontiers left"),
         (PLANNED, "planned path (first plan of each leg)"),
         (WALKED, "walked path (ground truth)"),
         (START, "start"),
@@ -126,8 +145,9 @@ fn legend(img: &mut RgbImage, top: u32, resolution: f64) {
         (OBSTACLE, "obstacles dropped after mapping"),
     ];
     for (k, (colour, label)) in entries.iter().enumerate() {
-        let column = (k / 5) as i32 * 300;
-        let y = top as i32 + (k % 5) as i32 * 12;
+        let rows = LEGEND_ROWS as usize;
+        let column = (k / rows) as i32 * 300;
+        let y = top as i32 + (k % rows) as i32 * 12;
         let swatch = Rect::at(column + 4, y).of_size(10, 10);
         draw_filled_rect_mut(img, swatch, *colour);
         draw_hollow_rect_mut(img, swatch, TEXT);
@@ -135,7 +155,7 @@ fn legend(img: &mut RgbImage, top: u32, resolution: f64) {
     }
     // Scale bar: 5 m.
     let length = (5.0 / resolution * f64::from(SCALE)) as i32;
-    let y = top as i32 + 5 * 12 + 2;
+    let y = (top + LEGEND_ROWS * 12 + 2) as i32;
     let bar = Rect::at(4, y).of_size(length.max(1) as u32, 4);
     draw_filled_rect_mut(img, bar, TEXT);
     text(img, length + 10, y - 2, "5 m", TEXT);

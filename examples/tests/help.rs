@@ -50,11 +50,24 @@ const EXAMPLES: [(&str, &[&str]); 9] = [
             "--goal",
             "--obstacles",
             "--kidnap",
+            "--lap",
+            "--frontier",
+            "--max-scans",
+            "--min-coverage",
+            "--start",
+            "--building",
             "--registration",
             "--planner",
             "--out",
             "--config",
             "--print-config",
+            "information-gain",
+            "greedy",
+            "tour",
+            "corridor",
+            "anywhere",
+            "office",
+            "small",
             "p2plane",
             "loam",
             "cost-aware",
@@ -226,6 +239,12 @@ fn mission_rejects_a_malformed_seed_and_goal() {
     rejected("mission", &["--goal", "nan,nan"], "--goal");
     rejected("mission", &["--kidnap", "0.5"], "--kidnap");
     rejected("mission", &["--goals", "-1"], "--goals");
+    rejected("mission", &["--frontier", "nearest"], "--frontier");
+    rejected("mission", &["--building", "huge"], "--building");
+    rejected("mission", &["--min-coverage", "101"], "--min-coverage");
+    // The exploration's options mean nothing on the scripted lap.
+    rejected("mission", &["--lap", "--frontier", "greedy"], "--frontier");
+    rejected("mission", &["--lap", "--start", "anywhere"], "--start");
 }
 
 #[test]

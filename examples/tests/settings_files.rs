@@ -224,7 +224,10 @@ fn slam_settings_round_trip_take_effect_and_yield_to_options() {
 
 #[test]
 fn mission_settings_round_trip_take_effect_and_yield_to_options() {
-    round_trip("mission", &["slam", "navigator", "navigator.grid"]);
+    round_trip(
+        "mission",
+        &["slam", "navigator", "navigator.grid", "explorer", "lidar"],
+    );
     let dir = scratch("mission_effect");
     let path = write(
         &dir,
@@ -252,6 +255,34 @@ fn mission_settings_round_trip_take_effect_and_yield_to_options() {
         &["--config", &path, "--planner", "astar", "--print-config"],
     );
     assert_eq!(value(&printed, "navigator.planner").as_str(), Some("AStar"));
+    // The frontier rule: `--frontier` wins over the file, and keeps the file's margin when it
+    // names the same rule.
+    let path = write(
+        &dir,
+        "explorer.toml",
+        "[explorer]\nchoice = { kind = \"Tour\", keep_margin = 3.0 }\n",
+    );
+    let printed = stdout_of("mission", &["--config", &path, "--print-config"]);
+    assert_eq!(
+        value(&printed, "explorer.choice.keep_margin").as_float(),
+        Some(3.0)
+    );
+    let printed = stdout_of(
+        "mission",
+        &["--config", &path, "--frontier", "tour", "--print-config"],
+    );
+    assert_eq!(
+        value(&printed, "explorer.choice.keep_margin").as_float(),
+        Some(3.0)
+    );
+    let printed = stdout_of(
+        "mission",
+        &["--config", &path, "--frontier", "greedy", "--print-config"],
+    );
+    assert_eq!(
+        value(&printed, "explorer.choice.kind").as_str(),
+        Some("GreedyNearestFrontier")
+    );
     std::fs::remove_dir_all(&dir).ok();
     bad_fields(
         "mission",

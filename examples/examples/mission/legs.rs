@@ -11,8 +11,8 @@ use spot_nav_examples::Progress;
 /// Scans a leg may take before the robot gives up (5 minutes at 5 Hz).
 pub(crate) const MAX_CYCLES: usize = 1500;
 
-/// The world and map frames of the run: the map frame is the odometry frame of the lap, which
-/// starts at the first body pose.
+/// The world and map frames of the run: the map frame is the odometry frame of the mapping
+/// (lap or exploration), which starts at the first body pose.
 pub(crate) struct Frames {
     pub(crate) world_t_map: Pose3,
 }
@@ -30,14 +30,20 @@ impl Frames {
 }
 
 /// `count` goals in the building (world frame): at least 0.6 m from every obstacle, in space
-/// the lap saw (a floor point of the map within 0.25 m, free on the planning `grid`), at least
-/// 5 m from the one before and reachable from it with Spot's clearance.
+/// the mapping saw (a floor point of the map within 0.25 m, free on the planning `grid`, and
+/// `on_map` at its map-frame position), at least 5 m from the one before (the first from
+/// `start`) and reachable from it with Spot's clearance on the true floor plan (the first from
+/// `route_start`: where the robot stands may lie closer to a wall than that clearance, after an
+/// exploration, and any place the robot reached is connected to where it started).
+#[allow(clippy::too_many_arguments)] // Each is one thing a goal is checked against.
 pub(crate) fn random_goals(
     building: &Building,
     map: &PointCloud,
     grid: &slam_core::BitGrid,
+    on_map: impl Fn(Vector2<f64>) -> bool,
     frames: &Frames,
     start: Vector2<f64>,
+    route_start: Vector2<f64>,
     count: usize,
     seed: u64,
 ) -> Result<Vec<Vector2<f64>>> {
@@ -57,16 +63,16 @@ pub(crate) fn random_goals(
         if goals.len() == count {
             return Ok(goals);
         }
-        let from = goals.last().copied().unwrap_or(start);
+        let (from, route_from) = goals.last().map_or((start, route_start), |&g| (g, g));
         let p = Vector2::new(rng.range(0.0, size.x), rng.range(0.0, size.y));
-        let free_on_map = grid
-            .cell_at(frames.to_map(p))
-            .is_some_and(|c| !grid.is_blocked(c));
+        let on_grid = frames.to_map(p);
+        let free_on_map = grid.cell_at(on_grid).is_some_and(|c| !grid.is_blocked(c));
         if seen.contains(&key(p))
             && free_on_map
+            && on_map(on_grid)
             && building.clearance(p) >= 0.6
             && (p - from).norm() >= 5.0
-            && Route::between(building, from, p, &RouteConfig::default()).is_ok()
+            && Route::between(building, route_from, p, &RouteConfig::default()).is_ok()
         {
             goals.push(p);
         }

@@ -1,44 +1,53 @@
 //! The main job, on a simulated Spot: map an unknown building, then walk to goals in it with no
 //! recorded route, around obstacles dropped after mapping.
 //!
-//! 1. Mapping: Spot walks one lap of the generated building's corridor loop while the Graph-SLAM
-//!    engine maps it (point-to-plane ICP or LOAM odometry, loop closure, Levenberg-Marquardt).
-//! 2. Navigation: from where the lap ended, the `Navigator` walks the robot (a `CommandedSpot`
-//!    that moves only as commanded, with drifting odometry) to each goal in turn: each scan it
-//!    localises against the map, replans on the map's inflated occupancy grid and follows the
-//!    filtered waypoints. Boxes are dropped on the routes of some legs after mapping.
+//! 1. Mapping, by default by exploring: Spot starts at a random reachable spot (seeded by
+//!    `--seed`) with no map and no route; the Graph-SLAM engine maps live while the explorer
+//!    sends the navigator from frontier to frontier (`--frontier`: information gain, greedy or
+//!    tour) until no reachable frontier is left. With `--lap`, Spot walks one scripted lap of
+//!    the building's corridor loop instead (a route from the true floor plan) while the engine
+//!    maps it (point-to-plane ICP or LOAM odometry, loop closure, Levenberg-Marquardt).
+//! 2. Navigation: from where the mapping ended, the `Navigator` walks the robot (a
+//!    `CommandedSpot` that moves only as commanded, with drifting odometry) to each goal in
+//!    turn: each scan it localises against the map, replans on the map's inflated occupancy
+//!    grid and follows the filtered waypoints. Random goals lie where the mapping saw free floor
+//!    the robot can reach (after an exploration: rooms included). Boxes are dropped on the
+//!    routes of some legs after mapping.
 //!
-//! Prints the mapping accuracy and each leg's result against the simulator's ground truth and
-//! writes them to `--out` (default `mission-out/`): `map.ply`, `grid.png`, `map.yaml` +
-//! `map.pgm` (ROS `map_server`), `estimate.tum` and `ground_truth.tum` (body poses in the map
-//! frame), `summary.json`. Exits with status 1 when a goal was not reached.
+//! Prints the mapping's figures (coverage of the reachable floor, distance, loops, ATE) and
+//! each leg's result against the simulator's ground truth and writes them to `--out` (default
+//! `mission-out/`): `map.ply`, `grid.png`, `map.yaml` + `map.pgm` (ROS `map_server`),
+//! `estimate.tum` and `ground_truth.tum` (body poses in the map frame), `summary.json`. Exits
+//! with status 1 when the exploration fell short of `--min-coverage` or collided, or a goal was
+//! not reached.
 
 mod args;
+mod exploring;
 mod legs;
+mod mapped;
 mod mapping;
+mod reachable;
 mod report;
 
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Parser;
+use gridmap::CellState;
 use nalgebra::{Translation3, UnitQuaternion, Vector2};
-use slam_core::Pose3;
+use slam_core::{Cell, Pose3};
 use spot_adapter::nav::{DriveOutcome, Navigator, PlannerKind};
-use spot_adapter::pipelines::{
-    loam_slam, point_to_plane_localiser, point_to_plane_slam, scan_context_places,
-};
+use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::Robot;
-use spot_adapter::sim::{
-    CommandedSpot, RouteConfig, SimulatedSpot, SimulationConfig, shortest_length,
-};
+use spot_adapter::sim::{RouteConfig, SimulationConfig, shortest_length};
 use spot_nav_examples::picture::Overlay;
-use spot_nav_examples::{Registration, Timings, out, print_settings, value_name};
+use spot_nav_examples::{Timings, out, print_settings, value_name};
 
-use args::{Args, PlannerChoice, Settings};
-use legs::{Frames, leg, random_goals};
-use mapping::map_building;
+use args::{Args, BuildingSize, PlannerChoice, Settings};
+use legs::{leg, random_goals};
+use mapped::{Mapped, MappingSettings, by_exploring, by_lap};
+use reachable::ReachableCells;
 use report::{LegSummary, Summary, write_outputs};
 
 /// A goal counts as reached within this distance of the true body (metres).
@@ -59,12 +68,17 @@ fn mission(args: &Args) -> Result<()> {
             PlannerChoice::Astar => PlannerKind::AStar,
         };
     }
+    if let Some(rule) = args.frontier {
+        settings.explorer.choice = rule.apply(settings.explorer.choice);
+    }
     if let Some(format) = args.settings.print_config {
         return print_settings(&settings, format);
     }
     let Settings {
         slam: slam_settings,
         navigator: nav_config,
+        explorer: explorer_config,
+        lidar,
     } = settings;
     let planner_name = match nav_config.planner {
         PlannerKind::CellCostAStar => value_name(&PlannerChoice::CostAware),
@@ -75,43 +89,44 @@ fn mission(args: &Args) -> Result<()> {
     if args.goal.is_empty() && args.goals == 0 {
         bail!("--goals 0 and no --goal: nothing to visit");
     }
-    let config = SimulationConfig::with_seed(seed);
-    let sim = SimulatedSpot::corridor_loop(&config)?;
-    let mut building = sim.building().clone();
-    let truth = sim.ground_truth();
-    let frames = Frames {
-        world_t_map: truth.first().context("empty lap")?.pose,
+    // Before anything is simulated: bad explorer settings are refused by name.
+    if !args.lap {
+        explorer_config.validate()?;
+    }
+    let config = SimulationConfig {
+        building: BuildingSize::chosen(args).config(),
+        lidar,
+        ..SimulationConfig::with_seed(seed)
     };
-    let lap_end = truth.last().context("empty lap")?.pose;
-    out!(
-        "building    seed {seed}: {:.1} x {:.1} m, {} rooms",
-        building.size().x,
-        building.size().y,
-        building.rooms().len()
-    )?;
-    let mapped = match args.registration {
-        // Loops by position and by appearance, as the slam example seeks them.
-        Registration::PointToPlane => map_building(
-            point_to_plane_slam(slam_settings)?.with_place_recognizer(scan_context_places()),
-            sim,
-            &nav_config.map_config(),
-        )?,
-        Registration::Loam => map_building(
-            loam_slam(slam_settings)?.with_place_recognizer(scan_context_places()),
-            sim,
-            &nav_config.map_config(),
-        )?,
+    let mapping = MappingSettings {
+        registration: args.registration,
+        slam: slam_settings,
+        navigator: &nav_config,
+        explorer: &explorer_config,
+        max_scans: args.max_scans,
+        start: args.start,
     };
-
-    let start = lap_end.translation.vector.xy();
-    let mut spot = CommandedSpot::new(
-        building.clone(),
+    let Mapped {
+        mut spot,
+        frames,
+        map,
+        navigation,
+        map_t_body,
         start,
-        lap_end.rotation.euler_angles().2,
-        &config,
-    )?;
-    // The map frame's origin is the body at the lap's start: the LiDAR sits its mounting height
-    // above it.
+        mut trajectories,
+        frontiers_left,
+        lap,
+        exploration,
+    } = if args.lap {
+        by_lap(&config, mapping)?
+    } else {
+        by_exploring(&config, mapping)?
+    };
+    let mut building = spot.building().clone();
+    let exploration_failure = exploration
+        .as_ref()
+        .and_then(|e| e.failure(args.min_coverage / 100.0));
+
     // What the legs' shortest ways are measured at: the navigator's inflation and cells.
     let (inflation, resolution) = (nav_config.planning.inflation, nav_config.grid.resolution);
     let started = Instant::now();
@@ -126,9 +141,9 @@ fn mission(args: &Args) -> Result<()> {
         });
     let mut nav = Navigator::new(
         point_to_plane_localiser(),
-        &mapped.map,
-        &mapped.navigation,
-        mapped.map_t_body * kidnap,
+        &map,
+        &navigation,
+        map_t_body * kidnap,
         spot.description(),
         nav_config,
     )?;
@@ -141,14 +156,31 @@ fn mission(args: &Args) -> Result<()> {
         started.elapsed().as_secs_f64()
     )?;
 
-    // Goals (world frame) from where the lap ended.
-    let goals_world: Vec<Vector2<f64>> = if args.goal.is_empty() {
+    // Goals (world frame) from where the mapping ended; none when the exploration failed.
+    let here = spot.position();
+    let goals_world: Vec<Vector2<f64>> = if exploration_failure.is_some() {
+        Vec::new()
+    } else if args.goal.is_empty() {
+        // After an exploration: only where it mapped free floor that the robot can reach on
+        // the map, never in unknown space (the lap's goals keep today's draws).
+        let reachable = ReachableCells::from(nav.grid(), map_t_body.translation.vector.xy());
+        let occupancy = navigation.occupancy();
+        let explored = |p: Vector2<f64>| {
+            args.lap
+                || (reachable.contains(p) && {
+                    let (x, y) = occupancy.geometry().cell_coords(p);
+                    matches!((u32::try_from(x), u32::try_from(y)), (Ok(x), Ok(y))
+                        if occupancy.state(Cell::new(x, y)) == CellState::Free)
+                })
+        };
         random_goals(
             &building,
-            &mapped.map,
+            &map,
             nav.grid(),
+            explored,
             &frames,
-            start,
+            here,
+            if args.lap { here } else { start },
             args.goals,
             seed,
         )?
@@ -161,12 +193,18 @@ fn mission(args: &Args) -> Result<()> {
         .map(|k| 1 + k * (goals.len() - 1) / args.obstacles.max(1))
         .collect();
 
-    let mut trajectories = (Vec::new(), Vec::new());
     let mut overlay = Overlay {
         start: Some(frames.to_map(start)),
+        explored: trajectories
+            .1
+            .iter()
+            .map(|p| p.pose.translation.vector.xy())
+            .collect(),
+        frontiers: frontiers_left,
         goals: goals.clone(),
         ..Overlay::default()
     };
+    let explored_scans = trajectories.1.len();
     let mut legs = Vec::new();
     let mut obstacles = Vec::new();
     for (k, (&goal, &goal_world)) in goals.iter().zip(&goals_world).enumerate() {
@@ -244,8 +282,7 @@ fn mission(args: &Args) -> Result<()> {
         overlay.planned.push(walk.planned);
         legs.push(summary);
     }
-    overlay.walked = trajectories
-        .1
+    overlay.walked = trajectories.1[explored_scans.saturating_sub(1)..]
         .iter()
         .map(|p| p.pose.translation.vector.xy())
         .collect();
@@ -257,7 +294,10 @@ fn mission(args: &Args) -> Result<()> {
         registration: value_name(&args.registration),
         planner: planner_name,
         kidnap: args.kidnap,
-        mapping: mapped.summary.clone(),
+        mode: if args.lap { "lap" } else { "explore" },
+        building: value_name(&BuildingSize::chosen(args)),
+        mapping: lap,
+        exploration,
         obstacles,
         goals: legs,
         reached,
@@ -265,13 +305,16 @@ fn mission(args: &Args) -> Result<()> {
     };
     write_outputs(
         &args.out,
-        &mapped.map,
-        mapped.navigation.occupancy(),
+        &map,
+        navigation.occupancy(),
         nav.grid(),
         &overlay,
         &trajectories,
         &summary,
     )?;
+    if let Some(failure) = exploration_failure {
+        bail!("{failure}");
+    }
     out!(
         "result      {reached} of {} goals reached within {REACHED_WITHIN} m, {collisions} collisions",
         summary.goals.len()

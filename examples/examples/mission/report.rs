@@ -9,7 +9,7 @@ use slam_core::io::{PlyEncoding, StampedPose, write_ply, write_tum};
 use spot_nav_examples::out;
 use spot_nav_examples::picture::{self, Overlay};
 
-/// The mapping lap's figures (`summary.json`'s `mapping`).
+/// The mapping lap's figures (`summary.json`'s `mapping`, with `--lap`).
 #[derive(Clone, Debug, Serialize)]
 pub(crate) struct MappingSummary {
     pub(crate) scans: usize,
@@ -20,6 +20,44 @@ pub(crate) struct MappingSummary {
     pub(crate) loop_end_point_error_m: f64,
     pub(crate) segment_drift_percent: Option<f64>,
     pub(crate) mean_ms_per_scan: f64,
+    pub(crate) seconds: f64,
+}
+
+/// The exploration's figures (`summary.json`'s `exploration`).
+#[derive(Clone, Debug, Serialize)]
+pub(crate) struct ExplorationSummary {
+    /// `complete` (no reachable frontier left) or `gave_up` (the scan budget ran out).
+    pub(crate) outcome: &'static str,
+    /// `information-gain`, `greedy` or `tour`.
+    pub(crate) frontier_rule: String,
+    /// Where the robot started (world frame, metres).
+    pub(crate) start: [f64; 2],
+    /// Share of the reachable floor (free at the navigator's inflation, connected to the
+    /// start, on the simulator's floor plan) that the final grid knows free.
+    pub(crate) coverage: f64,
+    pub(crate) reachable_floor_m2: f64,
+    /// Walked by the ground truth.
+    pub(crate) walked_m: f64,
+    /// Walked by the engine's estimate.
+    pub(crate) estimated_walked_m: f64,
+    pub(crate) scans: usize,
+    pub(crate) keyframes: usize,
+    pub(crate) loops_closed: usize,
+    /// Of the body trajectory (optimised, every scan) after the best rigid alignment.
+    pub(crate) ate_m: f64,
+    /// Frontier decisions (a map rendered, a frontier picked, a navigator made).
+    pub(crate) decisions: usize,
+    pub(crate) decision_ms_mean: f64,
+    /// The engine and the navigator on one scan, the decisions apart.
+    pub(crate) cycle_ms_mean: f64,
+    /// Why each frontier given up was (`no_path`, `blocked`, `lost`,
+    /// `still_unknown_from_goal`).
+    pub(crate) frontiers_given_up: Vec<&'static str>,
+    /// Frontiers left with no reachable goal at the last decision.
+    pub(crate) frontiers_unreachable: usize,
+    /// Cells of every frontier on the final map (unreachable ones included).
+    pub(crate) frontier_cells_left: usize,
+    pub(crate) collisions: usize,
     pub(crate) seconds: f64,
 }
 
@@ -56,7 +94,16 @@ pub(crate) struct Summary {
     pub(crate) registration: String,
     pub(crate) planner: String,
     pub(crate) kidnap: Option<[f64; 2]>,
-    pub(crate) mapping: MappingSummary,
+    /// `explore` or `lap`.
+    pub(crate) mode: &'static str,
+    /// `office` or `small`.
+    pub(crate) building: String,
+    /// The lap's figures (`--lap` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) mapping: Option<MappingSummary>,
+    /// The exploration's figures (not with `--lap`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) exploration: Option<ExplorationSummary>,
     /// Plan-view footprints of the dropped boxes in the map frame: min and max corners.
     pub(crate) obstacles: Vec<[[f64; 2]; 2]>,
     pub(crate) goals: Vec<LegSummary>,

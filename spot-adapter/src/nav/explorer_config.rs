@@ -5,7 +5,11 @@ use crate::nav::NavError;
 /// How the explorer picks the next frontier among the reachable ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", deny_unknown_fields)
+)]
 pub enum FrontierChoice {
     /// Scraps before large areas: among the frontiers whose walk is at most `detour` metres
     /// longer than the nearest one's, the one that would reveal least (unknown area in sight

@@ -68,6 +68,23 @@ impl Default for BuildingConfig {
 }
 
 impl BuildingConfig {
+    /// About the smallest building the generator makes: a 10 m x 10 m corridor loop with
+    /// shallow rooms round it and a core of rooms inside (about 17 m x 17 m, 14-16 rooms, one
+    /// piece of furniture each). An exploration of it takes seconds, not minutes: the tests'
+    /// and the mission's small building.
+    #[must_use]
+    pub fn small() -> Self {
+        Self {
+            loop_length_x: (10.0, 10.0),
+            loop_length_y: (10.0, 10.0),
+            outer_room_depth: (2.5, 3.0),
+            corridor_width: (1.8, 2.0),
+            room_width: (4.5, 6.0),
+            furniture_per_room: (1, 1),
+            ..Self::default()
+        }
+    }
+
     pub(crate) fn validate(&self) -> Result<(), SimError> {
         // (name of the range's low end, of its high end, the range, its floor, the requirement)
         let ranges = [

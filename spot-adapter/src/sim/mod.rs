@@ -22,6 +22,7 @@ mod building_config;
 mod cloud_folder_writer;
 mod commanded_spot;
 mod error;
+mod floor_coverage;
 mod floor_plan;
 mod gait_sway;
 mod generator;
@@ -46,6 +47,7 @@ pub use cloud_folder_writer::{
 };
 pub use commanded_spot::CommandedSpot;
 pub use error::SimError;
+pub use floor_coverage::{FloorCoverage, floor_coverage};
 pub use floor_plan::OBSTACLE_HEIGHT;
 pub use gait_sway::GaitSway;
 pub use hand_shake::HandShake;

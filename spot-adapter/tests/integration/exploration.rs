@@ -6,9 +6,6 @@
 //! that gives the README's figures.
 #![allow(clippy::unwrap_used)]
 
-use std::collections::VecDeque;
-
-use gridmap::CellState;
 use nalgebra::Vector2;
 use slam_core::Pose3;
 use spot_adapter::nav::{
@@ -18,21 +15,15 @@ use spot_adapter::nav::{
 use spot_adapter::pipelines::{
     point_to_plane_localiser, point_to_plane_slam, point_to_plane_tracker, slam_config,
 };
-use spot_adapter::sim::{Building, BuildingConfig, CommandedSpot, SimulationConfig};
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, SimulationConfig, floor_coverage,
+};
 
-/// About the smallest building the generator makes: a 10 m x 10 m corridor loop with shallow
-/// rooms round it and a core of rooms inside (about 17 m x 17 m, 14-16 rooms).
+/// About the smallest building the generator makes (`BuildingConfig::small`: a 10 m x 10 m
+/// corridor loop with shallow rooms round it and a core of rooms inside, about 17 m x 17 m,
+/// 14-16 rooms).
 pub fn small_building(seed: u64) -> Building {
-    let config = BuildingConfig {
-        loop_length_x: (10.0, 10.0),
-        loop_length_y: (10.0, 10.0),
-        outer_room_depth: (2.5, 3.0),
-        corridor_width: (1.8, 2.0),
-        room_width: (4.5, 6.0),
-        furniture_per_room: (1, 1),
-        ..BuildingConfig::default()
-    };
-    Building::generate(seed, &config).unwrap()
+    Building::generate(seed, &BuildingConfig::small()).unwrap()
 }
 
 /// An exploration's figures on the ground truth.
@@ -98,47 +89,23 @@ pub fn explore_building(
     }
 }
 
-/// The share of `building`'s floor free at the planning inflation (cell centres that far from
-/// every obstacle) and 4-connected to `start` that the final grid knows free.
+/// The share of `building`'s floor free at the planning inflation and 4-connected to `start`
+/// that the final grid knows free (`spot_adapter::sim::floor_coverage`, as the mission reports
+/// it).
 pub fn coverage(
     building: &Building,
     start: Vector2<f64>,
     world_t_map: &Pose3,
     report: &ExplorationReport,
 ) -> f64 {
-    let inflation = NavigatorConfig::default().planning.inflation;
-    let resolution = 0.1;
-    let size = building.size();
-    let (w, h) = ((size.x / resolution) as i64, (size.y / resolution) as i64);
-    let centre = |x: i64, y: i64| Vector2::new(x as f64 + 0.5, y as f64 + 0.5) * resolution;
-    let free = |x: i64, y: i64| {
-        x >= 0 && y >= 0 && x < w && y < h && building.clearance(centre(x, y)) >= inflation
-    };
-    let first = ((start.x / resolution) as i64, (start.y / resolution) as i64);
-    let mut seen = vec![false; (w * h) as usize];
-    let mut queue = VecDeque::from([first]);
-    seen[(first.1 * w + first.0) as usize] = true;
-    let occupancy = report.navigation.occupancy();
-    let map_t_world = world_t_map.inverse();
-    let (mut reachable, mut known) = (0usize, 0usize);
-    while let Some((x, y)) = queue.pop_front() {
-        reachable += 1;
-        let p = map_t_world * nalgebra::Point3::new(centre(x, y).x, centre(x, y).y, 0.0);
-        let (cx, cy) = occupancy.geometry().cell_coords(p.coords.xy());
-        if let (Ok(cx), Ok(cy)) = (u32::try_from(cx), u32::try_from(cy))
-            && occupancy.state(slam_core::Cell::new(cx, cy)) == CellState::Free
-        {
-            known += 1;
-        }
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
-            let (nx, ny) = (x + dx, y + dy);
-            if free(nx, ny) && !seen[(ny * w + nx) as usize] {
-                seen[(ny * w + nx) as usize] = true;
-                queue.push_back((nx, ny));
-            }
-        }
-    }
-    known as f64 / reachable as f64
+    floor_coverage(
+        building,
+        start,
+        world_t_map,
+        report.navigation.occupancy(),
+        NavigatorConfig::default().planning.inflation,
+    )
+    .share()
 }
 
 fn print(name: &str, e: &Explored) {
