@@ -1,8 +1,9 @@
 //! Many random goals on buildings the navigator was not tuned on: each leg starts where the last
 //! ended; reached, collisions and the final error are measured on the simulator's ground truth.
-//! Boxes are dropped on two legs' routes after mapping, so the same twenty legs test both the
-//! plain walks and replanning around new obstacles. Each building is mapped once for all its
-//! tests.
+//! Boxes are dropped on two legs' routes after mapping, so the same legs test both the plain
+//! walks and replanning around new obstacles. Each building is mapped once for all its tests.
+//! The suite walks the first twelve of each building's twenty goals (both boxes included); the
+//! twenty, whose counts the README gives, are the ignored `twenty_random_goals_*` tests.
 #![allow(clippy::unwrap_used)]
 
 use std::sync::OnceLock;
@@ -21,12 +22,14 @@ fn mapped(seed: u64) -> &'static (Building, PointCloud, NavigationMap) {
     MAPS[usize::try_from(seed - 4).unwrap()].get_or_init(|| building_and_map(seed))
 }
 
-/// 20 random goals on `seed`'s building, with 0.6 m boxes dropped after mapping on the routes
-/// of the legs in `boxes_before`: prints the legs, returns (reached within 0.10 m, collisions).
-fn twenty_goals(seed: u64, boxes_before: &[usize]) -> (usize, usize) {
+/// The first `count` of 20 random goals on `seed`'s building, with 0.6 m boxes dropped after
+/// mapping on the routes of the legs in `boxes_before`: prints the legs, returns (reached within
+/// 0.10 m, collisions).
+fn random_legs(seed: u64, count: usize, boxes_before: &[usize]) -> (usize, usize) {
     let (building, map, navigation) = mapped(seed);
     let start = building.corridor_loop()[0];
-    let goals = random_goals(building, map, start, 20, seed);
+    let mut goals = random_goals(building, map, start, 20, seed);
+    goals.truncate(count);
     let start = Start {
         boxes_before: boxes_before.to_vec(),
         ..Start::at(start)
@@ -58,7 +61,7 @@ fn twenty_goals(seed: u64, boxes_before: &[usize]) -> (usize, usize) {
             leg.worst_localisation
         );
     }
-    eprintln!("seed {seed}: {reached} of 20 reached within 0.10 m, {collisions} collisions");
+    eprintln!("seed {seed}: {reached} of {count} reached within 0.10 m, {collisions} collisions");
     (reached, collisions)
 }
 
@@ -109,27 +112,38 @@ fn a_kidnapped_start_recovers_on_building_6() {
     kidnapped(6);
 }
 
-/// Twenty random goals, with two boxes dropped on routes after mapping (before legs 3 and 11):
-/// at least 19 reached within 0.10 m by ground truth, no collision.
-fn twenty_goals_two_boxes(seed: u64) {
-    let (reached, collisions) = twenty_goals(seed, &[3, 11]);
-    assert!(reached >= 19, "{reached} of 20");
+/// The first `count` of twenty random goals, with two boxes dropped on routes after mapping
+/// (before legs 3 and 11): all but one at most reached within 0.10 m by ground truth, no
+/// collision.
+fn goals_and_two_boxes(seed: u64, count: usize) {
+    let (reached, collisions) = random_legs(seed, count, &[3, 11]);
+    assert!(reached + 1 >= count, "{reached} of {count}");
     assert_eq!(collisions, 0);
 }
 
 #[test]
-fn twenty_random_goals_and_two_boxes_on_building_4() {
-    twenty_goals_two_boxes(4);
+fn twelve_random_goals_and_two_boxes_on_building_4() {
+    goals_and_two_boxes(4, 12);
 }
 
 #[test]
-fn twenty_random_goals_and_two_boxes_on_building_5() {
-    twenty_goals_two_boxes(5);
+fn twelve_random_goals_and_two_boxes_on_building_5() {
+    goals_and_two_boxes(5, 12);
 }
 
 #[test]
-fn twenty_random_goals_and_two_boxes_on_building_6() {
-    twenty_goals_two_boxes(6);
+fn twelve_random_goals_and_two_boxes_on_building_6() {
+    goals_and_two_boxes(6, 12);
+}
+
+/// The README's figure: all twenty goals on the three buildings (about 3 minutes).
+/// `cargo test -p spot-nav-adapter --release --test integration multi_goal::twenty -- --ignored --nocapture`
+#[test]
+#[ignore = "the README's 60-goal figure; the suite walks the first 12 of each building"]
+fn twenty_random_goals_and_two_boxes_on_buildings_4_to_6() {
+    for seed in 4..=6 {
+        goals_and_two_boxes(seed, 20);
+    }
 }
 
 /// The localiser's registration of a scan taken at each of the 20 goals (facing four ways),
