@@ -15,8 +15,10 @@
 //!   `posegraph::IncrementalSmoother` (iSAM2-style, no robust back end) in place of graduated
 //!   non-convexity over Levenberg-Marquardt; after its table rows, a line on stderr with the
 //!   smoother's counters (optimisations, updates, restarts, share of the free nodes re-factored
-//!   per update). With revisits the walk closes about one loop (each later lap rides on the
-//!   first lap's keyframes), so the back end matters only with a keyframe every 0.2 m.
+//!   per update; `SLAM_LAPS_SMOOTHER_ITERATIONS=1` caps its updates per loop closure, as
+//!   iSAM2 runs, instead of converging each time). With revisits the walk closes about one
+//!   loop (each later lap rides on the first lap's keyframes), so the back end matters only
+//!   with a keyframe every 0.2 m.
 //!
 //! `cargo bench -p spot-nav-benches --bench slam_laps` (10 laps of seeds 5 and 6, all four
 //! setups: well over 20 minutes on 2 cores, most of it the `every-keyframe` ones). `SLAM_LAPS=3`,
@@ -37,6 +39,10 @@ use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, Simulati
 
 /// The environment variable that makes the binary run one setup as a child.
 const CHILD: &str = "SLAM_LAPS_CHILD";
+
+/// The environment variable that caps the smoother's updates per optimisation (default 100,
+/// to convergence; 1 is iSAM2's one update per new loop).
+const SMOOTHER_ITERATIONS: &str = "SLAM_LAPS_SMOOTHER_ITERATIONS";
 
 /// The suffix of a setup with the incremental smoother as its back end.
 const INCREMENTAL: &str = "-incremental";
@@ -76,7 +82,14 @@ fn quantile(ms: &[f64], q: f64) -> f64 {
 fn child(seed: u64, setup: &str, laps: usize, offset: f64) -> Result<(), String> {
     let config = config(setup).ok_or_else(|| format!("unknown setup {setup:?}"))?;
     if setup.ends_with(INCREMENTAL) {
-        let mut slam = point_to_plane_slam_optimized_by(config, IncrementalSmoother::default())
+        let mut smoother = IncrementalSmoother::default();
+        if let Some(cap) = std::env::var(SMOOTHER_ITERATIONS)
+            .ok()
+            .and_then(|v| v.parse().ok())
+        {
+            smoother.config.max_iterations = cap;
+        }
+        let mut slam = point_to_plane_slam_optimized_by(config, smoother)
             .map_err(|e| e.to_string())?
             .with_place_recognizer(scan_context_places());
         walk(&mut slam, seed, setup, laps, offset)?;

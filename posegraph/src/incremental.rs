@@ -97,8 +97,11 @@ impl IncrementalConfig {
 /// nodes), which reaches the batch solvers' optimum.
 ///
 /// Robust kernels enter as IRLS weights taken when an edge is linearised. Between calls the
-/// graph may only grow (another graph makes it start afresh); the poses of the nodes it has seen
-/// are its own: it writes every free node at each call.
+/// graph may only grow (another graph makes it start afresh, counted in
+/// [`SmootherStatistics::restarts`]); the poses of the nodes it has seen are its own: it writes
+/// every free node at each call. The Graph-SLAM engine's graph only grows, so it can be the
+/// engine's optimiser; but it does not reject a wrong loop, which the engine's default
+/// (graduated non-convexity) does.
 ///
 /// When not to use it: for a single solve of a whole graph (use
 /// [`LevenbergMarquardt`](crate::LevenbergMarquardt): Gauss-Newton here has no damping), or for
