@@ -74,7 +74,7 @@ pub use error::{GraphFileError, UnknownTag};
 pub use gauss_newton::GaussNewton;
 pub use gnc::{GncConfig, GncReport, GraduatedNonConvexity, KnownInliers};
 pub use gnc_loss::GncLoss;
-pub use incremental::{IncrementalConfig, IncrementalSmoother};
+pub use incremental::{IncrementalConfig, IncrementalSmoother, SmootherStatistics};
 pub use levenberg_marquardt::LevenbergMarquardt;
 pub use linearize::{ErrorModel, Linearize};
 pub use solver::{SolverConfig, SolverPose};

@@ -39,7 +39,9 @@ use registration::{
     IcpConfig, IcpKernel, LoamConfig, LoamRegistrator, PointToPlaneIcp, PointToPointIcp,
     ScanContextConfig, ScanContextIndexConfig, ScanContextRecognizer,
 };
-use slam_core::{GraphSlam, GraphSlamConfig, InvalidSetting, MapRegistrator, PlaceRecognizer};
+use slam_core::{
+    GraphSlam, GraphSlamConfig, InvalidSetting, MapRegistrator, Optimizer, PlaceRecognizer, Pose3,
+};
 
 /// Graph-SLAM with point-to-plane ICP odometry and loop refinement.
 pub type PointToPlaneSlam = GraphSlam<PointToPlaneIcp, PointToPointIcp, GraduatedNonConvexity>;
@@ -69,6 +71,23 @@ fn assemble<R: MapRegistrator>(
     odometry: R,
     refine: R,
 ) -> Result<GraphSlam<R, PointToPointIcp, GraduatedNonConvexity>, InvalidSetting> {
+    // Odometry edges carry no kernel and loops carry the engine's loop kernel: the ones without
+    // are the known inliers (an odometry edge from an old keyframe the walk rode on joins ids
+    // that are not consecutive).
+    let gnc = GraduatedNonConvexity::try_new(GncConfig {
+        known_inliers: KnownInliers::WithoutKernel,
+        ..GncConfig::default()
+    })?;
+    assemble_with(config, odometry, refine, gnc)
+}
+
+/// [`assemble`] with `optimizer` as the back end.
+fn assemble_with<R: MapRegistrator, O: Optimizer<Pose3>>(
+    config: GraphSlamConfig,
+    odometry: R,
+    refine: R,
+    optimizer: O,
+) -> Result<GraphSlam<R, PointToPointIcp, O>, InvalidSetting> {
     let loop_check = PointToPointIcp {
         config: IcpConfig {
             max_correspondence_distance: 1.0,
@@ -78,14 +97,7 @@ fn assemble<R: MapRegistrator>(
             ..IcpConfig::default()
         },
     };
-    // Odometry edges carry no kernel and loops carry the engine's loop kernel: the ones without
-    // are the known inliers (an odometry edge from an old keyframe the walk rode on joins ids
-    // that are not consecutive).
-    let gnc = GraduatedNonConvexity::try_new(GncConfig {
-        known_inliers: KnownInliers::WithoutKernel,
-        ..GncConfig::default()
-    })?;
-    GraphSlam::try_new(config, odometry, loop_check, refine, gnc)
+    GraphSlam::try_new(config, odometry, loop_check, refine, optimizer)
 }
 
 /// Point-to-plane ICP for tracking a scan against a map (the SLAM odometry's fine stage after the
@@ -169,14 +181,36 @@ pub fn point_to_plane_slam_with(
     odometry: PointToPlaneIcp,
 ) -> Result<PointToPlaneSlam, InvalidSetting> {
     odometry.config.validate()?;
-    let refine = PointToPlaneIcp {
+    assemble(config, odometry, point_to_plane_refine())
+}
+
+/// [`point_to_plane_slam`] with `optimizer` in place of graduated non-convexity (to compare
+/// back ends, say an incremental smoother that does not re-solve the whole graph per loop but
+/// has no defence against a wrong loop).
+///
+/// # Errors
+/// [`InvalidSetting`] naming the first bad setting of `config`.
+pub fn point_to_plane_slam_optimized_by<O: Optimizer<Pose3>>(
+    config: GraphSlamConfig,
+    optimizer: O,
+) -> Result<GraphSlam<PointToPlaneIcp, PointToPointIcp, O>, InvalidSetting> {
+    assemble_with(
+        config,
+        point_to_plane_tracker(),
+        point_to_plane_refine(),
+        optimizer,
+    )
+}
+
+/// Point-to-plane loop refinement: Tukey 10 cm, pairs within 1 m.
+fn point_to_plane_refine() -> PointToPlaneIcp {
+    PointToPlaneIcp {
         config: IcpConfig {
             kernel: IcpKernel::Tukey { k: 0.10 },
             max_correspondence_distance: 1.0,
             ..IcpConfig::default()
         },
-    };
-    assemble(config, odometry, refine)
+    }
 }
 
 /// LOAM odometry against a local map of edge and planar features (5 cm and 10 cm voxels,

@@ -298,3 +298,41 @@ fn bad_input_is_an_error_and_the_smoother_recovers() {
     };
     assert!(IncrementalSmoother::try_new(bad).is_err());
 }
+
+#[test]
+fn the_statistics_tell_a_growing_graph_from_one_that_changed() {
+    let info = Pose2::identity_information();
+    let step = Pose2::new([1.0, 0.0].into(), 0.1);
+    let mut g = PoseGraph::<Pose2>::new();
+    g.add_node(0, Pose2::identity()).unwrap();
+    g.fix(0).unwrap();
+    let mut smoother = IncrementalSmoother::default();
+    for i in 1..=20u64 {
+        let guess = compose2(g.pose(i - 1).unwrap(), &step);
+        g.add_node(i, guess).unwrap();
+        g.add_edge(i - 1, i, step, info, None).unwrap();
+        smoother.update(&mut g).unwrap();
+    }
+    // Appended only: never afresh, and an odometry step re-factors only the newest nodes.
+    let chain = smoother.statistics();
+    assert_eq!((chain.restarts, chain.updates), (0, 20), "{chain:?}");
+    assert!(chain.refactored <= 2 * chain.updates, "{chain:?}");
+    g.add_edge(0, 20, compose2(g.pose(20).unwrap(), &step), info, None)
+        .unwrap();
+    smoother.optimize(&mut g).unwrap();
+    let grown = smoother.statistics();
+    assert_eq!((grown.restarts, grown.optimizations), (0, 1), "{grown:?}");
+    assert!(grown.updates > 20, "{grown:?}");
+    // A fixed flag changed: the next update starts afresh, and says so.
+    g.fix(10).unwrap();
+    smoother.update(&mut g).unwrap();
+    let changed = smoother.statistics();
+    assert_eq!(changed.restarts, 1, "{changed:?}");
+    assert_eq!(changed.updates, grown.updates + 1);
+    // An error drops the state: counted too.
+    g.add_node(21, step).unwrap();
+    g.add_edge(20, 21, step, info, None).unwrap();
+    g.set_pose(21, Pose2::new([f64::NAN, 0.0].into(), 0.0));
+    assert!(smoother.update(&mut g).is_err());
+    assert_eq!(smoother.statistics().restarts, 2);
+}

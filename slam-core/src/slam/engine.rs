@@ -61,6 +61,13 @@ pub(super) struct GyroReading {
 /// [`GraphSlamConfig::inline_loop_closure`] (the default) [`GraphSlam::process`] calls it after
 /// each new keyframe; otherwise the caller schedules it (between scans, or on a timer), so that
 /// odometry is never held up. Either way the result is deterministic for a given input.
+///
+/// The pose graph only grows: a keyframe appends a node with its odometry edge, a loop appends
+/// an edge, only the first node is fixed (when it is added), and nothing but the optimiser
+/// moves a pose. An incremental optimiser ([`IncrementalOptimizer`], such as posegraph's
+/// `IncrementalSmoother`) therefore keeps its factorisation from one loop closure to the next.
+///
+/// [`IncrementalOptimizer`]: crate::IncrementalOptimizer
 pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> {
     pub(super) config: GraphSlamConfig,
     pub(super) odometry: R,

@@ -215,3 +215,47 @@ impl Optimizer<Pose3> for DenseGaussNewton {
         })
     }
 }
+
+/// `inner` behind a check of what an incremental optimiser needs of its caller: at each call
+/// the graph is the graph of the last call grown (every node's id and fixed flag and every
+/// edge, measurement and information included, as they were; nodes and edges only appended).
+pub(super) struct GrowthCheck<O> {
+    pub(super) inner: O,
+    /// The graph as the last call left it.
+    last: Option<PoseGraph<Pose3>>,
+    /// Calls so far.
+    pub(super) calls: usize,
+}
+
+impl<O> GrowthCheck<O> {
+    pub(super) fn new(inner: O) -> Self {
+        Self {
+            inner,
+            last: None,
+            calls: 0,
+        }
+    }
+}
+
+impl<O: Optimizer<Pose3>> Optimizer<Pose3> for GrowthCheck<O> {
+    fn optimize(&mut self, g: &mut PoseGraph<Pose3>) -> Result<OptimizationReport, OptimizeError> {
+        if let Some(last) = &self.last {
+            assert!(g.node_count() >= last.node_count() && g.edge_count() >= last.edge_count());
+            for (now, before) in g.nodes().iter().zip(last.nodes()) {
+                assert_eq!(
+                    (now.id, now.fixed),
+                    (before.id, before.fixed),
+                    "call {}",
+                    self.calls
+                );
+            }
+            for (k, (now, before)) in g.edges().iter().zip(last.edges()).enumerate() {
+                assert_eq!(now, before, "edge {k} changed before call {}", self.calls);
+            }
+        }
+        self.calls += 1;
+        let report = self.inner.optimize(g);
+        self.last = Some(g.clone());
+        report
+    }
+}

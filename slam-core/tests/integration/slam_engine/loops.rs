@@ -1,6 +1,6 @@
 //! Loop closure on the drifting loop: the drift removed, and every rejected candidate counted.
 
-use super::backends::{BruteIcp, DenseGaussNewton};
+use super::backends::{BruteIcp, DenseGaussNewton, GrowthCheck};
 use super::{brute_engine, drifting_odometry, feed, hall, loop_config, loop_poses, scan};
 use slam_core::io::StampedPose;
 use slam_core::{
@@ -147,6 +147,36 @@ fn loop_closure_removes_odometry_drift() {
         "{near} of {}",
         map.len()
     );
+}
+
+/// Between optimisations the engine's graph only grows: nodes and edges appended, no edge or
+/// fixed flag changed, so an incremental optimiser (posegraph's `IncrementalSmoother`) keeps
+/// its factor from one loop closure to the next instead of starting afresh.
+#[test]
+fn the_graph_only_grows_between_optimisations() {
+    let world = hall();
+    let truth = loop_poses();
+    let odom = drifting_odometry(&truth);
+    // A keyframe every step, revisits too, each trying a loop: a closure on each of the last.
+    let config = GraphSlamConfig {
+        revisit_radius: 0.0,
+        loop_min_keyframe_gap: 1,
+        ..loop_config()
+    };
+    let mut slam = GraphSlam::try_new(
+        config,
+        BruteIcp { max_distance: 0.5 },
+        BruteIcp { max_distance: 1.0 },
+        BruteIcp { max_distance: 0.5 },
+        GrowthCheck::new(DenseGaussNewton),
+    )
+    .unwrap();
+    for (k, (gt, od)) in truth.iter().zip(&odom).enumerate() {
+        feed(&mut slam, &world, k, gt, *od);
+    }
+    let calls = slam.optimizer().calls;
+    assert_eq!(calls, slam.report().loops_closed);
+    assert!(calls >= 2, "{calls} optimisations: {:?}", slam.report());
 }
 
 /// The drifting loop through `config` with the caller running the loop-closure steps (as a
