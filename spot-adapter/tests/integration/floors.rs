@@ -1,0 +1,157 @@
+//! Buildings of several floors: the floors setting, the staircase and the slab as rays see
+//! them, and the tour's heights against the steps.
+
+#![allow(clippy::unwrap_used)]
+
+use nalgebra::{Point3, Vector3};
+use spot_adapter::sim::{
+    BoxKind, Building, BuildingConfig, FloorsTour, HitTarget, SLAB_THICKNESS, STAIRS_SPEED,
+    SimError,
+};
+
+fn two_floors(seed: u64) -> Building {
+    let config = BuildingConfig {
+        floors: 2,
+        ..BuildingConfig::default()
+    };
+    Building::generate(seed, &config).unwrap()
+}
+
+/// The kind of box a ray hit, if it hit one.
+fn kind(building: &Building, target: HitTarget) -> Option<BoxKind> {
+    match target {
+        HitTarget::Box(i) => Some(building.boxes()[i].kind),
+        _ => None,
+    }
+}
+
+#[test]
+fn floors_outside_one_to_three_are_refused_by_name() {
+    for floors in [0, 4, 100] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        match Building::generate(1, &config) {
+            Err(SimError::InvalidConfig(e)) => {
+                assert_eq!(e.setting, "floors");
+                assert!((e.value - floors as f64).abs() < 1e-12);
+            }
+            other => panic!("{floors} floors: expected an invalid floors, got {other:?}"),
+        }
+    }
+    // One floor is the default, and the same building as before the setting existed.
+    let one = BuildingConfig {
+        floors: 1,
+        ..BuildingConfig::default()
+    };
+    assert_eq!(BuildingConfig::default(), one);
+    let b = Building::generate(1, &one).unwrap();
+    assert_eq!(b.floors(), 1);
+    assert!(b.staircases().is_empty());
+    assert!((b.top_ceiling() - b.ceiling_height()).abs() < 1e-15);
+    for floors in 2..=3 {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(1, &config).unwrap();
+        assert_eq!(b.floors(), floors);
+        assert_eq!(b.staircases().len(), floors - 1);
+    }
+}
+
+#[test]
+fn rays_see_each_step_the_slab_and_through_the_stairwell() {
+    let b = two_floors(5);
+    let storey = b.floor_height(1);
+    assert!((storey - b.ceiling_height() - SLAB_THICKNESS).abs() < 1e-12);
+    let flight = b.staircases()[0];
+    // The oracle: step k's top at k rises, the rises dividing the storey evenly.
+    let rise = storey / (flight.steps + 1) as f64;
+    assert!((0.15..=0.21).contains(&rise), "rise {rise}");
+    let down = -Vector3::z();
+    for k in 1..=flight.steps {
+        let p = flight.foot + flight.up * ((k as f64 - 0.5) * flight.tread);
+        let origin = Point3::new(p.x, p.y, k as f64 * rise + 0.3);
+        let hit = b.cast_ray(&origin, &down, 10.0).unwrap();
+        assert_eq!(kind(&b, hit.target), Some(BoxKind::Step), "step {k}");
+        assert!(
+            (origin.z - hit.range - k as f64 * rise).abs() < 1e-9,
+            "step {k}"
+        );
+    }
+    // Up from the middle of the flight: through the stairwell to the upper floor's ceiling.
+    let mid = flight.foot + flight.up * (0.5 * flight.run());
+    let origin = Point3::new(mid.x, mid.y, 0.5 * storey + 0.5);
+    let hit = b.cast_ray(&origin, &Vector3::z(), 20.0).unwrap();
+    assert_eq!(hit.target, HitTarget::Ceiling);
+    assert!((hit.range - (storey + b.ceiling_height() - origin.z)).abs() < 1e-9);
+    // Up from the corridor: the slab's underside; down on the floor above: its top.
+    let corridor = b.corridor_loop()[0];
+    let origin = Point3::new(corridor.x, corridor.y, 1.0);
+    let hit = b.cast_ray(&origin, &Vector3::z(), 20.0).unwrap();
+    assert_eq!(kind(&b, hit.target), Some(BoxKind::Slab));
+    assert!((hit.range - (b.ceiling_height() - 1.0)).abs() < 1e-9);
+    let origin = Point3::new(corridor.x, corridor.y, storey + 0.7);
+    let hit = b.cast_ray(&origin, &down, 20.0).unwrap();
+    assert_eq!(kind(&b, hit.target), Some(BoxKind::Slab));
+    assert!((hit.range - 0.7).abs() < 1e-9);
+    // The ground floor's plan counts the staircase as an obstacle, the upper floor not.
+    assert!(b.is_obstacle(mid));
+    assert!(!b.is_obstacle(corridor));
+}
+
+#[test]
+fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let tour = FloorsTour::new(&b).unwrap();
+        let body = 0.5;
+        let (poses, stairs) = tour.walk(0.6, 5.0, body).unwrap();
+        let rise = b.staircases()[0].rise;
+        let mut top = f64::NEG_INFINITY;
+        for (k, p) in poses.iter().enumerate() {
+            let t = p.pose.translation.vector;
+            // The oracle: the surface straight below the body, as a ray finds it.
+            let hit = b.cast_ray(&Point3::from(t), &-Vector3::z(), 20.0).unwrap();
+            let ground = t.z - hit.range;
+            assert!(
+                (t.z - body - ground).abs() <= 0.5 * rise + 1e-9,
+                "seed {seed}, sample {k}: body at {:.3} m over ground at {ground:.3} m",
+                t.z
+            );
+            top = top.max(t.z - body);
+            if stairs[k] && stairs.get(k + 1) == Some(&true) {
+                // Along the slope at the stairs speed, pitched with it.
+                let next = poses[k + 1].pose.translation.vector;
+                let speed = (next - t).norm() * 5.0;
+                assert!((speed - STAIRS_SPEED).abs() < 0.1, "speed {speed}");
+            }
+        }
+        assert!((top - b.floor_height(floors - 1)).abs() < 1e-9, "top {top}");
+        let (first, last) = (poses[0].pose, poses[poses.len() - 1].pose);
+        assert!((first.translation.vector - last.translation.vector).norm() < 1e-9);
+        // Two passes over each flight; the lap of every floor makes the tour long.
+        let climbs = stairs.windows(2).filter(|w| !w[0] && w[1]).count();
+        assert_eq!(climbs, 2 * (floors - 1));
+        assert!(tour.route().length() > 100.0 * floors as f64);
+        // Mid-flight the body pitches with the flight, nose up (a negative pitch) going up.
+        let flight = b.staircases()[0];
+        let slope = (flight.rise / flight.tread).atan();
+        let mid = poses
+            .iter()
+            .zip(&stairs)
+            .find(|(p, on)| {
+                **on && (p.pose.translation.z - body - 0.5 * flight.climb()).abs() < 0.3
+            })
+            .unwrap()
+            .0;
+        let (_, pitch, _) = mid.pose.rotation.euler_angles();
+        assert!((pitch + slope).abs() < 0.05, "pitch {pitch}, slope {slope}");
+    }
+}
