@@ -77,6 +77,18 @@ impl Default for BuildingConfig {
 }
 
 impl BuildingConfig {
+    /// The floor count: 1 to [`MAX_FLOORS`].
+    fn validate_floors(&self) -> Result<(), SimError> {
+        if (1..=MAX_FLOORS).contains(&self.floors) {
+            return Ok(());
+        }
+        Err(SimError::invalid(
+            "floors",
+            self.floors as f64,
+            "1, 2 or 3 (a building has at least one floor; the tour and the tests go to 3)",
+        ))
+    }
+
     pub(crate) fn validate(&self) -> Result<(), SimError> {
         // (name of the range's low end, of its high end, the range, its floor, the requirement)
         let ranges = [
@@ -170,13 +182,7 @@ impl BuildingConfig {
                 "at least 1.2 m below room_width.0",
             ));
         }
-        if !(1..=MAX_FLOORS).contains(&self.floors) {
-            return Err(SimError::invalid(
-                "floors",
-                self.floors as f64,
-                "1, 2 or 3 (a building has at least one floor; the tour and the tests go to 3)",
-            ));
-        }
+        self.validate_floors()?;
         if self.furniture_per_room.0 > self.furniture_per_room.1 {
             return Err(SimError::invalid(
                 "furniture_per_room.0",

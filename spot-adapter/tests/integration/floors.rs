@@ -50,14 +50,17 @@ fn floors_outside_one_to_three_are_refused_by_name() {
     assert_eq!(b.floors(), 1);
     assert!(b.staircases().is_empty());
     assert!((b.top_ceiling() - b.ceiling_height()).abs() < 1e-15);
-    for floors in 2..=3 {
+    // Every seed's layout has rooms for the staircases, and a tour over them.
+    for seed in 0..30 {
+        let floors = 2 + (seed % 2) as usize;
         let config = BuildingConfig {
             floors,
             ..BuildingConfig::default()
         };
-        let b = Building::generate(1, &config).unwrap();
+        let b = Building::generate(seed, &config).unwrap();
         assert_eq!(b.floors(), floors);
         assert_eq!(b.staircases().len(), floors - 1);
+        FloorsTour::new(&b).unwrap();
     }
 }
 
