@@ -158,3 +158,38 @@ fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
         assert!((pitch + slope).abs() < 0.05, "pitch {pitch}, slope {slope}");
     }
 }
+
+/// Graph-SLAM (point-to-plane, the robot's odometry, no place recognition) over seed 1's tour
+/// of two floors, against the truth: ATE and end height within 5 cm. About 20 s in release:
+/// `cargo test --release -p spot-nav-adapter --test integration -- --ignored two_floors`.
+///
+/// With Scan Context added (as the `slam` example runs it) the engine takes the upper floor,
+/// whose layout repeats the ground floor's, for the ground floor and ends 5.6 m low (spot-adapter's
+/// README, "Two floors by the stairs"); this test holds what works, the stairs themselves.
+#[test]
+#[ignore = "about 20 s: maps a 408 m tour over two floors"]
+fn two_floors_are_mapped_through_the_stairs_without_place_recognition() {
+    use spot_adapter::eval::TrajectoryEvaluation;
+    use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
+    use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
+
+    let mut config = SimulationConfig::with_seed(1);
+    config.building.floors = 2;
+    let sim = SimulatedSpot::floors_tour(&config).unwrap();
+    let body_t_lidar = sim.body_t_lidar();
+    let truth = sim.ground_truth();
+    let mut slam = point_to_plane_slam(slam_config()).unwrap();
+    for sample in sim {
+        slam.process(&sample.scan_input());
+    }
+    let (e, _) =
+        TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
+            .unwrap();
+    assert!(e.end_point.path_length > 400.0);
+    assert!(e.ate.rmse <= 0.05, "ATE {} m", e.ate.rmse);
+    assert!(
+        e.height_drift.abs() <= 0.05,
+        "height drift {} m",
+        e.height_drift
+    );
+}
