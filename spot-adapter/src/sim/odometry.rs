@@ -135,3 +135,31 @@ impl OdometryModel {
         self.odom_t_body
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The end-point error of 10 m walked straight east in 0.1 m steps, slipping `slip` times.
+    fn end_error(slip: f64) -> f64 {
+        let mut model = OdometryModel::new(OdometryDriftConfig::default(), 7).unwrap();
+        let mut truth = Pose3::identity();
+        let mut odom = model.step_slipping(&truth, slip);
+        for _ in 0..100 {
+            truth.translation.vector.x += 0.1;
+            odom = model.step_slipping(&truth, slip);
+        }
+        (odom.translation.vector - truth.translation.vector).norm()
+    }
+
+    #[test]
+    fn slipping_three_times_drifts_about_three_times_as_far() {
+        let (flat, stairs) = (end_error(1.0), end_error(3.0));
+        // The bias alone: 1.9 % of 10 m, then three times that; noise adds a few millimetres.
+        assert!((flat - 0.19).abs() < 0.03, "flat {flat}");
+        assert!(
+            (stairs / flat - 3.0).abs() < 0.3,
+            "stairs {stairs}, flat {flat}"
+        );
+    }
+}

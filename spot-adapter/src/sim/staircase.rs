@@ -114,7 +114,7 @@ impl Staircase {
     }
 
     /// The plan-view rectangle (min, max) left open in the slab above: the flight widened by
-    /// [`STAIRWELL_MARGIN`] at its sides and foot, ending where the upper floor begins.
+    /// 0.1 m at its sides and foot, ending where the upper floor begins.
     #[must_use]
     pub fn stairwell(&self) -> (Vector2<f64>, Vector2<f64>) {
         self.span(-STAIRWELL_MARGIN, self.run(), STAIRWELL_MARGIN)
