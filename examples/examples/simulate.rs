@@ -62,6 +62,11 @@ struct Args {
     /// every point's `time` says when), instead of the whole sweep from the pose at its stamp.
     #[arg(long)]
     skewed: bool,
+    /// Floors of the building (1 to 3). Above one, Spot walks a lap of the ground floor,
+    /// climbs the stairs, walks a lap of each floor above and comes back down (Spot's walk:
+    /// `--motion` is for one floor).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    floors: usize,
     /// Write the recording to this folder.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -159,7 +164,8 @@ fn simulate(args: &Args) -> Result<()> {
     config.lidar = args.sensor.lidar();
     config.motion = args.motion.profile();
     config.motion_distortion = args.skewed;
-    let mut sim = SimulatedSpot::corridor_loop(&config)?;
+    config.building.floors = args.floors;
+    let mut sim = SimulatedSpot::floors_tour(&config)?;
     let size = sim.building().size();
     let truth = sim.ground_truth();
     let gt: Vec<Pose3> = truth.iter().map(|p| p.pose).collect();
@@ -172,6 +178,19 @@ fn simulate(args: &Args) -> Result<()> {
         path_length(&gt),
         sim.len()
     )?;
+    if sim.building().floors() > 1 {
+        let stairs = sim.on_stairs().iter().filter(|&&on| on).count();
+        let flight = sim.building().staircases()[0];
+        out!(
+            "{} floors {:.2} m apart; flights of {} steps ({:.3} m rise, {:.2} m tread, {:.1} m run); {stairs} samples on the stairs",
+            sim.building().floors(),
+            sim.building().floor_height(1),
+            flight.steps,
+            flight.rise,
+            flight.tread,
+            flight.run(),
+        )?;
+    }
     out!(
         "{} with {}: {}",
         value_name(&args.motion),

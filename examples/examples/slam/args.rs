@@ -124,6 +124,16 @@ pub(crate) struct Args {
     /// or a person carrying it (1.2 m/s, shaking, quick turns, a sample every 0.5 s).
     #[arg(long, value_enum, value_name = "MOTION", default_value_t = Motion::Walk, conflicts_with = "recording")]
     pub(crate) motion: Motion,
+    /// Floors of the simulated building (1 to 3). Above one, Spot walks a lap of the ground
+    /// floor, climbs the stairs, walks a lap of each floor above and comes back down; the
+    /// report adds the height error on each floor.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        conflicts_with = "recording"
+    )]
+    pub(crate) floors: usize,
     /// Simulate a blank north corridor: plain walls and shut doors, where LiDAR odometry has
     /// little to hold on to along the corridor.
     #[arg(long, conflicts_with = "recording")]

@@ -88,6 +88,7 @@ fn slam(args: &Args) -> Result<()> {
         sim_config.motion = args.motion.profile();
         sim_config.motion_distortion = args.skewed;
         sim_config.building.blank_corridor = args.blank_corridor;
+        sim_config.building.floors = args.floors;
         if let Some(range) = args.lidar_range {
             sim_config.lidar.max_range = range;
         }
@@ -99,7 +100,7 @@ fn slam(args: &Args) -> Result<()> {
             );
         }
         sim_config.gyro_drift = args.gyro_drift.map(f64::to_radians);
-        let sim = SimulatedSpot::corridor_loop(&sim_config)?;
+        let sim = SimulatedSpot::floors_tour(&sim_config)?;
         let body_t_lidar = sim.body_t_lidar();
         let truth = sim.ground_truth();
         let context = RunContext {
@@ -195,8 +196,13 @@ fn simulation_description(args: &Args) -> String {
     let gyro = args
         .gyro_drift
         .map_or_else(String::new, |d| format!(", a gyro drifting {d} deg/s"));
+    let walk = if args.floors > 1 {
+        format!("tour of {} floors by the stairs", args.floors)
+    } else {
+        "corridor lap".to_owned()
+    };
     format!(
-        "simulated corridor lap, seed {}{}{}{range}{gyro}",
+        "simulated {walk}, seed {}{}{}{range}{gyro}",
         args.seed,
         if args.skewed { ", skewed scans" } else { "" },
         if args.blank_corridor {

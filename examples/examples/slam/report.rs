@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use gridmap::{UnknownCells, inflate};
 use nalgebra::Vector2;
 use posegraph::g2o::{G2oGraph, write_g2o};
-use slam_core::io::{PcdEncoding, PlyEncoding, write_pcd, write_ply, write_tum};
+use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
 use spot_adapter::record::DroppedPoints;
@@ -49,6 +49,9 @@ pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         seconds: run.seconds,
     };
     let summary = report(slam, &mapping, points, args, context)?;
+    if let (Some(truth), true) = (&truth, args.floors > 1) {
+        print_floor_heights(&mapping.estimate, truth, args.floors)?;
+    }
     if let Some(dir) = &args.out {
         write_outputs(slam, &mapping, dir, args.lidar_height, &summary)?;
     }
@@ -132,6 +135,58 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         points,
         accuracy,
     })
+}
+
+/// The height error on each floor of a tour over several floors: the estimate moved rigidly so
+/// that its first pose is the truth's (as the height drift is measured), then its z against
+/// the truth's at every pose standing on a floor (within 5 cm of a floor's height), mean and
+/// largest per floor. The floors' heights come from the truth: its highest point is the top
+/// floor.
+fn print_floor_heights(
+    estimate: &[StampedPose],
+    truth: &[StampedPose],
+    floors: usize,
+) -> Result<()> {
+    let (Some(e0), Some(t0)) = (estimate.first(), truth.first()) else {
+        return Ok(());
+    };
+    let align = t0.pose * e0.pose.inverse();
+    let z0 = t0.pose.translation.z;
+    let top = truth
+        .iter()
+        .map(|p| p.pose.translation.z)
+        .fold(z0, f64::max);
+    let storey = (top - z0) / (floors - 1) as f64;
+    let mut errors = vec![Vec::new(); floors];
+    for e in estimate {
+        // The simulator's samples carry the same stamps as its truth.
+        let Some(t) = truth.iter().find(|t| (t.stamp - e.stamp).abs() < 1e-6) else {
+            continue;
+        };
+        let dz = t.pose.translation.z - z0;
+        let floor = (dz / storey).round();
+        if (dz - floor * storey).abs() < 0.05 && floor >= 0.0 {
+            let z = (align * e.pose).translation.z;
+            errors[floor as usize].push(z - t.pose.translation.z);
+        }
+    }
+    let lines: Vec<String> = errors
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
+            let worst = e.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            format!(
+                "floor {k} {mean:+.3} m mean, {worst:.3} m max ({} poses)",
+                e.len()
+            )
+        })
+        .collect();
+    out!(
+        "floors      height error (first pose aligned): {}",
+        lines.join("; ")
+    )?;
+    Ok(())
 }
 
 /// The accuracy lines: ATE and drifts, KITTI's RPE, each step's rotation error.

@@ -27,6 +27,7 @@ use nalgebra::{Point3, Vector2, Vector3};
 use crate::sim::SimError;
 use crate::sim::ray_cast::{BoxGrid, HitTarget, RayHit};
 use crate::sim::solid_box::{BoxId, SolidBox};
+use crate::sim::staircase::Staircase;
 
 /// A room: its rectangle between wall centre lines and its door onto the corridor.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,6 +82,12 @@ pub struct Building {
     pub(crate) corridor_loop: [Vector2<f64>; 4],
     pub(crate) corridor_width: f64,
     pub(crate) index: BoxGrid,
+    /// Floors (1 to 3), each `storey_height` above the one below.
+    pub(crate) floors: usize,
+    /// Floor-to-floor height (metres): the ceiling height plus the slab.
+    pub(crate) storey_height: f64,
+    /// The flight from floor `k` to floor `k + 1` at index `k`.
+    pub(crate) staircases: Vec<Staircase>,
     /// Boxes of the generated structure; those after it were added, with the ids in `added`.
     generated: usize,
     added: Vec<BoxId>,
@@ -107,6 +114,9 @@ impl Building {
             corridor_loop,
             corridor_width,
             index,
+            floors: 1,
+            storey_height: ceiling_height,
+            staircases: Vec::new(),
             added: Vec::new(),
             next_id: 0,
         }
@@ -177,7 +187,7 @@ impl Building {
                 target = Some(HitTarget::Floor);
             }
         } else if dir.z > 0.0 {
-            let t = (self.ceiling_height - origin.z) / dir.z;
+            let t = (self.top_ceiling() - origin.z) / dir.z;
             if t >= 0.0 && t < limit {
                 limit = t;
                 target = Some(HitTarget::Ceiling);
@@ -214,10 +224,38 @@ impl Building {
         self.size
     }
 
-    /// Ceiling height (metres); the floor is at z = 0.
+    /// Ceiling height (metres) above each floor; the ground floor is at z = 0.
     #[must_use]
     pub fn ceiling_height(&self) -> f64 {
         self.ceiling_height
+    }
+
+    /// Number of floors, 1 unless [`BuildingConfig::floors`](crate::sim::BuildingConfig)
+    /// asked for more.
+    #[must_use]
+    pub fn floors(&self) -> usize {
+        self.floors
+    }
+
+    /// Height of floor `k` (metres): `k` storeys (the ceiling height plus a 0.2 m slab) above
+    /// the ground floor.
+    #[must_use]
+    pub fn floor_height(&self, k: usize) -> f64 {
+        k as f64 * self.storey_height
+    }
+
+    /// Height of the top floor's ceiling (metres): the ceiling plane rays reach through
+    /// stairwells; [`Building::ceiling_height`] with one floor.
+    #[must_use]
+    pub fn top_ceiling(&self) -> f64 {
+        self.floor_height(self.floors - 1) + self.ceiling_height
+    }
+
+    /// The staircases, the one from floor `k` to floor `k + 1` at index `k` (none with one
+    /// floor).
+    #[must_use]
+    pub fn staircases(&self) -> &[Staircase] {
+        &self.staircases
     }
 
     /// Corners of the corridor loop's centre line, counter-clockwise from the south-west.

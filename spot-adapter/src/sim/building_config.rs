@@ -2,6 +2,9 @@
 
 use crate::sim::SimError;
 
+/// The most floors a building may have.
+pub const MAX_FLOORS: usize = 3;
+
 /// Ranges the generator draws from (metres). Defaults give realistic office scales.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(
@@ -45,6 +48,11 @@ pub struct BuildingConfig {
     /// plane-like normals does not (1.1 cm). The rooms behind the shut doors are left out of
     /// [`Building::rooms`](crate::sim::Building::rooms). Default false.
     pub blank_corridor: bool,
+    /// Floors, 1 (the default) to 3. Above one, the ground floor's layout is stacked (every
+    /// floor has the same rooms and corridor, so one floor plan serves them all) with a slab
+    /// between the floors, and a straight staircase joins each floor to the next through a
+    /// stairwell in the slab above it (see [`Staircase`](crate::sim::Staircase)).
+    pub floors: usize,
 }
 
 impl Default for BuildingConfig {
@@ -63,6 +71,7 @@ impl Default for BuildingConfig {
             furniture_per_room: (1, 3),
             repeated_rooms: false,
             blank_corridor: false,
+            floors: 1,
         }
     }
 }
@@ -83,6 +92,18 @@ impl BuildingConfig {
             furniture_per_room: (1, 1),
             ..Self::default()
         }
+    }
+
+    /// The floor count: 1 to [`MAX_FLOORS`].
+    fn validate_floors(&self) -> Result<(), SimError> {
+        if (1..=MAX_FLOORS).contains(&self.floors) {
+            return Ok(());
+        }
+        Err(SimError::invalid(
+            "floors",
+            self.floors as f64,
+            "1, 2 or 3 (a building has at least one floor; the tour and the tests go to 3)",
+        ))
     }
 
     pub(crate) fn validate(&self) -> Result<(), SimError> {
@@ -178,6 +199,7 @@ impl BuildingConfig {
                 "at least 1.2 m below room_width.0",
             ));
         }
+        self.validate_floors()?;
         if self.furniture_per_room.0 > self.furniture_per_room.1 {
             return Err(SimError::invalid(
                 "furniture_per_room.0",

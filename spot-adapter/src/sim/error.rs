@@ -34,6 +34,19 @@ pub enum SimError {
     /// A box to add to a building is not a finite, non-empty box.
     #[error("a box needs finite corners with min below max on every axis")]
     InvalidBox,
+    /// No room of the generated layout is deep and wide enough for the staircases a
+    /// building of several floors needs.
+    #[error(
+        "{floors} floors need {needed} rooms deep enough for a staircase; the layout has {found}"
+    )]
+    NoRoomForStairs {
+        /// Floors asked for.
+        floors: usize,
+        /// Staircases needed (one per floor above the ground floor).
+        needed: usize,
+        /// Core rooms deep and wide enough.
+        found: usize,
+    },
     /// A grid could not be built.
     #[error(transparent)]
     Grid(#[from] slam_core::GridError),

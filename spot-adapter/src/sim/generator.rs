@@ -218,7 +218,7 @@ impl Building {
             rooms.retain(|r| r.inward.x != 0.0 || r.door.y < core[3] - 1e-9);
         }
 
-        Ok(Self::from_generated(
+        let building = Self::from_generated(
             d.boxes,
             rooms,
             Vector2::new(w, h),
@@ -230,7 +230,8 @@ impl Building {
                 Vector2::new(cx0 + 0.5 * cw, cy1 - 0.5 * cw),
             ],
             cw,
-        ))
+        );
+        building.stack_floors(config.floors, config.wall_thickness)
     }
 }
 

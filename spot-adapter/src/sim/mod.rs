@@ -14,7 +14,7 @@
 //! Simplifications, each documented where it lives: by default a scan is cast from one pose (no
 //! motion distortion; [`SimulationConfig::motion_distortion`] turns it on), Spot's body stays
 //! level at a fixed height unless [`GaitSway`] is set (a handheld LiDAR shakes by its
-//! [`HandShake`]), the floor is flat, and surfaces reflect every ray (no intensity, no
+//! [`HandShake`]) or it climbs stairs ([`FloorsTour`]), each floor is flat, and surfaces reflect every ray (no intensity, no
 //! multi-path).
 
 mod building;
@@ -24,6 +24,8 @@ mod commanded_spot;
 mod error;
 mod floor_coverage;
 mod floor_plan;
+mod floor_stacking;
+mod floors_tour;
 mod gait_sway;
 mod generator;
 mod hand_shake;
@@ -38,10 +40,11 @@ mod setting_checks;
 mod simulated_spot;
 mod solid_box;
 mod speed_profile;
+mod staircase;
 mod timed_walk;
 
 pub use building::{Building, Room};
-pub use building_config::BuildingConfig;
+pub use building_config::{BuildingConfig, MAX_FLOORS};
 pub use cloud_folder_writer::{
     CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat,
 };
@@ -49,6 +52,8 @@ pub use commanded_spot::CommandedSpot;
 pub use error::SimError;
 pub use floor_coverage::{FloorCoverage, floor_coverage};
 pub use floor_plan::OBSTACLE_HEIGHT;
+pub use floor_stacking::SLAB_THICKNESS;
+pub use floors_tour::{FloorsTour, STAIRS_SPEED};
 pub use gait_sway::GaitSway;
 pub use hand_shake::HandShake;
 pub use lidar::{LidarConfig, SpinningLidar};
@@ -58,5 +63,6 @@ pub use ray_cast::{HitTarget, RayHit};
 pub use rng::SimRng;
 pub use route::Route;
 pub use route_planning::{RouteConfig, shortest_length};
-pub use simulated_spot::{SimulatedSpot, SimulationConfig};
+pub use simulated_spot::{STAIRS_SLIP, SimulatedSpot, SimulationConfig};
 pub use solid_box::{BoxId, BoxKind, SolidBox};
+pub use staircase::Staircase;

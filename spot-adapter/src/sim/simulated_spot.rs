@@ -10,6 +10,7 @@ use crate::robot::{MotionLimits, Sample, SpotGeometry};
 use crate::sim::SimError;
 use crate::sim::building::Building;
 use crate::sim::building_config::BuildingConfig;
+use crate::sim::floors_tour::FloorsTour;
 use crate::sim::gait_sway::GaitSway;
 use crate::sim::hand_shake::HandShake;
 use crate::sim::lidar::{LidarConfig, SpinningLidar};
@@ -65,6 +66,10 @@ pub struct SimulationConfig {
 /// pitch as well as heading.
 const GYRO_DRIFT_AXIS: [f64; 3] = [0.36, -0.48, 0.8];
 
+/// How many times faster the odometry drifts on a flight of stairs than on the flat: feet slip
+/// on the step edges (the thesis saw Spot's odometry drift most on its stairs walk).
+pub const STAIRS_SLIP: f64 = 3.0;
+
 impl Default for SimulationConfig {
     fn default() -> Self {
         Self {
@@ -119,6 +124,8 @@ pub struct SimulatedSpot {
     body_t_lidar: Pose3,
     motion: Motion,
     truth: Vec<StampedPose>,
+    /// Whether each sample of `truth` is on a flight of stairs (empty: none is).
+    on_stairs: Vec<bool>,
     next: usize,
     motion_distortion: bool,
     gyro_drift: Option<f64>,
@@ -238,6 +245,7 @@ impl SimulatedSpot {
             body_t_lidar,
             motion,
             truth,
+            on_stairs: Vec::new(),
             next: 0,
             motion_distortion: config.motion_distortion,
             gyro_drift: config.gyro_drift,
@@ -253,6 +261,47 @@ impl SimulatedSpot {
         let building = Building::generate(config.seed, &config.building)?;
         let route = Route::corridor_loop(&building);
         Self::new(building, &route, config)
+    }
+
+    /// The tour of every floor ([`FloorsTour`]) of the building `config.building` generates
+    /// for `config.seed`: Spot's walk (whatever `config.motion` says) at `config.speed` on the
+    /// floors and [`STAIRS_SPEED`](crate::sim::STAIRS_SPEED) along the slope of
+    /// the stairs, the odometry drifting [`STAIRS_SLIP`] times faster on them. With one floor,
+    /// [`SimulatedSpot::corridor_loop`].
+    ///
+    /// # Errors
+    /// As [`Building::generate`] and [`SimulatedSpot::new`].
+    pub fn floors_tour(config: &SimulationConfig) -> Result<Self, SimError> {
+        let building = Building::generate(config.seed, &config.building)?;
+        if building.floors() == 1 {
+            let route = Route::corridor_loop(&building);
+            return Self::new(building, &route, config);
+        }
+        let tour = FloorsTour::new(&building)?;
+        let (mut truth, on_stairs) = tour.walk(
+            config.speed,
+            config.lidar.rotation_rate,
+            config.spot.body_height,
+        )?;
+        for p in &mut truth {
+            p.pose *= config.gait_sway.offset(p.stamp);
+        }
+        let walk = SimulationConfig {
+            motion: MotionProfile::Walk,
+            ..config.clone()
+        };
+        let mut sim = Self::new(building, tour.route(), &walk)?;
+        sim.truth = truth;
+        sim.on_stairs = on_stairs;
+        Ok(sim)
+    }
+
+    /// Whether each sample is on a flight of stairs (all `false` off a [`FloorsTour`]).
+    #[must_use]
+    pub fn on_stairs(&self) -> Vec<bool> {
+        (0..self.truth.len())
+            .map(|k| self.on_stairs.get(k).copied().unwrap_or(false))
+            .collect()
     }
 
     /// The building walked through.
@@ -336,8 +385,13 @@ impl Iterator for SimulatedSpot {
             stamp,
             pose: world_t_body,
         } = *self.truth.get(self.next)?;
+        let slip = if self.on_stairs.get(self.next).copied().unwrap_or(false) {
+            STAIRS_SLIP
+        } else {
+            1.0
+        };
         self.next += 1;
-        let odom_t_body = self.odometry.step(&world_t_body);
+        let odom_t_body = self.odometry.step_slipping(&world_t_body, slip);
         let body_t_lidar = self.body_t_lidar;
         let start = world_t_body * body_t_lidar;
         let cloud = match (&self.motion, self.truth.get(self.next)) {

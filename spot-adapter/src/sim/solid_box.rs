@@ -20,6 +20,11 @@ pub enum BoxKind {
     ///
     /// [`Building::add_box`]: crate::sim::Building::add_box
     Obstacle,
+    /// The concrete slab between two floors (the ceiling below, the floor above), with a
+    /// stairwell left open.
+    Slab,
+    /// A step of a staircase, solid down to the floor it stands on.
+    Step,
 }
 
 /// An axis-aligned solid box (metres, world frame).

@@ -16,6 +16,7 @@ mod commanded;
 mod config;
 mod evaluation;
 mod exploration;
+mod floors;
 mod lidar_models;
 mod lidar_only;
 mod motion_profiles;

@@ -1,0 +1,195 @@
+//! Buildings of several floors: the floors setting, the staircase and the slab as rays see
+//! them, and the tour's heights against the steps.
+
+#![allow(clippy::unwrap_used)]
+
+use nalgebra::{Point3, Vector3};
+use spot_adapter::sim::{
+    BoxKind, Building, BuildingConfig, FloorsTour, HitTarget, SLAB_THICKNESS, STAIRS_SPEED,
+    SimError,
+};
+
+fn two_floors(seed: u64) -> Building {
+    let config = BuildingConfig {
+        floors: 2,
+        ..BuildingConfig::default()
+    };
+    Building::generate(seed, &config).unwrap()
+}
+
+/// The kind of box a ray hit, if it hit one.
+fn kind(building: &Building, target: HitTarget) -> Option<BoxKind> {
+    match target {
+        HitTarget::Box(i) => Some(building.boxes()[i].kind),
+        _ => None,
+    }
+}
+
+#[test]
+fn floors_outside_one_to_three_are_refused_by_name() {
+    for floors in [0, 4, 100] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        match Building::generate(1, &config) {
+            Err(SimError::InvalidConfig(e)) => {
+                assert_eq!(e.setting, "floors");
+                assert!((e.value - floors as f64).abs() < 1e-12);
+            }
+            other => panic!("{floors} floors: expected an invalid floors, got {other:?}"),
+        }
+    }
+    // One floor is the default, and the same building as before the setting existed.
+    let one = BuildingConfig {
+        floors: 1,
+        ..BuildingConfig::default()
+    };
+    assert_eq!(BuildingConfig::default(), one);
+    let b = Building::generate(1, &one).unwrap();
+    assert_eq!(b.floors(), 1);
+    assert!(b.staircases().is_empty());
+    assert!((b.top_ceiling() - b.ceiling_height()).abs() < 1e-15);
+    // Every seed's layout has rooms for the staircases, and a tour over them.
+    for seed in 0..30 {
+        let floors = 2 + (seed % 2) as usize;
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        assert_eq!(b.floors(), floors);
+        assert_eq!(b.staircases().len(), floors - 1);
+        FloorsTour::new(&b).unwrap();
+    }
+}
+
+#[test]
+fn rays_see_each_step_the_slab_and_through_the_stairwell() {
+    let b = two_floors(5);
+    let storey = b.floor_height(1);
+    assert!((storey - b.ceiling_height() - SLAB_THICKNESS).abs() < 1e-12);
+    let flight = b.staircases()[0];
+    // The oracle: step k's top at k rises, the rises dividing the storey evenly.
+    let rise = storey / (flight.steps + 1) as f64;
+    assert!((0.15..=0.21).contains(&rise), "rise {rise}");
+    let down = -Vector3::z();
+    for k in 1..=flight.steps {
+        let p = flight.foot + flight.up * ((k as f64 - 0.5) * flight.tread);
+        let origin = Point3::new(p.x, p.y, k as f64 * rise + 0.3);
+        let hit = b.cast_ray(&origin, &down, 10.0).unwrap();
+        assert_eq!(kind(&b, hit.target), Some(BoxKind::Step), "step {k}");
+        assert!(
+            (origin.z - hit.range - k as f64 * rise).abs() < 1e-9,
+            "step {k}"
+        );
+    }
+    // Up from the middle of the flight: through the stairwell to the upper floor's ceiling.
+    let mid = flight.foot + flight.up * (0.5 * flight.run());
+    let origin = Point3::new(mid.x, mid.y, 0.5 * storey + 0.5);
+    let hit = b.cast_ray(&origin, &Vector3::z(), 20.0).unwrap();
+    assert_eq!(hit.target, HitTarget::Ceiling);
+    assert!((hit.range - (storey + b.ceiling_height() - origin.z)).abs() < 1e-9);
+    // Up from the corridor: the slab's underside; down on the floor above: its top.
+    let corridor = b.corridor_loop()[0];
+    let origin = Point3::new(corridor.x, corridor.y, 1.0);
+    let hit = b.cast_ray(&origin, &Vector3::z(), 20.0).unwrap();
+    assert_eq!(kind(&b, hit.target), Some(BoxKind::Slab));
+    assert!((hit.range - (b.ceiling_height() - 1.0)).abs() < 1e-9);
+    let origin = Point3::new(corridor.x, corridor.y, storey + 0.7);
+    let hit = b.cast_ray(&origin, &down, 20.0).unwrap();
+    assert_eq!(kind(&b, hit.target), Some(BoxKind::Slab));
+    assert!((hit.range - 0.7).abs() < 1e-9);
+    // The ground floor's plan counts the staircase as an obstacle, the upper floor not.
+    assert!(b.is_obstacle(mid));
+    assert!(!b.is_obstacle(corridor));
+}
+
+#[test]
+fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let tour = FloorsTour::new(&b).unwrap();
+        let body = 0.5;
+        let (poses, stairs) = tour.walk(0.6, 5.0, body).unwrap();
+        let rise = b.staircases()[0].rise;
+        let mut top = f64::NEG_INFINITY;
+        for (k, p) in poses.iter().enumerate() {
+            let t = p.pose.translation.vector;
+            // The oracle: the surface straight below the body, as a ray finds it.
+            let hit = b.cast_ray(&Point3::from(t), &-Vector3::z(), 20.0).unwrap();
+            let ground = t.z - hit.range;
+            assert!(
+                (t.z - body - ground).abs() <= 0.5 * rise + 1e-9,
+                "seed {seed}, sample {k}: body at {:.3} m over ground at {ground:.3} m",
+                t.z
+            );
+            top = top.max(t.z - body);
+            if stairs[k] && stairs.get(k + 1) == Some(&true) {
+                // Along the slope at the stairs speed, pitched with it.
+                let next = poses[k + 1].pose.translation.vector;
+                let speed = (next - t).norm() * 5.0;
+                assert!((speed - STAIRS_SPEED).abs() < 0.1, "speed {speed}");
+            }
+        }
+        assert!((top - b.floor_height(floors - 1)).abs() < 1e-9, "top {top}");
+        let (first, last) = (poses[0].pose, poses[poses.len() - 1].pose);
+        assert!((first.translation.vector - last.translation.vector).norm() < 1e-9);
+        // Two passes over each flight; the lap of every floor makes the tour long.
+        let climbs = stairs.windows(2).filter(|w| !w[0] && w[1]).count();
+        assert_eq!(climbs, 2 * (floors - 1));
+        assert!(tour.route().length() > 100.0 * floors as f64);
+        // Mid-flight the body pitches with the flight, nose up (a negative pitch) going up.
+        let flight = b.staircases()[0];
+        let slope = (flight.rise / flight.tread).atan();
+        let mid = poses
+            .iter()
+            .zip(&stairs)
+            .find(|(p, on)| {
+                **on && (p.pose.translation.z - body - 0.5 * flight.climb()).abs() < 0.3
+            })
+            .unwrap()
+            .0;
+        let (_, pitch, _) = mid.pose.rotation.euler_angles();
+        assert!((pitch + slope).abs() < 0.05, "pitch {pitch}, slope {slope}");
+    }
+}
+
+/// Graph-SLAM (point-to-plane, the robot's odometry, no place recognition) over seed 1's tour
+/// of two floors, against the truth: ATE and end height within 5 cm. About 20 s in release:
+/// `cargo test --release -p spot-nav-adapter --test integration -- --ignored two_floors`.
+///
+/// With Scan Context added (as the `slam` example runs it) the engine takes the upper floor,
+/// whose layout repeats the ground floor's, for the ground floor and ends 5.6 m low (spot-adapter's
+/// README, "Two floors by the stairs"); this test holds what works, the stairs themselves.
+#[test]
+#[ignore = "about 20 s: maps a 408 m tour over two floors"]
+fn two_floors_are_mapped_through_the_stairs_without_place_recognition() {
+    use spot_adapter::eval::TrajectoryEvaluation;
+    use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
+    use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
+
+    let mut config = SimulationConfig::with_seed(1);
+    config.building.floors = 2;
+    let sim = SimulatedSpot::floors_tour(&config).unwrap();
+    let body_t_lidar = sim.body_t_lidar();
+    let truth = sim.ground_truth();
+    let mut slam = point_to_plane_slam(slam_config()).unwrap();
+    for sample in sim {
+        slam.process(&sample.scan_input());
+    }
+    let (e, _) =
+        TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
+            .unwrap();
+    assert!(e.end_point.path_length > 400.0);
+    assert!(e.ate.rmse <= 0.05, "ATE {} m", e.ate.rmse);
+    assert!(
+        e.height_drift.abs() <= 0.05,
+        "height drift {} m",
+        e.height_drift
+    );
+}
