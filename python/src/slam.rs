@@ -66,6 +66,10 @@ fn slam_settings(dict: Option<&Bound<'_, PyDict>>) -> PyResult<GraphSlamConfig> 
     s.take("loop_min_keyframe_gap", &mut c.loop_min_keyframe_gap)?;
     s.take("loop_max_refine_shift", &mut c.loop_max_refine_shift)?;
     s.take("loop_max_drift_rate", &mut c.loop_max_drift_rate)?;
+    s.take(
+        "loop_max_height_drift_rate",
+        &mut c.loop_max_height_drift_rate,
+    )?;
     s.take("map_voxel_size", &mut c.map_voxel_size)?;
     s.take("min_scan_points", &mut c.min_scan_points)?;
     s.take("deskew", &mut c.deskew)?;

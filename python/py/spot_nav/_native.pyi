@@ -138,6 +138,7 @@ class Slam:
         loop_min_keyframe_gap: int = ...,
         loop_max_refine_shift: float = ...,
         loop_max_drift_rate: float = ...,
+        loop_max_height_drift_rate: float = ...,
         map_voxel_size: float = ...,
         min_scan_points: int = ...,
         deskew: bool = ...,

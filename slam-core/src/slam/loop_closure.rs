@@ -102,8 +102,21 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// radius plus [`GraphSlamConfig::loop_max_drift_rate`](super::GraphSlamConfig) of the
     /// distance walked between them.
     fn drift_allowance(&self, old: usize, new: usize) -> f64 {
-        let walked = (self.keyframes[new].walked - self.keyframes[old].walked).abs();
-        self.config.loop_search_radius + self.config.loop_max_drift_rate * walked
+        self.config.loop_search_radius + self.config.loop_max_drift_rate * self.walked(old, new)
+    }
+
+    /// How far (metres) a loop from keyframe `old` to `new` may move `new` up or down: the
+    /// loop search radius plus
+    /// [`GraphSlamConfig::loop_max_height_drift_rate`](super::GraphSlamConfig) of the distance
+    /// walked between them.
+    fn height_drift_allowance(&self, old: usize, new: usize) -> f64 {
+        self.config.loop_search_radius
+            + self.config.loop_max_height_drift_rate * self.walked(old, new)
+    }
+
+    /// The distance walked between keyframes `old` and `new` (metres).
+    fn walked(&self, old: usize, new: usize) -> f64 {
+        (self.keyframes[new].walked - self.keyframes[old].walked).abs()
     }
 
     /// Try the oldest queued loop candidate: coarse alignment of the new keyframe to the
@@ -192,6 +205,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             (refined.pose.translation.vector - self.keyframe_pose(new).translation.vector).norm();
         if correction > self.drift_allowance(cand, new) {
             return Err(LoopRejection::BeyondDrift);
+        }
+        let rise = (refined.pose.translation.z - self.keyframe_pose(new).translation.z).abs();
+        if rise > self.height_drift_allowance(cand, new) {
+            return Err(LoopRejection::BeyondHeightDrift);
         }
         let info = edge_information(
             self.config.loop_information,

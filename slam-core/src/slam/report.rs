@@ -97,13 +97,18 @@ pub enum LoopRejection {
     /// drifted ([`GraphSlamConfig::loop_max_drift_rate`](super::GraphSlamConfig)): a look-alike
     /// place.
     BeyondDrift,
+    /// The loop would move the new keyframe up or down further than the walk since the old one
+    /// could have drifted in height
+    /// ([`GraphSlamConfig::loop_max_height_drift_rate`](super::GraphSlamConfig)): a floor that
+    /// looks like another.
+    BeyondHeightDrift,
     /// The pose graph refused the edge (a non-finite measurement or information).
     EdgeRefused,
 }
 
 impl LoopRejection {
     /// Every reason, in the order a candidate meets the checks.
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 11] = [
         Self::CoarseTarget,
         Self::CoarseAlignment,
         Self::CoarseNotConverged,
@@ -113,6 +118,7 @@ impl LoopRejection {
         Self::RefineNotConverged,
         Self::RefineShift,
         Self::BeyondDrift,
+        Self::BeyondHeightDrift,
         Self::EdgeRefused,
     ];
 
@@ -129,6 +135,7 @@ impl LoopRejection {
             Self::RefineNotConverged => "refine_not_converged",
             Self::RefineShift => "refine_shift",
             Self::BeyondDrift => "beyond_drift",
+            Self::BeyondHeightDrift => "beyond_height_drift",
             Self::EdgeRefused => "edge_refused",
         }
     }

@@ -46,7 +46,7 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 12] = [
+    let cases: [(GraphSlamConfig, &str); 14] = [
         (
             GraphSlamConfig {
                 sweep_min_gain: f64::NAN,
@@ -81,6 +81,20 @@ fn bad_settings_are_refused_by_name() {
                 ..GraphSlamConfig::default()
             },
             "GraphSlamConfig::loop_max_drift_rate",
+        ),
+        (
+            GraphSlamConfig {
+                loop_max_height_drift_rate: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_max_height_drift_rate",
+        ),
+        (
+            GraphSlamConfig {
+                loop_max_height_drift_rate: -0.01,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::loop_max_height_drift_rate",
         ),
         (
             GraphSlamConfig {
