@@ -37,6 +37,22 @@ pub struct SlamSummary {
     pub points: Option<Points>,
     /// Accuracy against the ground truth, when it is known.
     pub accuracy: Option<Accuracy>,
+    /// The floors the walk stood on, lowest first (`gridmap::FloorLevels` over the scans'
+    /// poses): one for a walk on one floor, none for a walk too short to cover 5 m on a level.
+    pub floors: Vec<FloorSummary>,
+}
+
+/// One floor of the walk.
+#[derive(Clone, Debug, Serialize)]
+pub struct FloorSummary {
+    /// The median height of the scans' poses on it (metres, the map frame).
+    pub height_m: f64,
+    /// How far the walk went on it (metres, horizontally).
+    pub walked_m: f64,
+    /// The scans taken on it.
+    pub scans: usize,
+    /// The keyframes at its height.
+    pub keyframes: usize,
 }
 
 /// What was mapped.

@@ -34,6 +34,12 @@ pub enum GridMapError {
         /// Upper bound of the band above the floor.
         up_to: f64,
     },
+    /// A position of a walk is not finite.
+    #[error("position {index} of the walk is not finite")]
+    NonFinitePosition {
+        /// Its index.
+        index: usize,
+    },
     /// A floor estimate needs at least one hint of where the floor is.
     #[error("no floor hint given (points on the floor under the robot's poses)")]
     NoFloorHint,

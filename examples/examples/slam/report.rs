@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use gridmap::{UnknownCells, inflate};
+use gridmap::{FloorLevels, FloorLevelsConfig, UnknownCells, inflate};
 use nalgebra::Vector2;
 use posegraph::g2o::{G2oGraph, write_g2o};
 use slam_core::io::{PcdEncoding, PlyEncoding, StampedPose, write_pcd, write_ply, write_tum};
@@ -11,7 +11,9 @@ use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3};
 use spot_adapter::nav::{NavigationMap, NavigationMapConfig};
 use spot_adapter::record::DroppedPoints;
 use spot_nav_examples::health::skip_reasons;
-use spot_nav_examples::summary::{Accuracy, Loops, Points, SlamSummary, Times, write_summary};
+use spot_nav_examples::summary::{
+    Accuracy, FloorSummary, Loops, Points, SlamSummary, Times, write_summary,
+};
 use spot_nav_examples::{MappedScans, Mapping, evaluate, out, print_tracking_health, value_name};
 
 use crate::args::Args;
@@ -48,12 +50,14 @@ pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         evaluation,
         seconds: run.seconds,
     };
-    let summary = report(slam, &mapping, points, args, context)?;
+    let mut summary = report(slam, &mapping, points, args, context)?;
     if let (Some(truth), true) = (&truth, args.floors > 1) {
         print_floor_heights(&mapping.estimate, truth, args.floors)?;
     }
+    let floors = split_floors(slam)?;
+    summary.floors = print_floors(slam, &floors)?;
     if let Some(dir) = &args.out {
-        write_outputs(slam, &mapping, dir, args.lidar_height, &summary)?;
+        write_outputs(slam, &mapping, dir, args.lidar_height, &summary, &floors)?;
     }
     if let Some(path) = &args.summary {
         write_summary(path, &summary)?;
@@ -134,7 +138,69 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         time,
         points,
         accuracy,
+        floors: Vec::new(),
     })
+}
+
+/// The walk's floors: its LiDAR poses (the keyframes' frame) split by height.
+fn split_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+) -> Result<FloorLevels> {
+    let positions: Vec<_> = slam
+        .scan_trajectory()
+        .iter()
+        .map(|p| nalgebra::Point3::from(p.pose.translation.vector))
+        .collect();
+    FloorLevels::split(&positions, &FloorLevelsConfig::default())
+        .context("splitting the walk into floors")
+}
+
+/// The floors as `summary.json` gives them; printed when there are several, with the walk's
+/// changes of floor.
+fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &GraphSlam<R, C, O>,
+    floors: &FloorLevels,
+) -> Result<Vec<FloorSummary>> {
+    let keyframe_floors: Vec<Option<usize>> = slam
+        .keyframe_scans()
+        .map(|(pose, _)| floors.floor_at(pose.translation.z))
+        .collect();
+    let summaries: Vec<FloorSummary> = floors
+        .levels()
+        .iter()
+        .enumerate()
+        .map(|(k, level)| FloorSummary {
+            height_m: level.height,
+            walked_m: level.walked,
+            scans: level.poses,
+            keyframes: keyframe_floors.iter().filter(|f| **f == Some(k)).count(),
+        })
+        .collect();
+    if summaries.len() > 1 {
+        let each: Vec<String> = summaries
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                format!(
+                    "floor {k} at {:.2} m ({:.1} m walked, {} keyframes)",
+                    f.height_m, f.walked_m, f.keyframes
+                )
+            })
+            .collect();
+        let changes: Vec<String> = floors
+            .changes()
+            .iter()
+            .map(|c| format!("{}->{}", c.from, c.to))
+            .collect();
+        out!(
+            "floors      {} by height: {}; the walk changed floor {} times ({})",
+            summaries.len(),
+            each.join(", "),
+            changes.len(),
+            changes.join(", ")
+        )?;
+    }
+    Ok(summaries)
 }
 
 /// The height error on each floor of a tour over several floors: the estimate moved rigidly so
@@ -243,6 +309,65 @@ pub(crate) fn print_accuracy(a: &Accuracy) -> Result<()> {
     )
 }
 
+/// A grid per floor in `dir` (`grid_floor{k}.png`, `map_floor{k}.yaml` + `.pgm`), each from
+/// the keyframes at that floor's height with the walk on it drawn; the keyframes between floors
+/// (on the stairs) are in none.
+fn write_floor_grids(
+    scans: &[(Pose3, &slam_core::PointCloud)],
+    mapping: &Mapping,
+    dir: &Path,
+    lidar_height: f64,
+    floors: &FloorLevels,
+) -> Result<()> {
+    let mut written = Vec::new();
+    for k in 0..floors.levels().len() {
+        let on_floor: Vec<(Pose3, &slam_core::PointCloud)> = scans
+            .iter()
+            .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
+            .copied()
+            .collect();
+        let navigation = match NavigationMap::from_scans(
+            &on_floor,
+            lidar_height,
+            &NavigationMapConfig::default(),
+        ) {
+            Ok(navigation) => navigation,
+            Err(e) => {
+                eprintln!("note: no grid for floor {k} ({e:#})");
+                continue;
+            }
+        };
+        let grid = navigation.occupancy();
+        let planning = grid.to_planning_grid(UnknownCells::Free);
+        let inflated = inflate(&planning, INFLATION)?;
+        let path: Vec<_> = mapping
+            .estimate
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| floors.floor_of(*i) == Some(k))
+            .filter_map(|(_, p)| {
+                let t = p.pose.translation.vector;
+                planning.cell_at(Vector2::new(t.x, t.y))
+            })
+            .collect();
+        gridmap::write_png(
+            dir.join(format!("grid_floor{k}.png")),
+            grid,
+            Some(&inflated),
+            &path,
+            &[],
+        )?;
+        gridmap::write_ros_map(grid, dir.join(format!("map_floor{k}.yaml")))?;
+        written.push(format!("grid_floor{k}.png, map_floor{k}.yaml + .pgm"));
+    }
+    out!(
+        "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, {}, summary.json",
+        dir.display(),
+        written.join(", ")
+    )?;
+    Ok(())
+}
+
 /// The map, trajectory, graph, grid and summary in `dir` (made here, after the run).
 pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
@@ -250,6 +375,7 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     dir: &Path,
     lidar_height: f64,
     summary: &SlamSummary,
+    floors: &FloorLevels,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     write_summary(&dir.join("summary.json"), summary)?;
@@ -259,6 +385,9 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
     write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
     let scans: Vec<_> = slam.keyframe_scans().collect();
+    if floors.levels().len() > 1 {
+        return write_floor_grids(&scans, mapping, dir, lidar_height, floors);
+    }
     match NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default()) {
         Ok(navigation) => {
             let grid = navigation.occupancy();

@@ -200,3 +200,43 @@ fn two_floors_are_mapped_through_the_stairs_with_place_recognition() {
     assert!(report.place_candidates > 0);
     assert!(report.loop_rejections.get(LoopRejection::BeyondHeightDrift) > 0);
 }
+
+/// The tour's body poses split by height (`gridmap::FloorLevels`) give one floor per storey at
+/// the building's floor heights plus the body's height, every pose standing on a floor on that
+/// floor (the oracle: the building's own floor heights, and the tour's flags for the poses on
+/// the stairs), and the changes of floor the tour makes, up and back down.
+#[test]
+fn the_tour_splits_into_its_floors_by_height() {
+    use gridmap::{FloorLevels, FloorLevelsConfig};
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let body = 0.5;
+        let (poses, stairs) = FloorsTour::new(&b).unwrap().walk(0.6, 5.0, body).unwrap();
+        let positions: Vec<Point3<f64>> = poses
+            .iter()
+            .map(|p| Point3::from(p.pose.translation.vector))
+            .collect();
+        let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
+        assert_eq!(split.levels().len(), floors, "seed {seed}");
+        for (k, level) in split.levels().iter().enumerate() {
+            let truth = b.floor_height(k) + body;
+            assert!((level.height - truth).abs() < 0.02, "floor {k}: {level:?}");
+        }
+        for (i, p) in positions.iter().enumerate() {
+            if !stairs[i] {
+                let k = (0..floors)
+                    .find(|&k| (p.z - body - b.floor_height(k)).abs() < 0.05)
+                    .unwrap();
+                assert_eq!(split.floor_of(i), Some(k), "seed {seed}, pose {i}");
+            }
+        }
+        let changes: Vec<(usize, usize)> = split.changes().iter().map(|c| (c.from, c.to)).collect();
+        let mut expected: Vec<(usize, usize)> = (1..floors).map(|k| (k - 1, k)).collect();
+        expected.extend((1..floors).rev().map(|k| (k, k - 1)));
+        assert_eq!(changes, expected, "seed {seed}");
+    }
+}
