@@ -15,7 +15,8 @@ use crate::nav::travel_costs::TravelCosts;
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrontierGoal {
     /// Where the robot would stand (metres, map frame): the reachable cell nearest the
-    /// frontier's middle.
+    /// frontier's middle, or when none is within reach of it, the reachable cell nearest the
+    /// frontier.
     pub goal: Vector2<f64>,
     /// The frontier.
     pub frontier: Frontier,
@@ -132,7 +133,7 @@ impl Explorer {
         for frontier in frontiers {
             let Some((goal_cell, cost)) = costs
                 .as_ref()
-                .and_then(|c| self.goal_of(blocked, c, frontier.middle))
+                .and_then(|c| self.goal_of(blocked, c, &frontier))
             else {
                 decision.unreachable.push(frontier);
                 continue;
@@ -216,35 +217,37 @@ impl Explorer {
             .any(|g| (g.goal - goal).norm() <= self.config.give_up_radius)
     }
 
-    /// The reachable cell nearest `middle` within the goal reach (ties: the shorter walk), and
-    /// the walk there. (A goal kept 0.2 m inside the free space, away from the
-    /// inflation's edge, was blocked less often by the wall found beyond, but often could not
-    /// see its frontier: more walks and more walking.)
-    fn goal_of(&self, blocked: &BitGrid, costs: &TravelCosts, middle: Cell) -> Option<(Cell, f64)> {
+    /// The reachable cell nearest the frontier's middle within the goal reach (ties: the
+    /// shorter walk), and the walk there; when none is, the reachable cell nearest any of its
+    /// cells. A long frontier (a corridor's side seen from its far end) can have its middle on a
+    /// strip of free cells the inflation cuts off while its ends lie by the walkable floor:
+    /// walking to an end shows more of it, and the rest is decided again. (A goal kept 0.2 m
+    /// inside the free space, away from the inflation's edge, was blocked less often by the
+    /// wall found beyond, but often could not see its frontier: more walks and more walking.)
+    fn goal_of(
+        &self,
+        blocked: &BitGrid,
+        costs: &TravelCosts,
+        frontier: &Frontier,
+    ) -> Option<(Cell, f64)> {
         let r = (self.config.goal_reach / blocked.geometry().resolution).ceil() as i64;
-        let r2 = r * r;
-        let mut best: Option<(i64, f64, Cell)> = None;
-        for dy in -r..=r {
-            for dx in -r..=r {
-                let d2 = dx * dx + dy * dy;
-                if d2 > r2 {
-                    continue;
-                }
-                let (x, y) = (i64::from(middle.x) + dx, i64::from(middle.y) + dy);
-                let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
-                    continue;
-                };
-                let cell = Cell::new(x, y);
-                if let Some(cost) = costs.to(cell)
-                    && best
-                        .as_ref()
-                        .is_none_or(|&(bd, bc, _)| (d2, cost) < (bd, bc))
-                {
-                    best = Some((d2, cost, cell));
-                }
-            }
+        if let Some((_, cost, cell)) = nearest_reachable(costs, frontier.middle, r) {
+            return Some((cell, cost));
         }
-        best.map(|(_, cost, cell)| (cell, cost))
+        // Every few cells of the frontier: discs half a reach apart cover what every cell's
+        // would, at a fraction of the lookups.
+        let stride = usize::try_from(r / 2).unwrap_or(1).max(1);
+        frontier
+            .cells
+            .iter()
+            .step_by(stride)
+            .filter_map(|&c| nearest_reachable(costs, c, r))
+            .min_by(|a, b| {
+                (a.0, a.1)
+                    .partial_cmp(&(b.0, b.1))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .map(|(_, cost, cell)| (cell, cost))
     }
 
     /// Unknown area (square metres) a sensor at `middle` would see within sensor range: the
@@ -280,6 +283,34 @@ impl Explorer {
         }
         unknown as f64 * resolution * resolution
     }
+}
+
+/// The reachable cell nearest `centre` within `r` cells (ties: the shorter walk), with its
+/// squared distance in cells and the walk there.
+fn nearest_reachable(costs: &TravelCosts, centre: Cell, r: i64) -> Option<(i64, f64, Cell)> {
+    let r2 = r * r;
+    let mut best: Option<(i64, f64, Cell)> = None;
+    for dy in -r..=r {
+        for dx in -r..=r {
+            let d2 = dx * dx + dy * dy;
+            if d2 > r2 {
+                continue;
+            }
+            let (x, y) = (i64::from(centre.x) + dx, i64::from(centre.y) + dy);
+            let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
+                continue;
+            };
+            let cell = Cell::new(x, y);
+            if let Some(cost) = costs.to(cell)
+                && best
+                    .as_ref()
+                    .is_none_or(|&(bd, bc, _)| (d2, cost) < (bd, bc))
+            {
+                best = Some((d2, cost, cell));
+            }
+        }
+    }
+    best
 }
 
 /// How far (metres) the goal of the frontier walked to may move between decisions and still be
@@ -409,6 +440,65 @@ mod tests {
             assert_eq!(decision.unreachable.len(), 1);
             assert_eq!(decision.unreachable[0].size(), 16, "the patch's rim");
         }
+    }
+
+    /// A walled room 2 m square with a gap in its east wall, and through the gap a strip of
+    /// free cells 0.3 m wide and 4 m long (a corridor seen down its length from the room): the
+    /// strip's rim is one frontier whose middle lies 2 m out on cells the inflation blocks, more
+    /// than the goal reach from any reachable cell, while its near end is within reach.
+    #[test]
+    fn a_frontier_whose_middle_is_cut_off_is_reached_at_its_end() {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(70, 25, geometry, CellState::Unknown).unwrap();
+        for y in 0..=21 {
+            for x in 0..=60 {
+                let wall = (x <= 21 && (y == 0 || y == 21))
+                    || x == 0
+                    || (x == 21 && !(9..=11).contains(&y));
+                let state = if wall {
+                    CellState::Occupied
+                } else if x < 21 || (9..=11).contains(&y) {
+                    CellState::Free
+                } else {
+                    continue;
+                };
+                g.set(Cell::new(x, y), state).unwrap();
+            }
+        }
+        let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+        let blocked = planning.blocked();
+        let reach = ExplorerConfig::default().goal_reach;
+        let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
+        let chosen = decision.chosen.unwrap();
+        assert!(
+            decision.unreachable.is_empty(),
+            "{:?}",
+            decision.unreachable
+        );
+        assert!(chosen.frontier.size() > 70, "{chosen:?}");
+        // The oracle, by brute force over the grid: no cell the robot can reach lies within
+        // the goal reach of the frontier's middle, so the old rule found it unreachable ...
+        let costs =
+            TravelCosts::from_start(blocked, blocked.cell_at(Vector2::new(1.0, 1.0)).unwrap());
+        let middle = geometry.cell_center(chosen.frontier.middle);
+        let mut reachable = Vec::new();
+        for y in 0..blocked.height() {
+            for x in 0..blocked.width() {
+                if costs.to(Cell::new(x, y)).is_some() {
+                    reachable.push(geometry.cell_center(Cell::new(x, y)));
+                }
+            }
+        }
+        assert!(reachable.iter().all(|c| (c - middle).norm() > reach));
+        // ... and the goal is a reachable cell within the reach of one of its cells.
+        assert!(reachable.iter().any(|c| (c - chosen.goal).norm() < 1e-9));
+        let near_a_cell = chosen
+            .frontier
+            .cells
+            .iter()
+            .any(|&c| (geometry.cell_center(c) - chosen.goal).norm() <= reach + 1e-9);
+        assert!(near_a_cell, "{chosen:?}");
     }
 
     #[test]
