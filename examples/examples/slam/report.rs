@@ -187,13 +187,32 @@ fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
                 )
             })
             .collect();
+        let poses = slam.scan_trajectory();
         let changes: Vec<String> = floors
             .changes()
             .iter()
-            .map(|c| format!("{}->{}", c.from, c.to))
+            .map(|c| {
+                let at = |i: usize| {
+                    poses
+                        .get(i)
+                        .map_or_else(nalgebra::Vector3::zeros, |p| p.pose.translation.vector)
+                };
+                let (from, to) = (at(c.left_at), at(c.arrived_at));
+                let length: f64 = poses.get(c.left_at..=c.arrived_at).map_or(0.0, |run| {
+                    run.windows(2)
+                        .map(|w| {
+                            (w[1].pose.translation.vector - w[0].pose.translation.vector).norm()
+                        })
+                        .sum()
+                });
+                format!(
+                    "{}->{} from ({:.1}, {:.1}) to ({:.1}, {:.1}) over {length:.1} m",
+                    c.from, c.to, from.x, from.y, to.x, to.y
+                )
+            })
             .collect();
         out!(
-            "floors      {} by height: {}; the walk changed floor {} times ({})",
+            "floors      {} by height: {}; the walk changed floor {} times: {}",
             summaries.len(),
             each.join(", "),
             changes.len(),

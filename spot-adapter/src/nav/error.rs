@@ -52,6 +52,26 @@ pub enum NavError {
         /// The path's last cell.
         last: slam_core::Cell,
     },
+    /// A floor number beyond the floors given.
+    #[error("{what} is on floor {floor}, but there are {floors} floors (0 to {floors} - 1)")]
+    NoSuchFloor {
+        /// What was on it (`the goal`, `a stairs link's top`, ...).
+        what: &'static str,
+        /// The floor given.
+        floor: usize,
+        /// How many floors there are.
+        floors: usize,
+    },
+    /// A cell off its floor's grid.
+    #[error("{what} ({}, {}) is off floor {floor}'s grid", cell.x, cell.y)]
+    OffFloorGrid {
+        /// What it is (`the start`, `a stairs link's foot`, ...).
+        what: &'static str,
+        /// The floor.
+        floor: usize,
+        /// The cell given.
+        cell: slam_core::Cell,
+    },
 }
 
 /// Why [`drive`](super::drive) stopped early; the robot was sent a stop first.
