@@ -89,6 +89,10 @@ pub struct FrontierDecision {
 pub struct Explorer {
     config: ExplorerConfig,
     given_up: Vec<GivenUpFrontier>,
+    /// Per give-up: the decision it was made at, and whether it lapses (a first `NoPath`).
+    given_up_at: Vec<(usize, bool)>,
+    /// Decisions made.
+    decisions: usize,
     /// The goal of the last decision (metres, map frame), kept by [`FrontierChoice::Tour`].
     heading_for: Option<Vector2<f64>>,
 }
@@ -103,6 +107,8 @@ impl Explorer {
         Ok(Self {
             config,
             given_up: Vec::new(),
+            given_up_at: Vec::new(),
+            decisions: 0,
             heading_for: None,
         })
     }
@@ -117,6 +123,7 @@ impl Explorer {
         planning: &PlanningGrid,
         position: Vector2<f64>,
     ) -> FrontierDecision {
+        self.decisions += 1;
         let blocked = planning.blocked();
         let frontiers = find_frontiers(occupancy, self.config.min_frontier_cells);
         let start = nearest_free(blocked, position, self.config.goal_reach);
@@ -196,7 +203,15 @@ impl Explorer {
     /// Give up the frontier whose goal is `goal` (metres, map frame): frontiers with a goal
     /// within [`ExplorerConfig::give_up_radius`] of it are not picked again.
     pub fn give_up(&mut self, goal: Vector2<f64>, reason: GiveUpReason) {
+        // A first `NoPath` lapses after a while: the map it was planned on has grown since (a
+        // gap seen closed from one side can be open from the other, a wall's inflation seen
+        // early narrower than it first looked).
+        let again = self.given_up.iter().any(|g| {
+            g.reason == GiveUpReason::NoPath && (g.goal - goal).norm() <= self.config.give_up_radius
+        });
+        let lapses = reason == GiveUpReason::NoPath && !again;
         self.given_up.push(GivenUpFrontier { goal, reason });
+        self.given_up_at.push((self.decisions, lapses));
     }
 
     /// The frontiers given up so far, in order.
@@ -211,10 +226,16 @@ impl Explorer {
         &self.config
     }
 
+    /// Whether a frontier with its goal at `goal` was given up, and not for a first `NoPath`
+    /// [`NO_PATH_LAPSES_AFTER`] decisions ago or more.
     fn is_given_up(&self, goal: Vector2<f64>) -> bool {
         self.given_up
             .iter()
-            .any(|g| (g.goal - goal).norm() <= self.config.give_up_radius)
+            .zip(&self.given_up_at)
+            .any(|(g, &(at, lapses))| {
+                (g.goal - goal).norm() <= self.config.give_up_radius
+                    && !(lapses && self.decisions >= at + NO_PATH_LAPSES_AFTER)
+            })
     }
 
     /// The reachable cell nearest the frontier's middle within the goal reach (ties: the
@@ -312,6 +333,10 @@ fn nearest_reachable(costs: &TravelCosts, centre: Cell, r: i64) -> Option<(i64, 
     }
     best
 }
+
+/// Decisions after which a frontier given up for a first `NoPath` may be tried again (on the
+/// small buildings, about 25 m of walk).
+const NO_PATH_LAPSES_AFTER: usize = 20;
 
 /// How far (metres) the goal of the frontier walked to may move between decisions and still be
 /// taken for the same frontier: a frontier seen from nearer shrinks, and its middle moves.
@@ -510,7 +535,7 @@ mod tests {
             .chosen
             .unwrap()
             .goal;
-        explorer.give_up(goal, GiveUpReason::NoPath);
+        explorer.give_up(goal, GiveUpReason::Blocked);
         let decision = explorer.decide(&g, &planning, Vector2::new(1.0, 1.0));
         assert_eq!(decision.chosen, None, "nothing left to explore");
         assert_eq!((decision.reachable, decision.given_up), (0, 1));
@@ -518,9 +543,42 @@ mod tests {
             explorer.given_up(),
             [GivenUpFrontier {
                 goal,
-                reason: GiveUpReason::NoPath
+                reason: GiveUpReason::Blocked
             }]
         );
+    }
+
+    /// A frontier given up for a first `NoPath` is tried again once the map has been decided
+    /// on `NO_PATH_LAPSES_AFTER` more times; a second `NoPath` there, or any other reason, is
+    /// for good.
+    #[test]
+    fn a_first_no_path_lapses_and_a_second_does_not() {
+        let (g, planning) = corridor_and_patch();
+        let at = Vector2::new(1.0, 1.0);
+        for (reason, lapses) in [
+            (GiveUpReason::NoPath, true),
+            (GiveUpReason::Blocked, false),
+            (GiveUpReason::StillUnknownFromGoal, false),
+        ] {
+            let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+            let goal = explorer.decide(&g, &planning, at).chosen.unwrap().goal;
+            explorer.give_up(goal, reason);
+            for _ in 1..NO_PATH_LAPSES_AFTER {
+                assert_eq!(
+                    explorer.decide(&g, &planning, at).chosen,
+                    None,
+                    "{reason:?}"
+                );
+            }
+            let again = explorer.decide(&g, &planning, at).chosen;
+            assert_eq!(again.map(|c| c.goal), lapses.then_some(goal), "{reason:?}");
+            if lapses {
+                explorer.give_up(goal, GiveUpReason::NoPath);
+                for _ in 0..3 * NO_PATH_LAPSES_AFTER {
+                    assert_eq!(explorer.decide(&g, &planning, at).chosen, None);
+                }
+            }
+        }
     }
 
     #[test]

@@ -210,9 +210,8 @@ fn bad_exploration_settings_are_refused_by_name() {
 /// The README's figures: the greedy explorer, the tour (`FrontierChoice::Tour`, 2 m margin) and
 /// ours (the default) on small buildings, seeds 11-14 or `EXPLORATION_SEEDS=15-16`; coverage and
 /// collisions checked for greedy and ours, the distances printed (2026-12-05, against greedy,
-/// seeds 11-16: tour 0.92x, 1.09x, 1.17x, 1.26x, 1.10x, 1.19x; ours 1.22x, 1.13x, 1.28x, 1.34x,
-/// 1.59x, 1.17x, with 97.1 % and 95.3 % coverage on 11 and 12: this test fails on seed 12, an
-/// open defect of issue 35). About a minute a building:
+/// seeds 11-16: tour 1.02x, 0.97x, 1.39x, 1.53x, 1.20x, 1.54x; ours 1.05x, 1.00x, 1.27x, 1.72x,
+/// 1.21x, 0.87x, 100 % coverage on each). About a minute a building:
 /// `cargo test -p spot-nav-adapter --release --test integration
 /// exploration::against_the_greedy_explorer -- --ignored --nocapture`.
 #[test]
