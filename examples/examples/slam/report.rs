@@ -54,8 +54,9 @@ pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     if let (Some(truth), true) = (&truth, args.floors > 1) {
         print_floor_heights(&mapping.estimate, truth, args.floors)?;
     }
-    let floors = split_floors(slam)?;
-    summary.floors = print_floors(slam, &floors)?;
+    let poses = slam.scan_trajectory();
+    let floors = split_floors(&poses)?;
+    summary.floors = print_floors(slam, &poses, &floors)?;
     if let Some(dir) = &args.out {
         write_outputs(slam, &mapping, dir, args.lidar_height, &summary, &floors)?;
     }
@@ -142,12 +143,9 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     })
 }
 
-/// The walk's floors: its LiDAR poses (the keyframes' frame) split by height.
-fn split_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
-    slam: &GraphSlam<R, C, O>,
-) -> Result<FloorLevels> {
-    let positions: Vec<_> = slam
-        .scan_trajectory()
+/// The walk's floors: its scans' LiDAR poses (the keyframes' frame) split by height.
+fn split_floors(poses: &[StampedPose]) -> Result<FloorLevels> {
+    let positions: Vec<_> = poses
         .iter()
         .map(|p| nalgebra::Point3::from(p.pose.translation.vector))
         .collect();
@@ -159,6 +157,7 @@ fn split_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
 /// changes of floor.
 fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     slam: &GraphSlam<R, C, O>,
+    poses: &[StampedPose],
     floors: &FloorLevels,
 ) -> Result<Vec<FloorSummary>> {
     let keyframe_floors: Vec<Option<usize>> = slam
@@ -187,7 +186,6 @@ fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
                 )
             })
             .collect();
-        let poses = slam.scan_trajectory();
         let changes: Vec<String> = floors
             .changes()
             .iter()
@@ -356,27 +354,18 @@ fn write_floor_grids(
                 continue;
             }
         };
-        let grid = navigation.occupancy();
-        let planning = grid.to_planning_grid(UnknownCells::Free);
-        let inflated = inflate(&planning, INFLATION)?;
-        let path: Vec<_> = mapping
+        let walked = mapping
             .estimate
             .iter()
             .enumerate()
             .filter(|(i, _)| floors.floor_of(*i) == Some(k))
-            .filter_map(|(_, p)| {
-                let t = p.pose.translation.vector;
-                planning.cell_at(Vector2::new(t.x, t.y))
-            })
-            .collect();
-        gridmap::write_png(
-            dir.join(format!("grid_floor{k}.png")),
-            grid,
-            Some(&inflated),
-            &path,
-            &[],
+            .map(|(_, p)| p);
+        write_grid(
+            &navigation,
+            walked,
+            &dir.join(format!("grid_floor{k}.png")),
+            &dir.join(format!("map_floor{k}.yaml")),
         )?;
-        gridmap::write_ros_map(grid, dir.join(format!("map_floor{k}.yaml")))?;
         written.push(format!("grid_floor{k}.png, map_floor{k}.yaml + .pgm"));
     }
     out!(
@@ -384,6 +373,28 @@ fn write_floor_grids(
         dir.display(),
         written.join(", ")
     )?;
+    Ok(())
+}
+
+/// `navigation`'s grid as a picture at `png` (obstacles inflated, the `walked` poses drawn) and
+/// as a ROS map at `yaml`.
+fn write_grid<'a>(
+    navigation: &NavigationMap,
+    walked: impl Iterator<Item = &'a StampedPose>,
+    png: &Path,
+    yaml: &Path,
+) -> Result<()> {
+    let grid = navigation.occupancy();
+    let planning = grid.to_planning_grid(UnknownCells::Free);
+    let inflated = inflate(&planning, INFLATION)?;
+    let path: Vec<_> = walked
+        .filter_map(|p| {
+            let t = p.pose.translation.vector;
+            planning.cell_at(Vector2::new(t.x, t.y))
+        })
+        .collect();
+    gridmap::write_png(png, grid, Some(&inflated), &path, &[])?;
+    gridmap::write_ros_map(grid, yaml)?;
     Ok(())
 }
 
@@ -409,19 +420,12 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     }
     match NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default()) {
         Ok(navigation) => {
-            let grid = navigation.occupancy();
-            let planning = grid.to_planning_grid(UnknownCells::Free);
-            let inflated = inflate(&planning, INFLATION)?;
-            let path: Vec<_> = mapping
-                .estimate
-                .iter()
-                .filter_map(|p| {
-                    let t = p.pose.translation.vector;
-                    planning.cell_at(Vector2::new(t.x, t.y))
-                })
-                .collect();
-            gridmap::write_png(dir.join("grid.png"), grid, Some(&inflated), &path, &[])?;
-            gridmap::write_ros_map(grid, dir.join("map.yaml"))?;
+            write_grid(
+                &navigation,
+                mapping.estimate.iter(),
+                &dir.join("grid.png"),
+                &dir.join("map.yaml"),
+            )?;
             out!(
                 "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, grid.png, map.yaml + map.pgm, summary.json",
                 dir.display()
