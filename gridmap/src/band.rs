@@ -2,13 +2,13 @@
 //! height plus a margin, from a map cloud or from scans with free space from their beams.
 
 use nalgebra::{Point3, Vector2};
-use slam_core::{Cell, PointCloud, Pose3};
+use slam_core::{PointCloud, Pose3};
 
+use crate::band_accumulator::FloorBandAccumulator;
 use crate::builder::{OccupancyGridBuilder, extent};
 use crate::error::{GridMapError, check, check_not_negative};
 use crate::floor::FloorMap;
 use crate::occupancy::{CellState, OccupancyGrid};
-use crate::rays::{below_top, clip_to_box, traverse};
 
 /// The obstacle band, in metres above the local floor ([`FloorMap`]): points from `above_floor`
 /// to `up_to` are obstacles. Spot: the body frame is 0.50 m above the ground, the LiDAR 0.30 m
@@ -148,129 +148,9 @@ impl OccupancyGridBuilder {
         if scans.iter().all(|(_, c)| c.is_empty()) {
             return Err(GridMapError::EmptyCloud);
         }
-        let (min, max) = scan_bounds(scans, floor, band)?;
-        let mut grid = self.empty_grid(min, max, CellState::Unknown)?;
-        let g = *grid.geometry();
-        let (w, h) = (grid.width(), grid.height());
-        let cells = w as usize * h as usize;
-        let min_points = self.config().min_points;
-        let mut counts = if min_points > 1 {
-            vec![0u32; cells]
-        } else {
-            Vec::new()
-        };
-        // Per-scan stamps of the end cells already traced, for beams to obstacles and to free
-        // ends.
-        let (mut hit_stamp, mut free_stamp) = (vec![0u32; cells], vec![0u32; cells]);
-        let mut beams: Vec<(Vector2<f64>, Vector2<f64>, bool)> = Vec::new();
-        let size = Vector2::new(f64::from(w), f64::from(h));
-        let to_cells = |p: Point3<f64>| (p.coords.xy() - g.origin) / g.resolution;
-        let index = |v: Vector2<f64>| {
-            let (x, y) = (v.x.floor(), v.y.floor());
-            (x >= 0.0 && y >= 0.0 && x < f64::from(w) && y < f64::from(h))
-                .then(|| y as usize * w as usize + x as usize)
-        };
-        for (k, (pose, cloud)) in scans.iter().enumerate() {
-            let stamp = k as u32 + 1;
-            let origin = Point3::from(pose.translation.vector);
-            beams.clear();
-            for p in world_points(pose, cloud) {
-                let (lo, hi) = band_at(floor, band, p.x, p.y);
-                let kind = classify(p.z, (lo, hi));
-                let Some((a, b)) = below_top(origin, p, hi) else {
-                    continue;
-                };
-                let Some((a, b, cut)) = clip_to_box(to_cells(a), to_cells(b), size) else {
-                    continue;
-                };
-                let end = index(b);
-                if kind == Height::Obstacle && !cut {
-                    if let Some(i) = end {
-                        let c = Cell::new((i % w as usize) as u32, (i / w as usize) as u32);
-                        if min_points > 1 {
-                            counts[i] = counts[i].saturating_add(1);
-                            if counts[i] >= min_points {
-                                grid.set(c, CellState::Occupied)?;
-                            }
-                        } else {
-                            grid.set(c, CellState::Occupied)?;
-                        }
-                        if hit_stamp[i] == stamp {
-                            continue;
-                        }
-                        hit_stamp[i] = stamp;
-                    }
-                    beams.push((a, b, false));
-                } else {
-                    if let Some(i) = end {
-                        if free_stamp[i] == stamp {
-                            continue;
-                        }
-                        free_stamp[i] = stamp;
-                    }
-                    beams.push((a, b, true));
-                }
-            }
-            for &(a, b, include_end) in &beams {
-                traverse(a, b, include_end, |x, y| {
-                    if x >= 0 && y >= 0 && x < i64::from(w) && y < i64::from(h) {
-                        let c = Cell::new(x as u32, y as u32);
-                        if grid.state(c) == CellState::Unknown {
-                            // Free and occupied both are known: setting a known free cell free
-                            // again is a no-op, and an occupied one stays occupied.
-                            let _ = grid.set(c, CellState::Free);
-                        }
-                    }
-                });
-            }
-        }
-        Ok(grid)
+        let mut all =
+            FloorBandAccumulator::new(self.config().clone(), floor.clone(), band.clone())?;
+        all.add_scans(scans)?;
+        all.grid()
     }
-}
-
-/// The extent (x, y) of the scan origins, band points and floor points.
-fn scan_bounds(
-    scans: &[(Pose3, &PointCloud)],
-    floor: &FloorMap,
-    band: &ObstacleBandConfig,
-) -> Result<(Vector2<f64>, Vector2<f64>), GridMapError> {
-    let mut bounds: Option<(Vector2<f64>, Vector2<f64>)> = None;
-    let mut any_hit = false;
-    for (pose, cloud) in scans {
-        if !cloud.is_empty() {
-            OccupancyGridBuilder::check_cloud(cloud)?;
-        }
-        let mut grow = |p: Vector2<f64>| {
-            bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.inf(&p), hi.sup(&p))));
-        };
-        grow(pose.translation.vector.xy());
-        for p in world_points(pose, cloud) {
-            match classify(p.z, band_at(floor, band, p.x, p.y)) {
-                Height::Obstacle => {
-                    any_hit = true;
-                    grow(p.coords.xy());
-                }
-                Height::Floor => grow(p.coords.xy()),
-                Height::Overhang => {}
-            }
-        }
-    }
-    match bounds {
-        Some(b) if any_hit => Ok(b),
-        _ => Err(GridMapError::EmptyBand {
-            above_floor: band.above_floor,
-            up_to: band.up_to,
-        }),
-    }
-}
-
-/// The points of `cloud` in the world frame.
-fn world_points<'a>(
-    pose: &'a Pose3,
-    cloud: &'a PointCloud,
-) -> impl Iterator<Item = Point3<f64>> + 'a {
-    cloud
-        .points()
-        .iter()
-        .map(move |p| pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
 }

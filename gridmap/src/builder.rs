@@ -70,13 +70,13 @@ impl OccupancyGridBuilder {
         ))
     }
 
-    /// A grid over `extent` (min and max world x, y) with the configured margin.
-    pub(crate) fn empty_grid(
+    /// The geometry and size (columns, rows) of the grid over `min`..`max` (world x, y) with
+    /// the configured margin: its origin on a multiple of the resolution.
+    pub(crate) fn empty_grid_geometry(
         &self,
         min: Vector2<f64>,
         max: Vector2<f64>,
-        fill: CellState,
-    ) -> Result<OccupancyGrid, GridMapError> {
+    ) -> Result<(GridGeometry, u32, u32), GridMapError> {
         let r = self.config.resolution;
         let m = self.config.margin;
         let origin = Vector2::new(((min.x - m) / r).floor() * r, ((min.y - m) / r).floor() * r);
@@ -91,7 +91,18 @@ impl OccupancyGridBuilder {
                 max_cells: self.config.max_cells,
             });
         }
-        OccupancyGrid::new(w as u32, h as u32, GridGeometry::try_new(origin, r)?, fill)
+        Ok((GridGeometry::try_new(origin, r)?, w as u32, h as u32))
+    }
+
+    /// A grid over `extent` (min and max world x, y) with the configured margin.
+    pub(crate) fn empty_grid(
+        &self,
+        min: Vector2<f64>,
+        max: Vector2<f64>,
+        fill: CellState,
+    ) -> Result<OccupancyGrid, GridMapError> {
+        let (geometry, w, h) = self.empty_grid_geometry(min, max)?;
+        OccupancyGrid::new(w, h, geometry, fill)
     }
 
     /// Mark occupied every cell holding at least `min_points` of `points` (world x, y).

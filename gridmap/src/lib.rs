@@ -92,6 +92,7 @@
 //! the floor (drop-offs, stairs down).
 
 mod band;
+mod band_accumulator;
 mod builder;
 mod config;
 mod distance;
@@ -107,6 +108,7 @@ mod rays;
 mod ros_map;
 
 pub use band::ObstacleBandConfig;
+pub use band_accumulator::FloorBandAccumulator;
 pub use builder::OccupancyGridBuilder;
 pub use config::OccupancyGridConfig;
 pub use distance::{DistanceField, inflate, squared_distance_cells};

@@ -33,13 +33,30 @@ pub(crate) fn clip_to_box(
     b: Vector2<f64>,
     size: Vector2<f64>,
 ) -> Option<(Vector2<f64>, Vector2<f64>, bool)> {
+    clip_to_bounds(a, b, Vector2::zeros(), size)
+}
+
+/// The part of the segment from `a` to `b` inside the box `lo`..`hi` (Liang-Barsky), and
+/// whether `b` was cut off; `None` when it misses the box. A segment inside the box is returned as it
+/// is, so that its cells do not depend on the box.
+#[inline]
+pub(crate) fn clip_to_bounds(
+    a: Vector2<f64>,
+    b: Vector2<f64>,
+    lo: Vector2<f64>,
+    hi: Vector2<f64>,
+) -> Option<(Vector2<f64>, Vector2<f64>, bool)> {
+    let inside = |v: Vector2<f64>| v.x >= lo.x && v.y >= lo.y && v.x < hi.x && v.y < hi.y;
+    if inside(a) && inside(b) {
+        return Some((a, b, false));
+    }
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for (p, q) in [
-        (-d.x, a.x),
-        (d.x, size.x - a.x),
-        (-d.y, a.y),
-        (d.y, size.y - a.y),
+        (-d.x, a.x - lo.x),
+        (d.x, hi.x - a.x),
+        (-d.y, a.y - lo.y),
+        (d.y, hi.y - a.y),
     ] {
         if p == 0.0 {
             if q < 0.0 {
@@ -57,14 +74,14 @@ pub(crate) fn clip_to_box(
     if t0 > t1 {
         return None;
     }
-    // Keep the clipped end a hair inside the box so that its cell is on the grid.
-    let inside = |v: Vector2<f64>| {
+    // Keep the clipped ends a hair inside the box so that their cells are on the grid.
+    let keep_in = |v: Vector2<f64>| {
         Vector2::new(
-            v.x.clamp(0.0, (size.x - 1e-9).max(0.0)),
-            v.y.clamp(0.0, (size.y - 1e-9).max(0.0)),
+            v.x.clamp(lo.x, (hi.x - 1e-9).max(lo.x)),
+            v.y.clamp(lo.y, (hi.y - 1e-9).max(lo.y)),
         )
     };
-    Some((inside(a + d * t0), inside(a + d * t1), t1 < 1.0))
+    Some((keep_in(a + d * t0), keep_in(a + d * t1), t1 < 1.0))
 }
 
 /// `x.floor()` as an integer, without the library call `f64::floor` compiles to on baseline

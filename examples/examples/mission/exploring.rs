@@ -173,6 +173,8 @@ pub(crate) fn explore_building<R: MapRegistrator, C: MapRegistrator, O: Optimize
         ate_m: evaluation.ate.rmse,
         decisions: report.decisions,
         decision_ms_mean: mean(&report.decision_ms),
+        decision_ms_max: report.decision_ms.iter().copied().fold(0.0, f64::max),
+        full_renders: report.full_renders,
         cycle_ms_mean: mean(&compute_ms),
         frontiers_given_up: report.given_up.iter().map(|g| g.reason.name()).collect(),
         frontiers_unreachable: report.last_decision.unreachable.len(),
@@ -194,7 +196,7 @@ pub(crate) fn explore_building<R: MapRegistrator, C: MapRegistrator, O: Optimize
 /// The exploration's line of figures.
 fn print_exploration(s: &ExplorationSummary) -> Result<()> {
     out!(
-        "exploration {}: {:.1} % of {:.0} m² of reachable floor known free; {:.1} m walked in {} scans, {} keyframes, {} loops closed; ATE {:.3} m; {} decisions ({:.0} ms mean), {:.1} ms mean per scan; {} frontiers given up, {} unreachable left; {} collisions; {:.1} s",
+        "exploration {}: {:.1} % of {:.0} m² of reachable floor known free; {:.1} m walked in {} scans, {} keyframes, {} loops closed; ATE {:.3} m; {} decisions ({:.0} ms mean, {:.0} ms max, {} maps rendered afresh), {:.1} ms mean per scan; {} frontiers given up, {} unreachable left; {} collisions; {:.1} s",
         s.outcome,
         100.0 * s.coverage,
         s.reachable_floor_m2,
@@ -205,6 +207,8 @@ fn print_exploration(s: &ExplorationSummary) -> Result<()> {
         s.ate_m,
         s.decisions,
         s.decision_ms_mean,
+        s.decision_ms_max,
+        s.full_renders,
         s.cycle_ms_mean,
         s.frontiers_given_up.len(),
         s.frontiers_unreachable,

@@ -48,6 +48,11 @@ pub(crate) struct ExplorationSummary {
     /// Frontier decisions (a map rendered, a frontier picked, a navigator made).
     pub(crate) decisions: usize,
     pub(crate) decision_ms_mean: f64,
+    pub(crate) decision_ms_max: f64,
+    /// Decisions whose map was rendered afresh from every keyframe kept (the first, after a
+    /// loop closure moved the keyframes, when the map grew by half); the others added the new
+    /// keyframes only.
+    pub(crate) full_renders: usize,
     /// The engine and the navigator on one scan, the decisions apart.
     pub(crate) cycle_ms_mean: f64,
     /// Why each frontier given up was (`no_path`, `blocked`, `lost`,

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use gridmap::PlanningGrid;
 use nalgebra::Vector2;
-use slam_core::{CloudError, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, Registrator};
 
 use crate::nav::NavError;
 use crate::nav::config::NavigatorConfig;
@@ -16,6 +16,7 @@ use crate::nav::explorer::{
 };
 use crate::nav::explorer_config::ExplorerConfig;
 use crate::nav::frontier::is_frontier_cell;
+use crate::nav::growing_map::GrowingMap;
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::navigator::Navigator;
 use crate::nav::step::NavigationStep;
@@ -38,11 +39,16 @@ pub struct ExplorationReport {
     pub outcome: ExplorationOutcome,
     /// Samples taken.
     pub cycles: usize,
-    /// Frontier decisions made (each on a map rendered afresh from the keyframes).
+    /// Frontier decisions made (each on the map grown by the keyframes since the last one, or
+    /// rendered afresh: see `full_renders`).
     pub decisions: usize,
     /// Milliseconds of each decision that started a walk: rendering the map, picking the
     /// frontier and making the navigator on that map.
     pub decision_ms: Vec<f64>,
+    /// Decisions whose map was rendered afresh from every keyframe kept (the first, after a
+    /// loop closure moved the keyframes, and when the map has grown by half since the last);
+    /// the others added only the keyframes that came since.
+    pub full_renders: usize,
     /// Length of the body's path as the engine estimated it (metres).
     pub walked: f64,
     /// The frontiers given up on the way, and why.
@@ -74,7 +80,9 @@ pub struct ExplorationCycle<'a> {
 /// Explore with `robot` from where it stands: each sample goes into `slam` (a fresh engine: its
 /// map frame is the first scan's odometry frame); after every
 /// [`ExplorerConfig::decide_every`] new keyframes, a closed loop, or the end of a walk, the
-/// occupancy grid is rendered from the keyframes at their current poses, the [`Explorer`]
+/// occupancy grid is brought up to date (the keyframes since the last decision added to it, or
+/// all of them rendered afresh at their current poses when a loop moved one by more than half a
+/// cell or the map grew by half since the last such render), the [`Explorer`]
 /// picks a frontier, and a [`Navigator`] on that map (localising with `localiser`, settings
 /// `navigator` with its goal tolerance set to [`ExplorerConfig::arrive_within`]) walks toward
 /// it (it does not wait for what newly blocks the way: that is unknown space turning out to be
@@ -119,6 +127,7 @@ struct Exploration {
     cycles: usize,
     decisions: usize,
     decision_ms: Vec<f64>,
+    full_renders: usize,
     walked: f64,
     last_position: Option<Vector2<f64>>,
     /// The goal of the last walk, when it ended there.
@@ -159,6 +168,7 @@ impl Exploration {
             cycles: 0,
             decisions: 0,
             decision_ms: Vec::new(),
+            full_renders: 0,
             walked: 0.0,
             last_position: None,
             arrived_at: None,
@@ -196,15 +206,21 @@ impl Exploration {
             body_t_lidar = sample.body_t_lidar;
             slam.process(&sample.scan_input());
         }
+        let explorer = self.explorer.config();
+        let mut map = GrowingMap::new(
+            self.navigator.map_config(),
+            lidar_height,
+            explorer.keyframe_spacing,
+            explorer.map_voxel,
+            explorer.sensor_range,
+        );
         loop {
             let started = Instant::now();
             let map_t_body = slam
                 .current_lidar_pose()
                 .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
-            let scans = spread_keyframes(slam, self.explorer.config().keyframe_spacing);
-            let navigation =
-                NavigationMap::from_scans(&scans, lidar_height, &self.navigator.map_config())
-                    .map_err(ExplorationError::Navigation)?;
+            let (navigation, cloud) = map.update(slam)?;
+            self.full_renders = map.full_renders();
             let planning =
                 PlanningGrid::new(navigation.occupancy(), self.navigator.planning.clone())
                     .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
@@ -239,8 +255,6 @@ impl Exploration {
                     map_t_body,
                 ));
             }
-            let cloud = map_cloud(&scans, self.explorer.config().map_voxel)
-                .map_err(ExplorationError::Map)?;
             let mut walker = Navigator::new(
                 localiser.clone(),
                 &cloud,
@@ -382,6 +396,7 @@ impl Exploration {
             cycles: self.cycles,
             decisions: self.decisions,
             decision_ms: self.decision_ms.clone(),
+            full_renders: self.full_renders,
             walked: self.walked,
             given_up: self.explorer.given_up().to_vec(),
             last_decision,
@@ -389,36 +404,4 @@ impl Exploration {
             map_t_body,
         }
     }
-}
-
-/// The keyframes the map is rendered from: the first in each square of `spacing` metres (by
-/// LiDAR position) and the newest. A LiDAR sees all round, so one scan per square shows what
-/// the others do, and the render costs what the area explored costs, not the walk.
-fn spread_keyframes<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
-    slam: &GraphSlam<R, C, O>,
-    spacing: f64,
-) -> Vec<(Pose3, &PointCloud)> {
-    let mut squares = std::collections::HashSet::new();
-    let count = slam.keyframe_count();
-    slam.keyframe_scans()
-        .enumerate()
-        .filter(|(k, (pose, _))| {
-            let at = pose.translation.vector / spacing;
-            let square = (at.x.floor() as i64, at.y.floor() as i64);
-            squares.insert(square) || k + 1 == count
-        })
-        .map(|(_, scan)| scan)
-        .collect()
-}
-
-/// The map cloud of `scans` (each at its `map_T_lidar`), voxel-filtered at `voxel`.
-fn map_cloud(scans: &[(Pose3, &PointCloud)], voxel: f32) -> Result<PointCloud, CloudError> {
-    let mut all = PointCloud::new();
-    for (pose, cloud) in scans {
-        // Channels may differ between scans; the map keeps positions only.
-        all.extend_from(&PointCloud::from_points(
-            cloud.transformed(pose).into_parts().0,
-        ))?;
-    }
-    all.voxel_downsample(voxel)
 }

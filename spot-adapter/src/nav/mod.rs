@@ -68,6 +68,7 @@ mod floor_levelling;
 mod floor_route;
 mod frontier;
 mod frontier_tour;
+mod growing_map;
 mod localiser;
 mod navigation_map;
 mod navigator;

@@ -63,6 +63,11 @@ impl NavigationMap {
         Ok(Self { occupancy, floor })
     }
 
+    /// From an occupancy grid built over `floor` (the explorer's, grown scan by scan).
+    pub(crate) fn from_parts(occupancy: OccupancyGrid, floor: FloorMap) -> Self {
+        Self { occupancy, floor }
+    }
+
     /// The occupancy grid (occupied, free, unknown).
     #[must_use]
     pub fn occupancy(&self) -> &OccupancyGrid {

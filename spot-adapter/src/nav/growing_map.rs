@@ -1,0 +1,262 @@
+//! `GrowingMap`: the explorer's navigation map and localisation cloud, grown by the keyframes
+//! added since the last decision instead of rendered afresh from all of them at every decision.
+
+use std::collections::HashSet;
+
+use gridmap::{FloorBandAccumulator, FloorMap, floor_hints_below};
+use nalgebra::Point3;
+use rustc_hash::FxHashMap;
+use slam_core::{CloudError, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
+
+use crate::nav::NavError;
+use crate::nav::config::NavigationMapConfig;
+use crate::nav::error::ExplorationError;
+use crate::nav::navigation_map::NavigationMap;
+
+/// A rendered keyframe that moved farther than this share of a grid cell (or turned so far that
+/// a point [`GrowingMap`]'s `range` away moved so far) since it was rendered calls for a full
+/// render: half a cell keeps every cell within one of where a fresh render puts it.
+const MOVED_CELLS: f64 = 0.5;
+
+/// A full render also re-estimates the floor once the keyframes rendered have grown by this
+/// factor since the last one: the floor of the new places is otherwise extrapolated from the
+/// old ones (exact on one flat floor), and the full renders cost, summed, what a constant
+/// number of renders of the final map costs.
+const FLOOR_REFRESH_GROWTH: f64 = 1.5;
+
+/// The navigation map ([`NavigationMap`]) of a walk's keyframes, one per square of `spacing`
+/// metres (the first seen in it) plus the newest of each update, and their points thinned to
+/// `voxel` for localisation. An update adds the keyframes that came since the last; everything
+/// is rendered afresh (floor included) when a rendered keyframe moved by more than half a grid
+/// cell (a loop closed) or the keyframes grew by half since the last full render.
+pub(crate) struct GrowingMap {
+    config: NavigationMapConfig,
+    lidar_height: f64,
+    spacing: f64,
+    /// How far a turn is measured out (metres): the sensor's range.
+    range: f64,
+    /// Keyframes rendered: index and the pose they were rendered at.
+    rendered: Vec<(usize, Pose3)>,
+    squares: HashSet<(i64, i64)>,
+    /// Keyframes looked at so far.
+    seen: usize,
+    band: Option<FloorBandAccumulator>,
+    /// Keyframes rendered at the last full render.
+    rendered_at_full: usize,
+    cloud: VoxelCentroids,
+    /// Full renders so far.
+    full_renders: usize,
+}
+
+impl GrowingMap {
+    /// An empty map; see the type's docs for `spacing`, `voxel` and `range`.
+    pub(crate) fn new(
+        config: NavigationMapConfig,
+        lidar_height: f64,
+        spacing: f64,
+        voxel: f32,
+        range: f64,
+    ) -> Self {
+        Self {
+            config,
+            lidar_height,
+            spacing,
+            range,
+            rendered: Vec::new(),
+            squares: HashSet::new(),
+            seen: 0,
+            band: None,
+            rendered_at_full: 0,
+            cloud: VoxelCentroids::new(voxel),
+            full_renders: 0,
+        }
+    }
+
+    /// Full renders so far.
+    pub(crate) fn full_renders(&self) -> usize {
+        self.full_renders
+    }
+
+    /// The navigation map and the localisation cloud with the keyframes `slam` has now.
+    ///
+    /// # Errors
+    /// [`ExplorationError::Navigation`] with [`NavError::NavigationGrid`] when the grid or the
+    /// floor cannot be built (or [`NavError::InvalidConfig`] for bad settings),
+    /// [`ExplorationError::Map`] when the map cloud cannot be.
+    pub(crate) fn update<R, C, O, E>(
+        &mut self,
+        slam: &GraphSlam<R, C, O>,
+    ) -> Result<(NavigationMap, PointCloud), ExplorationError<E>>
+    where
+        R: MapRegistrator,
+        C: MapRegistrator,
+        O: Optimizer<Pose3>,
+        E: std::error::Error + Send + Sync + 'static,
+    {
+        let keyframes: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
+        self.update_from(&keyframes)
+    }
+
+    /// [`Self::update`] with the walk's keyframes (`map_T_lidar` and points, in order).
+    fn update_from<E: std::error::Error + Send + Sync + 'static>(
+        &mut self,
+        keyframes: &[(Pose3, &PointCloud)],
+    ) -> Result<(NavigationMap, PointCloud), ExplorationError<E>> {
+        let cell = self.config.grid.resolution;
+        let limit = MOVED_CELLS * cell;
+        let moved = self.rendered.iter().any(|&(k, at)| {
+            keyframes.get(k).is_none_or(|(now, _)| {
+                let d = at.inverse() * now;
+                d.translation.vector.norm() + d.rotation.angle() * self.range > limit
+            })
+        });
+        let grown = self.rendered.len() as f64
+            >= FLOOR_REFRESH_GROWTH * self.rendered_at_full.max(1) as f64;
+        let grid_error = |e| ExplorationError::Navigation(NavError::NavigationGrid(e));
+        if self.band.is_none() || moved || grown {
+            self.full_render(keyframes)?;
+        } else {
+            let fresh = self.pick(keyframes);
+            let scans: Vec<(Pose3, &PointCloud)> = fresh.iter().map(|&k| keyframes[k]).collect();
+            if let Some(band) = self.band.as_mut() {
+                band.add_scans(&scans).map_err(grid_error)?;
+            }
+            self.cloud.add(&scans).map_err(ExplorationError::Map)?;
+            self.rendered
+                .extend(fresh.iter().map(|&k| (k, keyframes[k].0)));
+        }
+        let band = self
+            .band
+            .as_ref()
+            .ok_or(grid_error(gridmap::GridMapError::EmptyCloud))?;
+        let occupancy = band.grid().map_err(grid_error)?;
+        let navigation = NavigationMap::from_parts(occupancy, band.floor().clone());
+        Ok((navigation, self.cloud.cloud()))
+    }
+
+    /// Everything rendered afresh from `keyframes` at their current poses.
+    fn full_render<E: std::error::Error + Send + Sync + 'static>(
+        &mut self,
+        keyframes: &[(Pose3, &PointCloud)],
+    ) -> Result<(), ExplorationError<E>> {
+        let grid_error = |e| ExplorationError::Navigation(NavError::NavigationGrid(e));
+        self.config
+            .validate()
+            .map_err(ExplorationError::Navigation)?;
+        self.rendered.clear();
+        self.squares.clear();
+        self.seen = 0;
+        let picked = self.pick(keyframes);
+        let scans: Vec<(Pose3, &PointCloud)> = picked.iter().map(|&k| keyframes[k]).collect();
+        let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
+        let hints = floor_hints_below(&poses, self.lidar_height);
+        let floor = FloorMap::estimate_from_scans(&scans, &hints, &self.config.floor)
+            .map_err(grid_error)?;
+        let mut band =
+            FloorBandAccumulator::new(self.config.grid.clone(), floor, self.config.band.clone())
+                .map_err(grid_error)?;
+        band.add_scans(&scans).map_err(grid_error)?;
+        self.cloud.clear();
+        self.cloud.add(&scans).map_err(ExplorationError::Map)?;
+        self.band = Some(band);
+        self.rendered = picked.iter().map(|&k| (k, keyframes[k].0)).collect();
+        self.rendered_at_full = self.rendered.len();
+        self.full_renders += 1;
+        Ok(())
+    }
+
+    /// The keyframes from the first not looked at yet that are the first in their square (by
+    /// LiDAR position), and the newest when it is not one of them or rendered already.
+    fn pick(&mut self, keyframes: &[(Pose3, &PointCloud)]) -> Vec<usize> {
+        let mut picked = Vec::new();
+        for (k, (pose, _)) in keyframes.iter().enumerate().skip(self.seen) {
+            let at = pose.translation.vector / self.spacing;
+            if self
+                .squares
+                .insert((at.x.floor() as i64, at.y.floor() as i64))
+            {
+                picked.push(k);
+            }
+        }
+        self.seen = keyframes.len();
+        if let Some(newest) = keyframes.len().checked_sub(1)
+            && picked.last() != Some(&newest)
+            && self.rendered.last().map(|&(k, _)| k) != Some(newest)
+        {
+            picked.push(newest);
+        }
+        picked
+    }
+}
+
+/// Points of placed scans thinned to one centroid per cubic voxel, added scan by scan: the
+/// cloud [`PointCloud::voxel_downsample`] gives for the scans merged in the order added.
+pub(crate) struct VoxelCentroids {
+    voxel: f32,
+    index: FxHashMap<[i64; 3], usize>,
+    sums: Vec<([f64; 3], u32)>,
+}
+
+impl VoxelCentroids {
+    pub(crate) fn new(voxel: f32) -> Self {
+        Self {
+            voxel,
+            index: FxHashMap::default(),
+            sums: Vec::new(),
+        }
+    }
+
+    pub(crate) fn clear(&mut self) {
+        self.index.clear();
+        self.sums.clear();
+    }
+
+    /// Adds each scan's points moved by its pose (non-finite ones skipped).
+    ///
+    /// # Errors
+    /// [`CloudError::InvalidVoxelSize`] unless the voxel is finite and positive.
+    pub(crate) fn add(&mut self, scans: &[(Pose3, &PointCloud)]) -> Result<(), CloudError> {
+        if !(self.voxel.is_finite() && self.voxel > 0.0) {
+            return Err(CloudError::InvalidVoxelSize { size: self.voxel });
+        }
+        let inv = 1.0 / f64::from(self.voxel);
+        for (pose, cloud) in scans {
+            let moved = cloud.transformed(pose);
+            for p in moved.points() {
+                if !p.iter().all(|v| v.is_finite()) {
+                    continue;
+                }
+                let v = [f64::from(p.x), f64::from(p.y), f64::from(p.z)];
+                let key = v.map(|c| (c * inv).floor() as i64);
+                let next = self.sums.len();
+                let slot = *self.index.entry(key).or_insert(next);
+                if slot == next {
+                    self.sums.push(([0.0; 3], 0));
+                }
+                let (sum, count) = &mut self.sums[slot];
+                for (s, c) in sum.iter_mut().zip(v) {
+                    *s += c;
+                }
+                *count += 1;
+            }
+        }
+        Ok(())
+    }
+
+    /// The centroids, in the order their voxels were first met.
+    pub(crate) fn cloud(&self) -> PointCloud {
+        PointCloud::from_points(
+            self.sums
+                .iter()
+                .map(|(s, n)| {
+                    let n = f64::from(*n);
+                    Point3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32)
+                })
+                .collect(),
+        )
+    }
+}
+
+#[cfg(test)]
+#[path = "growing_map_tests.rs"]
+mod tests;

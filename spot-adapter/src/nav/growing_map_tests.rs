@@ -1,0 +1,166 @@
+use super::*;
+use crate::nav::config::NavigatorConfig;
+use gridmap::CellState;
+use nalgebra::{Translation3, UnitQuaternion, Vector3};
+use slam_core::Cell;
+
+type Error = ExplorationError<std::io::Error>;
+
+/// A scan of a corridor 2 m wide along x with walls 2.5 m high, seen from x = `at` (the LiDAR
+/// 0.6 m above the floor): wall points at all heights, floor points, in the LiDAR frame.
+fn corridor_scan(at: f64) -> (Pose3, PointCloud) {
+    let mut points = Vec::new();
+    for i in 0..120 {
+        let x = -3.0 + 0.05 * f64::from(i);
+        for k in 0..10 {
+            let z = 0.25 * f64::from(k);
+            points.push(Point3::new(x as f32, 1.0, (z - 0.6) as f32));
+            points.push(Point3::new(x as f32, -1.0, (z - 0.6) as f32));
+        }
+        for k in 0..7 {
+            let y = -0.9 + 0.3 * f64::from(k);
+            points.push(Point3::new(x as f32, y as f32, -0.6));
+        }
+    }
+    (
+        Pose3::translation(at, 0.0, 0.6),
+        PointCloud::from_points(points),
+    )
+}
+
+fn map() -> GrowingMap {
+    GrowingMap::new(NavigatorConfig::default().map_config(), 0.6, 1.0, 0.1, 4.0)
+}
+
+fn refs(scans: &[(Pose3, PointCloud)]) -> Vec<(Pose3, &PointCloud)> {
+    scans.iter().map(|(p, c)| (*p, c)).collect()
+}
+
+/// The map cloud grown scan by scan is the scans merged and thinned at once.
+#[test]
+fn centroids_grown_scan_by_scan_are_the_merged_scans_thinned() {
+    let scans: Vec<_> = (0..5).map(|k| corridor_scan(0.7 * f64::from(k))).collect();
+    let mut grown = VoxelCentroids::new(0.1);
+    for s in refs(&scans) {
+        grown.add(&[s]).unwrap();
+    }
+    let mut merged = PointCloud::new();
+    for (pose, cloud) in &scans {
+        merged.extend_from(&cloud.transformed(pose)).unwrap();
+    }
+    let want = merged.voxel_downsample(0.1).unwrap();
+    let got = grown.cloud();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.points().iter().zip(want.points()) {
+        assert!((g - w).norm() < 1e-5, "{g} vs {w}");
+    }
+    assert!(VoxelCentroids::new(f32::NAN).add(&refs(&scans)).is_err());
+}
+
+/// Keyframes walked along the corridor: one a square of 1 m and the newest are rendered, only
+/// the new ones at each update; the grid is the one all of them give at once; a keyframe moved
+/// by more than half a cell, or a map grown by half, is rendered afresh.
+#[test]
+fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
+    // Keyframes every 0.25 m: four a square.
+    let scans: Vec<_> = (0..40)
+        .map(|k| corridor_scan(0.25 * f64::from(k)))
+        .collect();
+    let mut m = map();
+    let (first, _) = m
+        .update_from::<std::io::Error>(&refs(&scans[..24]))
+        .unwrap();
+    assert_eq!(m.full_renders(), 1);
+    // Squares 0-5 (keyframes 0, 4, ..., 20) and the newest (23).
+    assert_eq!(
+        m.rendered.iter().map(|r| r.0).collect::<Vec<_>>(),
+        [0, 4, 8, 12, 16, 20, 23]
+    );
+    let (second, cloud) = m
+        .update_from::<std::io::Error>(&refs(&scans[..28]))
+        .unwrap();
+    assert_eq!(
+        m.full_renders(),
+        1,
+        "grown by two: added, not rendered afresh"
+    );
+    assert_eq!(
+        m.rendered.iter().map(|r| r.0).collect::<Vec<_>>(),
+        [0, 4, 8, 12, 16, 20, 23, 24, 27]
+    );
+    // The grid of every rendered keyframe added at once over the same floor.
+    let rendered: Vec<(Pose3, &PointCloud)> = m
+        .rendered
+        .iter()
+        .map(|&(k, _)| (scans[k].0, &scans[k].1))
+        .collect();
+    let mut all = FloorBandAccumulator::new(
+        m.config.grid.clone(),
+        first.floor().clone(),
+        m.config.band.clone(),
+    )
+    .unwrap();
+    all.add_scans(&rendered).unwrap();
+    let want = all.grid().unwrap();
+    assert_eq!(second.occupancy().geometry(), want.geometry());
+    let (mut same, mut other) = (0, 0);
+    for y in 0..want.height() {
+        for x in 0..want.width() {
+            let c = Cell::new(x, y);
+            let (g, w) = (second.occupancy().state(c), want.state(c));
+            if g == w {
+                same += 1;
+            } else {
+                // Only a beam above the band beyond the grid of its time may be missing.
+                assert_eq!((w, g), (CellState::Free, CellState::Unknown), "cell {c:?}");
+                other += 1;
+            }
+        }
+    }
+    assert!(other * 100 <= same, "{other} of {same}");
+    assert!(second.occupancy().counts().1 > 100);
+    assert!(!cloud.is_empty());
+    // A keyframe moved by 2 cm (a fifth of a cell): kept as rendered.
+    let mut moved = scans.clone();
+    moved[4].0 = Pose3::from_parts(Translation3::new(1.02, 0.0, 0.6), moved[4].0.rotation);
+    m.update_from::<std::io::Error>(&refs(&moved[..29]))
+        .unwrap();
+    assert_eq!(m.full_renders(), 1);
+    // Turned by 1 degree: a point 4 m out moves 7 cm, more than half a cell.
+    moved[4].0.rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 1f64.to_radians());
+    m.update_from::<std::io::Error>(&refs(&moved[..30]))
+        .unwrap();
+    assert_eq!(m.full_renders(), 2);
+    assert_eq!(
+        m.rendered.iter().find(|r| r.0 == 4).map(|r| r.1),
+        Some(moved[4].0)
+    );
+    // Grown by half since that render: the floor is estimated again.
+    let before = m.rendered.len();
+    let mut k = 30;
+    while m.full_renders() == 2 && k < moved.len() {
+        k += 1;
+        m.update_from::<std::io::Error>(&refs(&moved[..k])).unwrap();
+    }
+    assert_eq!(m.full_renders(), 3);
+    assert!(m.rendered.len() <= before + before.div_ceil(2) + 1);
+}
+
+/// Scans without any point in the obstacle band give no map, and say why.
+#[test]
+fn a_map_without_obstacles_is_refused_by_name() {
+    let floor_only = PointCloud::from_points(vec![Point3::new(1.0, 0.0, -0.6); 50]);
+    let mut m = map();
+    let err = m
+        .update_from::<std::io::Error>(&[(Pose3::translation(0.0, 0.0, 0.6), &floor_only)])
+        .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::Navigation(NavError::NavigationGrid(
+                gridmap::GridMapError::EmptyBand { .. }
+            ))
+        ),
+        "{err:?}"
+    );
+}
