@@ -80,8 +80,9 @@ pub(crate) struct Args {
     #[arg(long, value_enum, default_value_t = StartArea::Corridor, conflicts_with = "lap")]
     pub(crate) start: StartArea,
     /// The generated building: `office` (a 34-44 m x 16-20 m corridor loop with rooms on both
-    /// sides), or `small` (a 10 m x 10 m loop, about 17 m x 17 m in all) [default: small when
-    /// exploring, office with `--lap`].
+    /// sides), `small` (a 10 m x 10 m loop, about 17 m x 17 m in all) or `large` (a 100-110 m x
+    /// 44-50 m loop, four times the office or more) [default: small when exploring, office with
+    /// `--lap`].
     #[arg(long, value_enum)]
     pub(crate) building: Option<BuildingSize>,
     /// Odometry and loop refinement backend of the mapping.
@@ -190,12 +191,14 @@ pub(crate) enum BuildingSize {
     Office,
     /// About the smallest building the generator makes (`BuildingConfig::small`).
     Small,
+    /// Four times the office floor or more (`BuildingConfig::large`: a 100-110 m x 44-50 m
+    /// corridor loop, about 115 m x 57 m in all).
+    Large,
 }
 
 impl BuildingSize {
-    /// `--building`, else the small building when exploring (the explorer does not yet cover
-    /// the office: it stops at 60 % with the long edges of corridors left unreachable) and the
-    /// office on the lap.
+    /// `--building`, else the small building when exploring (it takes seconds) and the office
+    /// on the lap.
     pub(crate) fn chosen(args: &Args) -> Self {
         args.building
             .unwrap_or(if args.lap { Self::Office } else { Self::Small })
@@ -205,6 +208,7 @@ impl BuildingSize {
         match self {
             Self::Office => BuildingConfig::default(),
             Self::Small => BuildingConfig::small(),
+            Self::Large => BuildingConfig::large(),
         }
     }
 }

@@ -94,6 +94,19 @@ impl BuildingConfig {
         }
     }
 
+    /// A floor four times the default's or more (the exploration issue's large building): a
+    /// 100-110 m x 44-50 m corridor loop with rooms 3-7 m wide on both sides and a core of rooms
+    /// inside, about 115 m x 57 m and 100-110 rooms in all.
+    #[must_use]
+    pub fn large() -> Self {
+        Self {
+            loop_length_x: (100.0, 110.0),
+            loop_length_y: (44.0, 50.0),
+            room_width: (3.0, 7.0),
+            ..Self::default()
+        }
+    }
+
     /// The floor count: 1 to [`MAX_FLOORS`].
     fn validate_floors(&self) -> Result<(), SimError> {
         if (1..=MAX_FLOORS).contains(&self.floors) {

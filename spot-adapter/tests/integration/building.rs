@@ -481,3 +481,26 @@ fn the_blank_corridor_has_flat_walls_and_changes_nothing_else() {
         assert_every_room_is_reachable(&b, seed);
     }
 }
+
+/// The large building is at least four times the default office floor (the exploration
+/// issue's 6,000 m² and 100 rooms), on several seeds, with every room reachable from the
+/// corridor.
+#[test]
+fn the_large_building_is_four_offices_with_a_hundred_rooms() {
+    for seed in 0..3 {
+        let office = building(seed);
+        let large = Building::generate(seed, &BuildingConfig::large()).unwrap();
+        let area = |b: &Building| b.size().x * b.size().y;
+        eprintln!(
+            "seed {seed}: large {:.0} m², {} rooms; office {:.0} m², {} rooms",
+            area(&large),
+            large.rooms().len(),
+            area(&office),
+            office.rooms().len()
+        );
+        assert!(area(&large) >= 6000.0, "{} m²", area(&large));
+        assert!(area(&large) >= 4.0 * area(&office));
+        assert!(large.rooms().len() >= 100, "{} rooms", large.rooms().len());
+        assert_every_room_is_reachable(&large, seed);
+    }
+}
