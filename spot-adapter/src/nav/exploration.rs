@@ -134,6 +134,8 @@ struct Exploration {
     arrived_at: Option<Vector2<f64>>,
     /// Goals a walk failed to once.
     failures: Vec<Vector2<f64>>,
+    /// The odometry of the last sample the engine took.
+    last_odometry: Option<Pose3>,
 }
 
 /// How one walk toward a frontier ended.
@@ -173,6 +175,7 @@ impl Exploration {
             last_position: None,
             arrived_at: None,
             failures: Vec::new(),
+            last_odometry: None,
         })
     }
 
@@ -205,6 +208,7 @@ impl Exploration {
             self.cycles += 1;
             body_t_lidar = sample.body_t_lidar;
             slam.process(&sample.scan_input());
+            self.last_odometry = Some(sample.odom_t_body);
         }
         let explorer = self.explorer.config();
         let mut map = GrowingMap::new(
@@ -255,15 +259,21 @@ impl Exploration {
                     map_t_body,
                 ));
             }
-            let mut walker = Navigator::new(
+            // The planning grid the frontier was picked on is the navigator's too.
+            let mut walker = Navigator::planned(
                 localiser.clone(),
                 &cloud,
                 &navigation,
+                planning,
                 map_t_body,
                 robot.description(),
                 self.navigator.clone(),
             )
             .map_err(ExplorationError::Navigation)?;
+            // The pose is the last sample's: the walk from there on is the odometry's.
+            if let Some(odom_t_body) = self.last_odometry {
+                walker = walker.with_start_odometry(odom_t_body);
+            }
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             match self.walk(robot, slam, &mut walker, &chosen, max_cycles, observe)? {
                 WalkEnd::Decide => {}
@@ -326,6 +336,7 @@ impl Exploration {
             self.cycles += 1;
             let started = Instant::now();
             slam.process(&sample.scan_input());
+            self.last_odometry = Some(sample.odom_t_body);
             let step = navigator
                 .step(&sample, goal)
                 .map_err(ExplorationError::Navigation)?;

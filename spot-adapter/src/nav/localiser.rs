@@ -273,6 +273,12 @@ impl<R: Registrator> Localiser<R> {
         })
     }
 
+    /// Takes `odom_t_body` as the odometry at the instant of the current estimate, so that the
+    /// next update carries the estimate along the odometry's motion since.
+    pub(crate) fn set_odometry(&mut self, odom_t_body: Pose3) {
+        self.last_odom_t_body = Some(odom_t_body);
+    }
+
     /// The registrator it localises with.
     pub(crate) fn registrator(&self) -> &R {
         &self.registrator

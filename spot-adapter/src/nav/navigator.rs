@@ -94,12 +94,37 @@ impl<R: Registrator> Navigator<R> {
     ) -> Result<Self, NavError> {
         config.validate()?;
         robot.limits.validate()?;
+        let planning = PlanningGrid::new(navigation.occupancy(), config.planning.clone())
+            .map_err(NavError::NavigationGrid)?;
+        Self::planned(
+            registrator,
+            map,
+            navigation,
+            planning,
+            map_t_body,
+            robot,
+            config,
+        )
+    }
+
+    /// [`Navigator::new`] with `planning`, the planning grid of `navigation`'s occupancy with
+    /// `config.planning`, made already (the explorer's, which it picked its frontier on).
+    pub(crate) fn planned(
+        registrator: R,
+        map: &PointCloud,
+        navigation: &NavigationMap,
+        planning: PlanningGrid,
+        map_t_body: Pose3,
+        robot: &RobotDescription,
+        config: NavigatorConfig,
+    ) -> Result<Self, NavError> {
+        config.validate()?;
+        robot.limits.validate()?;
         let target = registrator
             .prepare_target(map)
             .map_err(NavError::LocalisationMap)?;
+        // The live layer starts equal to the map, so its planning grid is the map's.
         let live = LiveLayer::new(navigation.occupancy().clone(), config.live.clone())
-            .map_err(NavError::NavigationGrid)?;
-        let planning = PlanningGrid::new(live.combined(), config.planning.clone())
             .map_err(NavError::NavigationGrid)?;
         let static_planning = planning.clone();
         let planner = config.planner;
@@ -122,6 +147,18 @@ impl<R: Registrator> Navigator<R> {
             replans: 0,
             recoveries: 0,
         })
+    }
+
+    /// This navigator told the robot's odometry at the instant its starting pose `map_t_body`
+    /// was taken, so that its first step carries that pose along the odometry's motion since
+    /// (by default the motion is counted from the first step's sample on). A navigator made
+    /// while the robot walks needs it: without it, the walk between the pose and the first step
+    /// (12 cm at 0.6 m/s and 5 Hz) reaches the localiser as a correction too large to take at
+    /// once, and in a corridor the estimate then lagged until a wide search put it 3 m off.
+    #[must_use]
+    pub fn with_start_odometry(mut self, odom_t_body: Pose3) -> Self {
+        self.localiser.set_odometry(odom_t_body);
+        self
     }
 
     /// This navigator planning with `planner` instead of [`NavigatorConfig::planner`] (which

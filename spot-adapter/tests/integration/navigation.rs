@@ -279,3 +279,49 @@ fn a_jump_larger_than_the_odometry_drift_is_rejected_until_confirmed() {
     assert_eq!(failures, 2);
     assert!((gated[2] - 0.15).abs() < 0.03, "{gated:?}");
 }
+
+/// A navigator made while the robot walks, from the pose of the last sample, with the odometry
+/// of that sample: its first step carries the pose along the odometry's motion since and
+/// localises within 3 cm of the truth. Without the odometry the 12 cm walked in between reach
+/// the localiser as a correction too large to take at once (the explorer's navigator then
+/// lagged down a corridor until a wide search put it 3 m off).
+#[test]
+fn a_navigator_made_while_walking_starts_from_the_odometry_of_its_pose() {
+    use spot_adapter::robot::{MobilityCommand, VelocityCommand};
+    let (building, map, navigation) = building_and_map(3);
+    let start = building.corridor_loop()[0];
+    let goal = building.corridor_loop()[1];
+    let config = SimulationConfig::default();
+    let mut spot = CommandedSpot::new(building, start, 0.0, &config).unwrap();
+    let walk = MobilityCommand::Velocity(VelocityCommand::new(0.6, 0.0));
+    let mut sample = spot.next_sample().unwrap();
+    for _ in 0..5 {
+        spot.send(&walk).unwrap();
+        sample = spot.next_sample().unwrap();
+    }
+    let (pose, odometry) = (spot.body_pose(), sample.odom_t_body);
+    spot.send(&walk).unwrap();
+    let next = spot.next_sample().unwrap();
+    let truth = spot.body_pose().translation.vector.xy();
+    assert!((truth - pose.translation.vector.xy()).norm() > 0.1);
+    let error = |with_odometry: bool| {
+        let mut nav = Navigator::new(
+            point_to_plane_localiser(),
+            &map,
+            &navigation,
+            pose,
+            spot.description(),
+            NavigatorConfig::default(),
+        )
+        .unwrap();
+        if with_odometry {
+            nav = nav.with_start_odometry(odometry);
+        }
+        nav.step(&next, goal).unwrap();
+        (nav.pose().translation.vector.xy() - truth).norm()
+    };
+    let (with, without) = (error(true), error(false));
+    eprintln!("first step {with:.3} m off with the start odometry, {without:.3} m without");
+    assert!(with <= 0.03, "{with} m");
+    assert!(without >= with + 0.05, "{without} m");
+}
