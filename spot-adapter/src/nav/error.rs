@@ -18,6 +18,9 @@ pub enum NavError {
         /// Goal y (metres).
         y: f64,
     },
+    /// An odometry pose given to the navigator is not finite.
+    #[error("the odometry pose given to the navigator is not finite")]
+    NonFiniteOdometry,
     /// The navigator's occupancy grid could not be built from the map.
     #[error("the navigation grid cannot be built from the map")]
     NavigationGrid(#[source] gridmap::GridMapError),

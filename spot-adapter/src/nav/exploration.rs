@@ -272,7 +272,9 @@ impl Exploration {
             .map_err(ExplorationError::Navigation)?;
             // The pose is the last sample's: the walk from there on is the odometry's.
             if let Some(odom_t_body) = self.last_odometry {
-                walker = walker.with_start_odometry(odom_t_body);
+                walker = walker
+                    .with_start_odometry(odom_t_body)
+                    .map_err(ExplorationError::Navigation)?;
             }
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             match self.walk(robot, slam, &mut walker, &chosen, max_cycles, observe)? {

@@ -155,10 +155,15 @@ impl<R: Registrator> Navigator<R> {
     /// while the robot walks needs it: without it, the walk between the pose and the first step
     /// (12 cm at 0.6 m/s and 5 Hz) reaches the localiser as a correction too large to take at
     /// once, and in a corridor the estimate then lagged until a wide search put it 3 m off.
-    #[must_use]
-    pub fn with_start_odometry(mut self, odom_t_body: Pose3) -> Self {
+    ///
+    /// # Errors
+    /// [`NavError::NonFiniteOdometry`] for a pose that is not finite.
+    pub fn with_start_odometry(mut self, odom_t_body: Pose3) -> Result<Self, NavError> {
+        if !slam_core::pose3_is_finite(&odom_t_body) {
+            return Err(NavError::NonFiniteOdometry);
+        }
         self.localiser.set_odometry(odom_t_body);
-        self
+        Ok(self)
     }
 
     /// This navigator planning with `planner` instead of [`NavigatorConfig::planner`] (which

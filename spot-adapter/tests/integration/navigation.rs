@@ -315,12 +315,27 @@ fn a_navigator_made_while_walking_starts_from_the_odometry_of_its_pose() {
         )
         .unwrap();
         if with_odometry {
-            nav = nav.with_start_odometry(odometry);
+            nav = nav.with_start_odometry(odometry).unwrap();
         }
         nav.step(&next, goal).unwrap();
         (nav.pose().translation.vector.xy() - truth).norm()
     };
     let (with, without) = (error(true), error(false));
+    let mut bad = odometry;
+    bad.translation.vector.y = f64::INFINITY;
+    let nav = Navigator::new(
+        point_to_plane_localiser(),
+        &map,
+        &navigation,
+        pose,
+        spot.description(),
+        NavigatorConfig::default(),
+    )
+    .unwrap();
+    assert!(matches!(
+        nav.with_start_odometry(bad),
+        Err(spot_adapter::nav::NavError::NonFiniteOdometry)
+    ));
     eprintln!("first step {with:.3} m off with the start odometry, {without:.3} m without");
     assert!(with <= 0.03, "{with} m");
     assert!(without >= with + 0.05, "{without} m");
