@@ -304,8 +304,8 @@ fn a_navigator_made_while_walking_starts_from_the_odometry_of_its_pose() {
     let next = spot.next_sample().unwrap();
     let truth = spot.body_pose().translation.vector.xy();
     assert!((truth - pose.translation.vector.xy()).norm() > 0.1);
-    let error = |with_odometry: bool| {
-        let mut nav = Navigator::new(
+    let navigator = || {
+        Navigator::new(
             point_to_plane_localiser(),
             &map,
             &navigation,
@@ -313,7 +313,10 @@ fn a_navigator_made_while_walking_starts_from_the_odometry_of_its_pose() {
             spot.description(),
             NavigatorConfig::default(),
         )
-        .unwrap();
+        .unwrap()
+    };
+    let error = |with_odometry: bool| {
+        let mut nav = navigator();
         if with_odometry {
             nav = nav.with_start_odometry(odometry).unwrap();
         }
@@ -323,17 +326,8 @@ fn a_navigator_made_while_walking_starts_from_the_odometry_of_its_pose() {
     let (with, without) = (error(true), error(false));
     let mut bad = odometry;
     bad.translation.vector.y = f64::INFINITY;
-    let nav = Navigator::new(
-        point_to_plane_localiser(),
-        &map,
-        &navigation,
-        pose,
-        spot.description(),
-        NavigatorConfig::default(),
-    )
-    .unwrap();
     assert!(matches!(
-        nav.with_start_odometry(bad),
+        navigator().with_start_odometry(bad),
         Err(spot_adapter::nav::NavError::NonFiniteOdometry)
     ));
     eprintln!("first step {with:.3} m off with the start odometry, {without:.3} m without");
