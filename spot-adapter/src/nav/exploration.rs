@@ -127,7 +127,6 @@ struct Exploration {
     cycles: usize,
     decisions: usize,
     decision_ms: Vec<f64>,
-    full_renders: usize,
     walked: f64,
     last_position: Option<Vector2<f64>>,
     /// The goal of the last walk, when it ended there.
@@ -170,7 +169,6 @@ impl Exploration {
             cycles: 0,
             decisions: 0,
             decision_ms: Vec::new(),
-            full_renders: 0,
             walked: 0.0,
             last_position: None,
             arrived_at: None,
@@ -224,7 +222,6 @@ impl Exploration {
                 .current_lidar_pose()
                 .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
             let (navigation, cloud) = map.update(slam)?;
-            self.full_renders = map.full_renders();
             let planning =
                 PlanningGrid::new(navigation.occupancy(), self.navigator.planning.clone())
                     .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
@@ -249,6 +246,7 @@ impl Exploration {
                     decision,
                     navigation,
                     map_t_body,
+                    map.full_renders(),
                 ));
             };
             if self.cycles >= max_cycles {
@@ -257,6 +255,7 @@ impl Exploration {
                     decision,
                     navigation,
                     map_t_body,
+                    map.full_renders(),
                 ));
             }
             // The planning grid the frontier was picked on is the navigator's too.
@@ -288,6 +287,7 @@ impl Exploration {
                         decision,
                         navigation,
                         map_t_body,
+                        map.full_renders(),
                     ));
                 }
             }
@@ -403,13 +403,14 @@ impl Exploration {
         last_decision: FrontierDecision,
         navigation: NavigationMap,
         map_t_body: Pose3,
+        full_renders: usize,
     ) -> ExplorationReport {
         ExplorationReport {
             outcome,
             cycles: self.cycles,
             decisions: self.decisions,
             decision_ms: self.decision_ms.clone(),
-            full_renders: self.full_renders,
+            full_renders,
             walked: self.walked,
             given_up: self.explorer.given_up().to_vec(),
             last_decision,
