@@ -106,6 +106,7 @@ mod picture;
 mod planning;
 mod rays;
 mod ros_map;
+mod walked;
 
 pub use band::ObstacleBandConfig;
 pub use band_accumulator::FloorBandAccumulator;
@@ -123,3 +124,4 @@ pub use planning::{
     CellRect, ClearanceCostConfig, PlanningGrid, PlanningGridConfig, clearance_step_costs,
 };
 pub use ros_map::{RosMapYaml, read_ros_map, ros_map_pgm, ros_map_yaml, write_ros_map};
+pub use walked::walked_cells;

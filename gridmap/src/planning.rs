@@ -107,6 +107,12 @@ pub struct PlanningGridConfig {
     /// Hard inflation, 0.30 m: Spot's half width (0.25 m) plus 0.05 m. Cells whose centre lies
     /// within it of an obstacle cell's centre are blocked.
     pub inflation: f64,
+    /// How much less the cells the robot has walked ([`PlanningGrid::with_walked`]) are
+    /// inflated, 0.05 m: the default's margin over Spot's half width. The robot fitted there,
+    /// so the margin, which covers where the grid puts an obstacle's surface (anywhere in its
+    /// cell), need not be added again: a door the robot walked through stays open when scans
+    /// from its other side add a cell to a jamb. Obstacle cells block whatever the relief.
+    pub walked_relief: f64,
     /// The clearance cost on the cells left free.
     pub cost: ClearanceCostConfig,
 }
@@ -116,6 +122,7 @@ impl Default for PlanningGridConfig {
         Self {
             unknown: UnknownCells::Blocked,
             inflation: 0.30,
+            walked_relief: 0.05,
             cost: ClearanceCostConfig::default(),
         }
     }
@@ -126,7 +133,7 @@ impl PlanningGridConfig {
     ///
     /// # Errors
     /// [`GridMapError::InvalidConfig`] for an inflation that is not finite, not negative and at
-    /// most 1000 m, or an invalid cost.
+    /// most 1000 m, a walked relief that is not finite and non-negative, or an invalid cost.
     pub fn validate(&self) -> Result<(), GridMapError> {
         check(
             self.inflation.is_finite() && (0.0..=1000.0).contains(&self.inflation),
@@ -134,6 +141,7 @@ impl PlanningGridConfig {
             self.inflation,
             "finite, from 0 to 1000 m",
         )?;
+        check_not_negative(&[("PlanningGridConfig::walked_relief", self.walked_relief)])?;
         self.cost.validate()
     }
 
@@ -271,6 +279,8 @@ pub struct PlanningGrid {
     clearance: Vec<f32>,
     costs: Vec<f32>,
     roomy: RoomyCache,
+    /// Cells the robot walked ([`PlanningGrid::with_walked`]): inflated by the walked inflation.
+    walked: Option<BitGrid>,
 }
 
 /// The last roomy mask asked for ([`PlanningGrid::roomy`]) with its clearance, kept up to date
@@ -301,6 +311,7 @@ impl PlanningGrid {
             costs: vec![1.0; w as usize * h as usize],
             config,
             roomy: RoomyCache::default(),
+            walked: None,
         };
         grid.recompute(
             occupancy,
@@ -312,6 +323,46 @@ impl PlanningGrid {
             },
         )?;
         Ok(grid)
+    }
+
+    /// This layer with `walked` (cells the robot's path crossed, e.g. [`crate::walked_cells`],
+    /// over `occupancy`, the grid it was built from) inflated by the inflation less
+    /// [`PlanningGridConfig::walked_relief`] (not below 0), here and in every [`Self::refresh`]. Obstacle cells stay blocked, and so does a walked cell that a new
+    /// obstacle comes within the walked inflation of.
+    ///
+    /// # Errors
+    /// [`GridMapError::GeometryMismatch`] when `walked` or `occupancy` is not the size and
+    /// placement of this layer.
+    pub fn with_walked(
+        mut self,
+        occupancy: &OccupancyGrid,
+        walked: BitGrid,
+    ) -> Result<Self, GridMapError> {
+        let same = |g: &BitGrid| {
+            (g.width(), g.height()) == (self.blocked.width(), self.blocked.height())
+                && g.geometry() == self.blocked.geometry()
+        };
+        if !same(&walked) {
+            return Err(GridMapError::GeometryMismatch);
+        }
+        self.walked = Some(walked);
+        let (w, h) = (occupancy.width(), occupancy.height());
+        self.recompute(
+            occupancy,
+            CellRect {
+                x0: 0,
+                y0: 0,
+                x1: w,
+                y1: h,
+            },
+        )?;
+        Ok(self)
+    }
+
+    /// The cells walked ([`Self::with_walked`]), when given.
+    #[must_use]
+    pub fn walked(&self) -> Option<&BitGrid> {
+        self.walked.as_ref()
     }
 
     /// Bring the layer up to date after the occupancy changed inside `changed` (cells outside it
@@ -364,6 +415,8 @@ impl PlanningGrid {
         let reach = self.config.reach();
         let r_cells = self.config.inflation / res;
         let limit = r_cells * r_cells + 1e-9;
+        let walked_cells = (self.config.inflation - self.config.walked_relief).max(0.0) / res;
+        let walked_limit = walked_cells * walked_cells + 1e-9;
         let sub_w = sub.width() as usize;
         for y in written.y0..written.y1 {
             for x in written.x0..written.x1 {
@@ -373,8 +426,13 @@ impl PlanningGrid {
                 let metres = (d2.sqrt() * res).min(reach);
                 self.clearance[i] = metres as f32;
                 self.costs[i] = self.config.cost.multiplier(metres);
-                // The same test as `inflate`, so that the blocked cells are `inflate`'s.
-                let blocked = d2 <= limit;
+                // The same test as `inflate`, so that the blocked cells are `inflate`'s (but for
+                // the cells walked).
+                let walked = self
+                    .walked
+                    .as_ref()
+                    .is_some_and(|m| m.is_blocked(Cell::new(x, y)));
+                let blocked = d2 <= if walked { walked_limit } else { limit };
                 self.blocked.set(Cell::new(x, y), blocked)?;
                 if let Some((min_clearance, roomy)) = self.roomy.0.get_mut() {
                     roomy.set(Cell::new(x, y), blocked || (metres as f32) < *min_clearance)?;
@@ -391,7 +449,8 @@ impl PlanningGrid {
     }
 
     /// Blocked cells: obstacles (and unknown cells, unless configured free) inflated by the
-    /// inflation radius, with the occupancy grid's size and placement.
+    /// inflation radius (less the walked relief on the cells walked), with the occupancy grid's
+    /// size and placement.
     #[must_use]
     pub fn blocked(&self) -> &BitGrid {
         &self.blocked

@@ -9,3 +9,4 @@ mod gridmap;
 mod live_layer;
 mod planning_grid;
 mod rng;
+mod walked;

@@ -42,6 +42,7 @@ fn config(unknown: bool, inflation: f64, weight: f64) -> PlanningGridConfig {
             UnknownCells::Free
         },
         inflation,
+        walked_relief: 0.05,
         cost: ClearanceCostConfig {
             weight,
             ..ClearanceCostConfig::default()
