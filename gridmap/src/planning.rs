@@ -191,6 +191,16 @@ fn obstacles(
     Ok(sub)
 }
 
+/// Every cell of `occupancy`.
+fn all_cells(occupancy: &OccupancyGrid) -> CellRect {
+    CellRect {
+        x0: 0,
+        y0: 0,
+        x1: occupancy.width(),
+        y1: occupancy.height(),
+    }
+}
+
 /// A rectangle of cells, `x0..x1` by `y0..y1` (ends excluded).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -313,21 +323,14 @@ impl PlanningGrid {
             roomy: RoomyCache::default(),
             walked: None,
         };
-        grid.recompute(
-            occupancy,
-            CellRect {
-                x0: 0,
-                y0: 0,
-                x1: w,
-                y1: h,
-            },
-        )?;
+        grid.recompute(occupancy, all_cells(occupancy))?;
         Ok(grid)
     }
 
     /// This layer with `walked` (cells the robot's path crossed, e.g. [`crate::walked_cells`],
     /// over `occupancy`, the grid it was built from) inflated by the inflation less
-    /// [`PlanningGridConfig::walked_relief`] (not below 0), here and in every [`Self::refresh`]. Obstacle cells stay blocked, and so does a walked cell that a new
+    /// [`PlanningGridConfig::walked_relief`] (not below 0), here and in every
+    /// [`Self::refresh`]. Obstacle cells stay blocked, and so does a walked cell that a new
     /// obstacle comes within the walked inflation of.
     ///
     /// # Errors
@@ -346,16 +349,7 @@ impl PlanningGrid {
             return Err(GridMapError::GeometryMismatch);
         }
         self.walked = Some(walked);
-        let (w, h) = (occupancy.width(), occupancy.height());
-        self.recompute(
-            occupancy,
-            CellRect {
-                x0: 0,
-                y0: 0,
-                x1: w,
-                y1: h,
-            },
-        )?;
+        self.recompute(occupancy, all_cells(occupancy))?;
         Ok(self)
     }
 

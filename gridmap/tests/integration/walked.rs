@@ -4,11 +4,10 @@
 #![allow(clippy::unwrap_used, clippy::panic)]
 
 use gridmap::{
-    CellRect, CellState, ClearanceCostConfig, FloorConfig, FloorMap, GridMapError,
-    ObstacleBandConfig, OccupancyGrid, OccupancyGridBuilder, OccupancyGridConfig, PlanningGrid,
+    CellRect, CellState, ClearanceCostConfig, GridMapError, OccupancyGrid, PlanningGrid,
     PlanningGridConfig, UnknownCells, walked_cells,
 };
-use nalgebra::{Point3, Vector2};
+use nalgebra::Vector2;
 use proptest::prelude::*;
 use slam_core::{BitGrid, Cell, GridGeometry, InvalidSetting};
 
@@ -190,18 +189,7 @@ proptest! {
 /// path closes it again.
 #[test]
 fn a_door_walked_through_stays_open_along_the_path() {
-    let world = crate::common::room(-0.8);
-    let cloud = world.surface_cloud(-0.15, -0.15, 12.15, 6.15, 0.04);
-    let floor = FloorMap::estimate(
-        &cloud,
-        &[Point3::new(1.0, 3.0, -0.8)],
-        &FloorConfig::default(),
-    )
-    .unwrap();
-    let mut occupancy = OccupancyGridBuilder::new(OccupancyGridConfig::default())
-        .unwrap()
-        .build_floor_band(&cloud, &floor, &ObstacleBandConfig::default())
-        .unwrap();
+    let mut occupancy = crate::planning_grid::room_occupancy();
     let config = PlanningGridConfig {
         inflation: 0.40,
         walked_relief: 0.15,
