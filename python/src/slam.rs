@@ -72,6 +72,7 @@ fn slam_settings(dict: Option<&Bound<'_, PyDict>>) -> PyResult<GraphSlamConfig> 
     )?;
     s.take("map_voxel_size", &mut c.map_voxel_size)?;
     s.take("min_scan_points", &mut c.min_scan_points)?;
+    s.take("odometry_gravity", &mut c.odometry_gravity)?;
     s.take("deskew", &mut c.deskew)?;
     s.take("sweep_motion", &mut c.sweep_motion)?;
     s.take("inline_loop_closure", &mut c.inline_loop_closure)?;

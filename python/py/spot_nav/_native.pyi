@@ -141,6 +141,7 @@ class Slam:
         loop_max_height_drift_rate: float = ...,
         map_voxel_size: float = ...,
         min_scan_points: int = ...,
+        odometry_gravity: bool = ...,
         deskew: bool = ...,
         sweep_motion: bool = ...,
         inline_loop_closure: bool = ...,

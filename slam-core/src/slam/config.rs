@@ -45,6 +45,9 @@ pub enum EdgeInformation {
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
+// Independent switches of independent stages (gravity, deskew, sweep motion, inline loops),
+// each named where it is read: not a state machine in disguise.
+#[allow(clippy::struct_excessive_bools)]
 pub struct GraphSlamConfig {
     /// A new keyframe once the LiDAR moved this far from the last one (thesis: 0.20 m).
     pub keyframe_distance: f64,
@@ -138,6 +141,14 @@ pub struct GraphSlamConfig {
     pub map_voxel_size: f32,
     /// Scans with fewer finite points are skipped.
     pub min_scan_points: usize,
+    /// Take the body's roll and pitch from the odometry, heading and position from the
+    /// registration (off by default for now): the odometry frame's z axis is up (Spot's state
+    /// estimator takes roll and pitch from its IMU) and the map frame is the odometry frame at
+    /// the first scan, so the odometry's tilt is the body's in the map, while registration
+    /// against a local map that drifts with the walk lets it drift (1 degree over a simulated
+    /// 800 m walk, and 0.4 m of height from walking forward on it). Leave it off for odometry
+    /// whose frame is not level. Scans without odometry are registered in all six degrees.
+    pub odometry_gravity: bool,
     /// Deskew keyframe scans that carry a per-point `time` channel, with the LiDAR velocity the
     /// odometry showed between the previous scan and this one (constant over the sweep). Scans
     /// without times, and scans more than a second after the previous one, are used as they
@@ -210,6 +221,7 @@ impl Default for GraphSlamConfig {
             loop_information: EdgeInformation::FromRegistration { scale: 1.0 },
             map_voxel_size: 0.05,
             min_scan_points: 100,
+            odometry_gravity: false,
             deskew: true,
             sweep_motion: true,
             sweep_min_gain: 0.05,

@@ -7,6 +7,7 @@ use std::time::Instant;
 use nalgebra::{Matrix6, UnitQuaternion};
 
 use super::config::GraphSlamConfig;
+use super::gravity::level_on_gravity;
 use super::information::edge_information;
 use super::keyframes::{Keyframe, Link, ScanPose};
 use super::local_map::{LocalMap, LocalWindow};
@@ -324,13 +325,18 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             Err(reason) => return self.skip(reason, started),
         };
         // 3. Track: register against the local map; LiDAR-only, with the sweep's own motion.
-        let tracked = self.track(
+        let mut tracked = self.track(
             scan,
             prepared,
             &guesses,
             velocity,
             swept && lidar_only.is_some(),
         );
+        if self.config.odometry_gravity
+            && let Some(odom_t_body) = scan.odom_t_body
+        {
+            tracked.pose = level_on_gravity(&tracked.pose, &odom_t_body, &scan.body_t_lidar);
+        }
         if let Some(basis) = self.turn_basis.take()
             && tracked.information.is_some()
         {

@@ -23,6 +23,7 @@
 mod config;
 mod deskew;
 mod engine;
+mod gravity;
 mod information;
 mod keyframes;
 mod local_map;
