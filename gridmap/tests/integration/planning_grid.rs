@@ -14,7 +14,8 @@ use slam_core::{Cell, GridGeometry, InvalidSetting};
 
 use crate::rng::rng;
 
-fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
+/// A grid of `w` x `h` cells of 0.1 m at (-1, 2): `density` % occupied, `unknown` % unknown.
+pub fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
     let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.1).unwrap();
     let mut grid = OccupancyGrid::new(w, h, geometry, CellState::Free).unwrap();
     let mut next = rng(seed);

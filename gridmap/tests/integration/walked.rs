@@ -11,6 +11,7 @@ use nalgebra::Vector2;
 use proptest::prelude::*;
 use slam_core::{BitGrid, Cell, GridGeometry, InvalidSetting};
 
+use crate::planning_grid::random_occupancy;
 use crate::rng::rng;
 
 const RES: f64 = 0.1;
@@ -44,25 +45,6 @@ fn segment_meets_square(a: Vector2<f64>, b: Vector2<f64>, x0: f64, y0: f64, s: f
         }
     }
     t0 <= t1
-}
-
-fn random_occupancy(w: u32, h: u32, density: u32, unknown: u32, seed: u64) -> OccupancyGrid {
-    let mut grid = OccupancyGrid::new(w, h, geometry(), CellState::Free).unwrap();
-    let mut next = rng(seed);
-    for y in 0..h {
-        for x in 0..w {
-            let r = (next() % 1000) as u32;
-            let state = if r < density * 10 {
-                CellState::Occupied
-            } else if r < (density + unknown) * 10 {
-                CellState::Unknown
-            } else {
-                continue;
-            };
-            grid.set(Cell::new(x, y), state).unwrap();
-        }
-    }
-    grid
 }
 
 fn random_mask(w: u32, h: u32, share: u64, seed: u64) -> BitGrid {
