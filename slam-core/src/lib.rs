@@ -61,7 +61,7 @@ pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
     EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, LoopRejection, LoopRejections,
-    ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew,
+    ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew, level_on_gravity,
 };
 pub use traits::optimizer::{
     IncrementalOptimizer, IncrementalReport, OptimizationReport, Optimizer, StopReason,

@@ -142,7 +142,7 @@ pub struct GraphSlamConfig {
     /// Scans with fewer finite points are skipped.
     pub min_scan_points: usize,
     /// Take the body's roll and pitch from the odometry, heading and position from the
-    /// registration (off by default for now): the odometry frame's z axis is up (Spot's state
+    /// registration (on by default): the odometry frame's z axis is up (Spot's state
     /// estimator takes roll and pitch from its IMU) and the map frame is the odometry frame at
     /// the first scan, so the odometry's tilt is the body's in the map, while registration
     /// against a local map that drifts with the walk lets it drift (1 degree over a simulated
@@ -221,7 +221,7 @@ impl Default for GraphSlamConfig {
             loop_information: EdgeInformation::FromRegistration { scale: 1.0 },
             map_voxel_size: 0.05,
             min_scan_points: 100,
-            odometry_gravity: false,
+            odometry_gravity: true,
             deskew: true,
             sweep_motion: true,
             sweep_min_gain: 0.05,

@@ -12,12 +12,24 @@ use nalgebra::UnitQuaternion;
 use crate::geometry::Pose3;
 
 /// `map_t_lidar` with the body's roll and pitch set to those of `odom_t_body` (the LiDAR mounted
-/// at `body_t_lidar`): the body's heading and position in the map are kept.
-pub(super) fn level_on_gravity(
-    map_t_lidar: &Pose3,
-    odom_t_body: &Pose3,
-    body_t_lidar: &Pose3,
-) -> Pose3 {
+/// at `body_t_lidar`): the body's heading and position in the map are kept. Both frames must
+/// have their z axis up (the map made from that odometry, e.g. by [`GraphSlam`](crate::GraphSlam)).
+/// For a body pose, pass the identity as `body_t_lidar`.
+///
+/// ```
+/// use slam_core::{Pose3, level_on_gravity};
+/// use slam_core::nalgebra::{Translation3, UnitQuaternion};
+///
+/// let tilted = Pose3::from_parts(
+///     Translation3::new(1.0, 2.0, 0.5),
+///     UnitQuaternion::from_euler_angles(0.02, -0.01, 0.7),
+/// );
+/// let level = level_on_gravity(&tilted, &Pose3::identity(), &Pose3::identity());
+/// let (roll, pitch, yaw) = level.rotation.euler_angles();
+/// assert!(roll.abs() < 1e-12 && pitch.abs() < 1e-12 && (yaw - 0.7).abs() < 1e-12);
+/// ```
+#[must_use]
+pub fn level_on_gravity(map_t_lidar: &Pose3, odom_t_body: &Pose3, body_t_lidar: &Pose3) -> Pose3 {
     let map_t_body = map_t_lidar * body_t_lidar.inverse();
     let (_, _, heading) = map_t_body.rotation.euler_angles();
     let (roll, pitch, _) = odom_t_body.rotation.euler_angles();

@@ -38,4 +38,5 @@ mod scan_tracking;
 pub use config::{EdgeInformation, GraphSlamConfig, TurnPrediction};
 pub use deskew::deskew;
 pub use engine::{GraphSlam, ScanInput};
+pub use gravity::level_on_gravity;
 pub use report::{LoopOutcome, LoopRejection, LoopRejections, ScanOutcome, SkipReason, SlamReport};

@@ -3,6 +3,7 @@
 
 use gridmap::{CellState, OccupancyGrid, PlanningGrid};
 use nalgebra::Vector2;
+use pathfind::line_of_sight;
 use slam_core::{BitGrid, Cell};
 
 use crate::nav::NavError;
@@ -140,7 +141,7 @@ impl Explorer {
         for frontier in frontiers {
             let Some((goal_cell, cost)) = costs
                 .as_ref()
-                .and_then(|c| self.goal_of(blocked, c, &frontier))
+                .and_then(|c| self.goal_of(occupancy, blocked, c, &frontier))
             else {
                 decision.unreachable.push(frontier);
                 continue;
@@ -247,12 +248,16 @@ impl Explorer {
     /// wall found beyond, but often could not see its frontier: more walks and more walking.)
     fn goal_of(
         &self,
+        occupancy: &OccupancyGrid,
         blocked: &BitGrid,
         costs: &TravelCosts,
         frontier: &Frontier,
     ) -> Option<(Cell, f64)> {
         let r = (self.config.goal_reach / blocked.geometry().resolution).ceil() as i64;
-        if let Some((_, cost, cell)) = nearest_reachable(costs, frontier.middle, r) {
+        // A goal that sees the frontier: the nearest reachable cell behind a wall from it (a
+        // strip of free cells seen through a door, running along the far side of a wall) shows
+        // nothing of it when the robot stands there.
+        if let Some((_, cost, cell)) = nearest_reachable(costs, frontier.middle, r, occupancy) {
             return Some((cell, cost));
         }
         // Every few cells of the frontier: discs half a reach apart cover what every cell's
@@ -262,7 +267,7 @@ impl Explorer {
             .cells
             .iter()
             .step_by(stride)
-            .filter_map(|&c| nearest_reachable(costs, c, r))
+            .filter_map(|&c| nearest_reachable(costs, c, r, occupancy))
             .min_by(|a, b| {
                 (a.0, a.1)
                     .partial_cmp(&(b.0, b.1))
@@ -306,9 +311,15 @@ impl Explorer {
     }
 }
 
-/// The reachable cell nearest `centre` within `r` cells (ties: the shorter walk), with its
-/// squared distance in cells and the walk there.
-fn nearest_reachable(costs: &TravelCosts, centre: Cell, r: i64) -> Option<(i64, f64, Cell)> {
+/// The reachable cell nearest `centre` within `r` cells (ties: the shorter walk) with no
+/// occupied cell of `occupancy` touched by the segment between them, with its squared distance in
+/// cells and the walk there.
+fn nearest_reachable(
+    costs: &TravelCosts,
+    centre: Cell,
+    r: i64,
+    occupancy: &OccupancyGrid,
+) -> Option<(i64, f64, Cell)> {
     let r2 = r * r;
     let mut best: Option<(i64, f64, Cell)> = None;
     for dy in -r..=r {
@@ -326,6 +337,7 @@ fn nearest_reachable(costs: &TravelCosts, centre: Cell, r: i64) -> Option<(i64, 
                 && best
                     .as_ref()
                     .is_none_or(|&(bd, bc, _)| (d2, cost) < (bd, bc))
+                && line_of_sight(occupancy.occupied(), cell, centre)
             {
                 best = Some((d2, cost, cell));
             }
@@ -579,6 +591,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A closed room 3.8 m x 1.9 m and, behind its north wall, a strip of floor two cells deep
+    /// running along it (seen through a door elsewhere) with unknown space beyond: `hole` opens
+    /// one cell of that wall.
+    fn room_and_strip_behind_its_wall(hole: Option<u32>) -> (OccupancyGrid, PlanningGrid) {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(40, 26, geometry, CellState::Unknown).unwrap();
+        for y in 0..=20 {
+            for x in 0..40 {
+                let wall = x == 0 || x == 39 || y == 0 || (y == 20 && hole != Some(x));
+                let state = if wall {
+                    CellState::Occupied
+                } else {
+                    CellState::Free
+                };
+                g.set(Cell::new(x, y), state).unwrap();
+            }
+        }
+        for y in 21..=22 {
+            for x in 5..=35 {
+                g.set(Cell::new(x, y), CellState::Free).unwrap();
+            }
+        }
+        let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+        (g, planning)
+    }
+
+    /// A frontier's goal must see it: the reachable cells nearest the strip lie under the wall,
+    /// from where the robot would see nothing of it, so the strip has no goal; through a hole in
+    /// the wall in line with the frontier's middle, the cell below the hole is its goal.
+    #[test]
+    fn a_frontier_behind_a_wall_is_not_given_a_goal_that_cannot_see_it() {
+        let at = Vector2::new(1.0, 1.0);
+        let (g, planning) = room_and_strip_behind_its_wall(None);
+        let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+        let decision = explorer.decide(&g, &planning, at);
+        assert_eq!(decision.chosen, None, "{decision:?}");
+        assert_eq!(decision.unreachable.len(), 1);
+        let middle = decision.unreachable[0].middle;
+        assert!(middle.y >= 21, "{middle:?}");
+
+        let (g, planning) = room_and_strip_behind_its_wall(Some(middle.x));
+        let decision = Explorer::new(ExplorerConfig::default())
+            .unwrap()
+            .decide(&g, &planning, at);
+        let chosen = decision.chosen.expect("a goal below the hole");
+        let goal = g.occupied().cell_at(chosen.goal).unwrap();
+        assert_eq!(goal.x, middle.x, "{chosen:?}");
+        assert!(line_of_sight(g.occupied(), goal, middle));
     }
 
     #[test]

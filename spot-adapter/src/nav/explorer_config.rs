@@ -64,8 +64,10 @@ pub struct ExplorerConfig {
     /// What a frontier would reveal: the unknown cells in sight of its middle (rays stopped by
     /// the first occupied cell) within this distance, 4 m (a room, a stretch of corridor).
     pub sensor_range: f64,
-    /// A frontier's goal is the reachable cell nearest its middle within this distance, 1.5 m;
-    /// a frontier with none (beyond the hard inflation of a gap, say) is unreachable.
+    /// A frontier's goal is the reachable cell nearest its middle within this distance, 1.5 m,
+    /// that sees it (no occupied cell on the segment between them: the nearest cell behind a
+    /// wall from a strip seen through a door shows nothing of it); a frontier with none (beyond
+    /// the hard inflation of a gap, say) is unreachable.
     pub goal_reach: f64,
     /// The walk to a frontier is re-decided after this many new keyframes, 10 (2 m at the
     /// engine's 0.2 m gate): by then the map has grown and the frontier may be gone.

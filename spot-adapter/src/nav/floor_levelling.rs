@@ -32,8 +32,15 @@ const MAX_TILT: f64 = 0.05;
 
 /// `map_t_lidar` corrected so that the floor returns of `cloud` (lidar frame) lie on `floor`:
 /// the plane through their heights above the floor, fitted about the sensor and trimmed of
-/// outliers, is taken out. `map_t_lidar` itself when too few floor returns are seen.
-pub(crate) fn level_on_floor(cloud: &PointCloud, map_t_lidar: &Pose3, floor: &FloorMap) -> Pose3 {
+/// outliers, is taken out; with `tilt_known` (the estimate's roll and pitch are the odometry's
+/// gravity) only their median height, so that a floor map a centimetre uneven across a room
+/// does not tilt a level scan. `map_t_lidar` itself when too few floor returns are seen.
+pub(crate) fn level_on_floor(
+    cloud: &PointCloud,
+    map_t_lidar: &Pose3,
+    floor: &FloorMap,
+    tilt_known: bool,
+) -> Pose3 {
     let sensor = map_t_lidar.translation.vector;
     // Each return as (dx, dy, height above the floor), relative to the sensor's plan position.
     let returns: Vec<Vector3<f64>> = cloud
@@ -47,6 +54,12 @@ pub(crate) fn level_on_floor(cloud: &PointCloud, map_t_lidar: &Pose3, floor: &Fl
                 .then(|| Vector3::new(dx, dy, above))
         })
         .collect();
+    if tilt_known {
+        return match median_height(&returns) {
+            Some(height) => Translation3::new(0.0, 0.0, -height) * map_t_lidar,
+            None => *map_t_lidar,
+        };
+    }
     let Some(first) = fit_plane(returns.iter()) else {
         return *map_t_lidar;
     };
@@ -65,6 +78,17 @@ pub(crate) fn level_on_floor(cloud: &PointCloud, map_t_lidar: &Pose3, floor: &Fl
     let turn = UnitQuaternion::from_euler_angles(-plane.slope_y, plane.slope_x, 0.0);
     let about_sensor = Translation3::from(sensor) * turn * Translation3::from(-sensor);
     Translation3::new(0.0, 0.0, -plane.offset) * about_sensor * map_t_lidar
+}
+
+/// The median height of the returns (robust to a low obstacle's top, a wall's foot and an
+/// uneven part of the floor map), or `None` with fewer than [`MIN_RETURNS`].
+fn median_height(returns: &[Vector3<f64>]) -> Option<f64> {
+    if returns.len() < MIN_RETURNS {
+        return None;
+    }
+    let mut heights: Vec<f64> = returns.iter().map(|r| r.z).collect();
+    let middle = heights.len() / 2;
+    Some(*heights.select_nth_unstable_by(middle, f64::total_cmp).1)
 }
 
 /// Heights above the floor as a plane about the sensor: `offset + slope_x dx + slope_y dy`.
@@ -139,7 +163,7 @@ mod tests {
             Translation3::new(0.0, 0.0, 0.047),
             UnitQuaternion::from_euler_angles(0.015, -0.015, 0.0),
         );
-        let levelled = level_on_floor(&scan(), &(truth * off), &floor);
+        let levelled = level_on_floor(&scan(), &(truth * off), &floor, false);
         for p in scan().points() {
             let p = Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z));
             let error = (levelled * p - truth * p).z.abs();
@@ -149,9 +173,44 @@ mod tests {
         let moved = (levelled.translation.vector - (truth * off).translation.vector).xy();
         assert!(moved.norm() < 0.005, "{moved:?}");
         // A level estimate stays as it is (to the points' f32 rounding).
-        let same = level_on_floor(&scan(), &truth, &floor);
+        let same = level_on_floor(&scan(), &truth, &floor, false);
         assert!((same.translation.vector - truth.translation.vector).norm() < 1e-6);
         assert!(same.rotation.angle_to(&truth.rotation) < 1e-6);
+    }
+
+    /// With the tilt known from gravity, only the height is corrected: returns on one side of
+    /// the room 2 cm above the floor map (a map a little uneven) would tilt the plane fit, and
+    /// must not turn the scan.
+    #[test]
+    fn a_known_tilt_is_kept_and_only_the_height_corrected() {
+        let floor = FloorMap::flat(0.0).unwrap();
+        let uneven = PointCloud::from_points(
+            scan()
+                .points()
+                .iter()
+                .map(|p| {
+                    let raised = p.z < -0.5 && p.x > 1.0;
+                    Point3::new(p.x, p.y, if raised { p.z + 0.02 } else { p.z })
+                })
+                .collect(),
+        );
+        let truth = Pose3::from_parts(
+            Translation3::new(2.0, 3.0, 0.8),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 1.2),
+        );
+        let high = Translation3::new(0.0, 0.0, 0.047) * truth;
+        let levelled = level_on_floor(&uneven, &high, &floor, true);
+        assert_eq!(levelled.rotation, high.rotation);
+        assert!((levelled.translation.vector.xy() - truth.translation.vector.xy()).norm() < 1e-9);
+        // Lowered to the median floor return (the raised side is the smaller part).
+        assert!(
+            (levelled.translation.z - 0.8).abs() < 0.003,
+            "{}",
+            levelled.translation.z
+        );
+        // The plane fit turns the same scan.
+        let fitted = level_on_floor(&uneven, &high, &floor, false);
+        assert!(fitted.rotation.angle_to(&high.rotation) > 1e-3);
     }
 
     #[test]
@@ -162,6 +221,7 @@ mod tests {
             Translation3::new(0.0, 0.0, 0.9),
             UnitQuaternion::from_euler_angles(0.02, 0.0, 0.0),
         );
-        assert_eq!(level_on_floor(&walls, &pose, &floor), pose);
+        assert_eq!(level_on_floor(&walls, &pose, &floor, false), pose);
+        assert_eq!(level_on_floor(&walls, &pose, &floor, true), pose);
     }
 }

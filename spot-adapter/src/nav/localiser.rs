@@ -6,7 +6,7 @@
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use slam_core::tracking::{ReachConfig, Tracker, TrackerConfig, scan_extent};
-use slam_core::{Pose3, Registrator};
+use slam_core::{Pose3, Registrator, level_on_gravity};
 
 use crate::nav::NavError;
 use crate::robot::Sample;
@@ -70,6 +70,12 @@ pub struct LocaliserConfig {
     pub walking_scan_voxel: f64,
     /// ... within this distance of the goal (metres) every scan is registered in full, 1.5 m.
     pub full_scan_within: f64,
+    /// Each correction keeps the odometry's roll and pitch (its heading and position come from
+    /// the scan), true: Spot's odometry frame has z up from its IMU, and so has a map made from
+    /// it ([`GraphSlamConfig::odometry_gravity`](slam_core::GraphSlamConfig::odometry_gravity)),
+    /// while a registration with thinned walking scans tilts up to a degree. Turn it off for a
+    /// map whose z axis is not up (one made LiDAR-only from a tilted first scan).
+    pub odometry_gravity: bool,
 }
 
 impl Default for LocaliserConfig {
@@ -90,6 +96,7 @@ impl Default for LocaliserConfig {
             max_searches: 3,
             walking_scan_voxel: 0.35,
             full_scan_within: 1.5,
+            odometry_gravity: true,
         }
     }
 }
@@ -363,7 +370,12 @@ impl<R: Registrator> Localiser<R> {
     }
 
     fn accept(&mut self, pose: Pose3, status: LocalisationStatus) -> LocalisationStatus {
-        self.map_t_body = pose;
+        self.map_t_body = match self.last_odom_t_body {
+            Some(odom_t_body) if self.config.odometry_gravity => {
+                level_on_gravity(&pose, &odom_t_body, &Pose3::identity())
+            }
+            _ => pose,
+        };
         self.walked_since_correction = 0.0;
         self.candidate = None;
         self.health.consecutive_failures = 0;

@@ -459,12 +459,13 @@ impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
     /// Fuse the scan (at the corrected `pose`) into the live layer and refresh the planning grid
     /// where it changed.
     fn fuse(&mut self, sample: &Sample, pose: &Pose3) -> Result<(), NavError> {
-        // Levelled on the map's floor: the estimate's height and tilt are its weakest part, and
-        // the live layer tells obstacles from floor by height.
+        // Levelled on the map's floor: the estimate's height (and tilt, without the odometry's
+        // gravity) are its weakest part, and the live layer tells obstacles from floor by height.
         let map_t_lidar = level_on_floor(
             &sample.cloud,
             &(pose * sample.body_t_lidar),
             self.map.floor(),
+            self.config.localiser.odometry_gravity,
         );
         let update = self
             .live
