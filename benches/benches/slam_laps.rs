@@ -36,6 +36,7 @@ use spot_adapter::pipelines::{
     point_to_plane_slam, point_to_plane_slam_optimized_by, scan_context_places, slam_config,
 };
 use spot_adapter::sim::{Building, BuildingConfig, Route, SimulatedSpot, SimulationConfig};
+use spot_nav_benches::{quantile, resident_mb};
 
 /// The environment variable that makes the binary run one setup as a child.
 const CHILD: &str = "SLAM_LAPS_CHILD";
@@ -56,26 +57,6 @@ fn config(setup: &str) -> Option<GraphSlamConfig> {
         _ => return None,
     }
     Some(config)
-}
-
-/// Resident memory of this process in MB (`VmRSS`), 0 where `/proc` has none.
-fn resident_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("VmRSS:"))
-                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        })
-        .map_or(0.0, |kb| kb / 1024.0)
-}
-
-/// The `q` quantile (nearest rank) of `ms`.
-fn quantile(ms: &[f64], q: f64) -> f64 {
-    let mut sorted = ms.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let rank = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len().max(1));
-    sorted.get(rank - 1).copied().unwrap_or(0.0)
 }
 
 /// One setup's walk of `laps` laps of seed `seed`'s building, a table row per lap on stdout.

@@ -161,6 +161,16 @@ impl PointCloud {
         (self.points, self.ring, self.intensity, self.time)
     }
 
+    /// The cloud with its positions and intensities only (the ring and time channels dropped).
+    #[must_use]
+    pub fn without_ring_and_time(self) -> Self {
+        Self {
+            ring: None,
+            time: None,
+            ..self
+        }
+    }
+
     /// The cloud with every point mapped by `a_T_b` (this cloud is in frame b; the result in a).
     #[must_use]
     pub fn transformed(&self, a_t_b: &Isometry3<f64>) -> Self {
@@ -324,6 +334,15 @@ mod tests {
         .unwrap()
         .with_intensity(vec![0.1, 0.2, 0.3, 0.4])
         .unwrap()
+    }
+
+    #[test]
+    fn without_ring_and_time_keeps_positions_and_intensities() {
+        let c = cloud().with_time(vec![0.0, 0.1, 0.2, 0.3]).unwrap();
+        let kept = c.clone().without_ring_and_time();
+        assert_eq!(kept.points(), c.points());
+        assert_eq!(kept.intensity(), c.intensity());
+        assert_eq!((kept.ring(), kept.time()), (None, None));
     }
 
     #[test]

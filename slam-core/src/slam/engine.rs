@@ -486,6 +486,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .voxel_downsample(self.config.map_voxel_size)
                 .unwrap_or(cloud)
         };
+        // Positions and intensities only: a voxel's ring and time mean nothing once the scan is
+        // deskewed and thinned, and they were a third of what the keyframe kept of it.
+        let cloud = cloud.without_ring_and_time();
         // The loop check's source from the scan already thinned to its voxel when the odometry
         // thins to the same one (an OS1-128 keyframe's 41,000 points not voxelised again).
         let same_voxel = self

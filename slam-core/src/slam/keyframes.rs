@@ -129,8 +129,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .collect()
     }
 
-    /// Every keyframe's scan (voxel-filtered, in the LiDAR frame) with its optimised
-    /// `map_T_lidar`: the rays an occupancy grid's free space comes from.
+    /// Every keyframe's scan (voxel-filtered, in the LiDAR frame; positions and intensities,
+    /// no ring or time channel) with its optimised `map_T_lidar`: the rays an occupancy grid's
+    /// free space comes from.
     pub fn keyframe_scans(&self) -> impl Iterator<Item = (Pose3, &PointCloud)> + '_ {
         self.keyframes
             .iter()

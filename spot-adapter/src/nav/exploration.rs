@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use gridmap::PlanningGrid;
+use gridmap::{OccupancyGrid, PlanningGrid};
 use nalgebra::Vector2;
 use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, Registrator};
 
@@ -75,6 +75,9 @@ pub struct ExplorationCycle<'a> {
     /// Milliseconds the engine and the navigator took on the sample, without the robot's own
     /// time (the decisions between walks are in [`ExplorationReport::decision_ms`]).
     pub compute_ms: f64,
+    /// Floor known free on the grid of the decision that started the walk (square metres):
+    /// how far the exploration has got.
+    pub known_free_m2: f64,
 }
 
 /// Explore with `robot` from where it stands: each sample goes into `slam` (a fresh engine: its
@@ -135,6 +138,17 @@ struct Exploration {
     failures: Vec<Vector2<f64>>,
     /// The odometry of the last sample the engine took.
     last_odometry: Option<Pose3>,
+}
+
+/// One walk toward a frontier: where to, and how much floor the decision's grid knew free.
+struct Walk<'a> {
+    target: &'a FrontierGoal,
+    known_free_m2: f64,
+}
+
+/// The floor `occupancy` knows free (square metres).
+fn known_free_area(occupancy: &OccupancyGrid) -> f64 {
+    occupancy.counts().0 as f64 * occupancy.geometry().resolution.powi(2)
 }
 
 /// How one walk toward a frontier ended.
@@ -276,7 +290,11 @@ impl Exploration {
                     .map_err(ExplorationError::Navigation)?;
             }
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
-            match self.walk(robot, slam, &mut walker, &chosen, max_cycles, observe)? {
+            let walk = Walk {
+                target: &chosen,
+                known_free_m2: known_free_area(navigation.occupancy()),
+            };
+            match self.walk(robot, slam, &mut walker, &walk, max_cycles, observe)? {
                 WalkEnd::Decide => {}
                 WalkEnd::Arrived => self.arrived_at = Some(chosen.goal),
                 WalkEnd::GiveUp(reason) => self.failed(chosen.goal, reason),
@@ -312,13 +330,13 @@ impl Exploration {
         }
     }
 
-    /// Walk toward `goal` until it is time to decide again.
+    /// Walk toward `walk.target`'s goal until it is time to decide again.
     fn walk<Rb, R, C, O, L>(
         &mut self,
         robot: &mut Rb,
         slam: &mut GraphSlam<R, C, O>,
         navigator: &mut Navigator<L>,
-        target: &FrontierGoal,
+        walk: &Walk<'_>,
         max_cycles: usize,
         observe: &mut impl FnMut(&ExplorationCycle<'_>),
     ) -> Result<WalkEnd, ExplorationError<Rb::Error>>
@@ -331,6 +349,7 @@ impl Exploration {
     {
         let keyframes = slam.keyframe_count();
         let loops = slam.report().loops_closed;
+        let target = walk.target;
         let goal = target.goal;
         let min_cells = self.explorer.config().min_frontier_cells;
         while self.cycles < max_cycles {
@@ -357,6 +376,7 @@ impl Exploration {
                 step: &step,
                 map_t_body,
                 compute_ms,
+                known_free_m2: walk.known_free_m2,
             });
             let end = match step {
                 NavigationStep::Walk(command) => {

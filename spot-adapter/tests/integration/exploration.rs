@@ -230,7 +230,7 @@ fn explores_a_small_building_to_full_coverage() {
 #[test]
 fn a_closed_door_leaves_its_room_out() {
     let mut building = small_building(12);
-    let room = building.rooms()[0].clone();
+    let room = building.rooms()[0];
     let start = building.corridor_loop()[0];
     let open = floor_coverage(
         &building,
@@ -315,14 +315,10 @@ fn a_frontier_shut_off_by_a_dropped_box_is_given_up_and_reported() {
         .rooms()
         .iter()
         .max_by(|a, b| (a.door - start).norm().total_cmp(&(b.door - start).norm()))
-        .unwrap()
-        .clone();
-    let (explored, shut_at) = explore_shutting(
-        &building,
-        FrontierChoice::default(),
-        3000,
-        Some(room.clone()),
-    );
+        .copied()
+        .unwrap();
+    let (explored, shut_at) =
+        explore_shutting(&building, FrontierChoice::default(), 3000, Some(room));
     print("box dropped in a door", &explored);
     let shut_at = shut_at.expect("the robot came near the door");
     let world_t_map = explored.world_t_map;
