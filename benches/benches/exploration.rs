@@ -20,7 +20,7 @@
 use nalgebra::Vector2;
 use slam_core::io::StampedPose;
 use spot_adapter::eval::TrajectoryEvaluation;
-use spot_adapter::nav::{ExplorerConfig, NavigatorConfig, explore};
+use spot_adapter::nav::{ExplorationReport, ExplorerConfig, NavigatorConfig, explore};
 use spot_adapter::pipelines::{point_to_plane_slam, point_to_plane_tracker, slam_config};
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, SimulationConfig, floor_coverage,
@@ -98,6 +98,23 @@ fn print_table(slam_ms: &[f64], compute_ms: &[f64], resident: (f64, usize, f64))
         "| resident MB (at a quarter of the floor known / at the end) | {at_quarter:.0} (scan {}) | {at_end:.0} | {:.2} | at most 2x |",
         quarter + 1,
         at_end / at_quarter
+    );
+}
+
+/// Prints the frontiers given up by reason and those left at the end.
+fn print_frontiers(report: &ExplorationReport) {
+    let mut reasons: Vec<(&str, usize)> = Vec::new();
+    for g in &report.given_up {
+        match reasons.iter_mut().find(|(r, _)| *r == g.reason.name()) {
+            Some((_, n)) => *n += 1,
+            None => reasons.push((g.reason.name(), 1)),
+        }
+    }
+    println!(
+        "Frontiers given up: {reasons:?}; at the end {} reachable, {} unreachable, {} by given-up goals.",
+        report.last_decision.reachable,
+        report.last_decision.unreachable.len(),
+        report.last_decision.given_up,
     );
 }
 
@@ -182,6 +199,7 @@ fn run() -> Result<(), String> {
         &compute_ms,
         (resident_at_quarter, quarter, resident_at_end),
     );
+    print_frontiers(&report);
     println!(
         "Navigation cycle with the decisions spread over it: {cycle_mean:.1} ms mean (issue's bar: at \
          most 10 ms); {} decisions, {:.0} ms mean, {:.0} ms at most. Resident {resident_at_start:.0} \

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use gridmap::{OccupancyGrid, PlanningGrid};
 use nalgebra::Vector2;
-use slam_core::{GraphSlam, MapRegistrator, Optimizer, Pose3, Registrator};
+use slam_core::{GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3, Registrator};
 
 use crate::nav::NavError;
 use crate::nav::config::NavigatorConfig;
@@ -86,10 +86,11 @@ pub struct ExplorationCycle<'a> {
 /// occupancy grid is brought up to date (the keyframes since the last decision added to it, or
 /// all of them rendered afresh at their current poses when a loop moved one by more than half a
 /// cell or the map grew by half since the last such render), the [`Explorer`]
-/// picks a frontier, and a [`Navigator`] on that map (localising with `localiser`, settings
-/// `navigator` with its goal tolerance set to [`ExplorerConfig::arrive_within`]) walks toward
-/// it (it does not wait for what newly blocks the way: that is unknown space turning out to be
-/// wall). The second walk near the same goal that ends with no path, blocked or lost gives its
+/// picks a frontier, and a [`Navigator`] on that map (localising with `localiser` against the
+/// map within [`ExplorerConfig::localise_within`] of the robot, settings `navigator` with its
+/// goal tolerance set to [`ExplorerConfig::arrive_within`]) walks toward it (it does not wait
+/// for what newly blocks the way: that is unknown space turning out to be wall) until the
+/// robot is half that distance from where it started, or one of the above. The second walk near the same goal that ends with no path, blocked or lost gives its
 /// frontier up, and so does standing at its goal with the frontier still there; the report
 /// lists them. Stops when no reachable frontier is left, or after `max_cycles` samples; the
 /// robot is sent a stop on every way out.
@@ -140,10 +141,13 @@ struct Exploration {
     last_odometry: Option<Pose3>,
 }
 
-/// One walk toward a frontier: where to, and how much floor the decision's grid knew free.
+/// One walk toward a frontier: where to and from, and how much floor the decision's grid knew
+/// free.
 struct Walk<'a> {
     target: &'a FrontierGoal,
     known_free_m2: f64,
+    /// Where the robot stood at the decision (metres, map frame).
+    from: Vector2<f64>,
 }
 
 /// The floor `occupancy` knows free (square metres).
@@ -272,27 +276,14 @@ impl Exploration {
                     map.full_renders(),
                 ));
             }
-            // The planning grid the frontier was picked on is the navigator's too.
-            let mut walker = Navigator::planned(
-                localiser.clone(),
-                &cloud,
-                &navigation,
-                planning,
-                map_t_body,
-                robot.description(),
-                self.navigator.clone(),
-            )
-            .map_err(ExplorationError::Navigation)?;
-            // The pose is the last sample's: the walk from there on is the odometry's.
-            if let Some(odom_t_body) = self.last_odometry {
-                walker = walker
-                    .with_start_odometry(odom_t_body)
-                    .map_err(ExplorationError::Navigation)?;
-            }
+            let mut walker = self
+                .walker(localiser, &cloud, &navigation, planning, map_t_body, robot)
+                .map_err(ExplorationError::Navigation)?;
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             let walk = Walk {
                 target: &chosen,
                 known_free_m2: known_free_area(navigation.occupancy()),
+                from: position,
             };
             match self.walk(robot, slam, &mut walker, &walk, max_cycles, observe)? {
                 WalkEnd::Decide => {}
@@ -309,6 +300,38 @@ impl Exploration {
                     ));
                 }
             }
+        }
+    }
+
+    /// The navigator of a walk from `map_t_body`: on the planning grid the frontier was picked
+    /// on, localising against the map `cloud` within [`ExplorerConfig::localise_within`] (the
+    /// walk is re-decided before it leaves that), from the odometry of the last sample.
+    fn walker<L: Registrator + Clone, Rb: Robot>(
+        &self,
+        localiser: &L,
+        cloud: &PointCloud,
+        navigation: &NavigationMap,
+        planning: PlanningGrid,
+        map_t_body: Pose3,
+        robot: &Rb,
+    ) -> Result<Navigator<L>, NavError> {
+        let reach = self.explorer.config().localise_within;
+        let at = map_t_body.translation.vector.xy();
+        let near =
+            cloud.filtered(|_, p| (f64::from(p.x) - at.x).hypot(f64::from(p.y) - at.y) <= reach);
+        let walker = Navigator::planned(
+            localiser.clone(),
+            &near,
+            navigation,
+            planning,
+            map_t_body,
+            robot.description(),
+            self.navigator.clone(),
+        )?;
+        // The pose is the last sample's: the walk from there on is the odometry's.
+        match self.last_odometry {
+            Some(odom_t_body) => walker.with_start_odometry(odom_t_body),
+            None => Ok(walker),
         }
     }
 
@@ -410,7 +433,12 @@ impl Exploration {
                 return Ok(WalkEnd::Decide);
             }
             let grown = slam.keyframe_count() >= keyframes + self.explorer.config().decide_every;
-            if grown || slam.report().loops_closed != loops {
+            // Half the navigator's map behind: its far side would soon be out of sight.
+            let far = map_t_body.is_some_and(|p| {
+                (p.translation.vector.xy() - walk.from).norm()
+                    > 0.5 * self.explorer.config().localise_within
+            });
+            if grown || far || slam.report().loops_closed != loops {
                 return Ok(WalkEnd::Decide);
             }
         }

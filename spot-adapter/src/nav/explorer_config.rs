@@ -84,6 +84,12 @@ pub struct ExplorerConfig {
     /// The map cloud the navigator localises against is thinned to this voxel, 0.1 m (the
     /// localiser's own).
     pub map_voxel: f32,
+    /// Each walk's navigator localises against the map within this distance of where the walk
+    /// starts (horizontally), 30 m, and the walk is re-decided once the robot is half of it
+    /// from there: setting up the navigator then costs the same at the end of a long
+    /// exploration as at its start, where the whole map took 12 ms mean and 25 ms at the end on
+    /// the office floor.
+    pub localise_within: f64,
 }
 
 impl Default for ExplorerConfig {
@@ -98,6 +104,7 @@ impl Default for ExplorerConfig {
             arrive_within: 0.3,
             keyframe_spacing: 1.0,
             map_voxel: 0.1,
+            localise_within: 30.0,
         }
     }
 }
@@ -116,6 +123,7 @@ impl ExplorerConfig {
             ("ExplorerConfig::arrive_within", self.arrive_within),
             ("ExplorerConfig::keyframe_spacing", self.keyframe_spacing),
             ("ExplorerConfig::map_voxel", f64::from(self.map_voxel)),
+            ("ExplorerConfig::localise_within", self.localise_within),
         ] {
             if !(value.is_finite() && value > 0.0) {
                 return Err(NavError::invalid(setting, value, "finite and positive"));
