@@ -200,6 +200,15 @@ fn run() -> Result<(), String> {
         (resident_at_quarter, quarter, resident_at_end),
     );
     print_frontiers(&report);
+    let stages = report.decision_stages;
+    let per = |ms: f64| ms / report.decisions.max(1) as f64;
+    println!(
+        "Decisions by stage, ms mean: map {:.1}, planning grid {:.1}, choice {:.1}, navigator {:.1}.",
+        per(stages.map),
+        per(stages.planning),
+        per(stages.choice),
+        per(stages.navigator)
+    );
     println!(
         "Navigation cycle with the decisions spread over it: {cycle_mean:.1} ms mean (issue's bar: at \
          most 10 ms); {} decisions, {:.0} ms mean, {:.0} ms at most. Resident {resident_at_start:.0} \

@@ -45,6 +45,8 @@ pub struct ExplorationReport {
     /// Milliseconds of each decision that started a walk: rendering the map, picking the
     /// frontier and making the navigator on that map.
     pub decision_ms: Vec<f64>,
+    /// Milliseconds of every decision by stage, summed over the exploration.
+    pub decision_stages: DecisionStages,
     /// Decisions whose map was rendered afresh from every keyframe kept (the first, after a
     /// loop closure moved the keyframes, and when the map has grown by half since the last);
     /// the others added only the keyframes that came since.
@@ -59,6 +61,19 @@ pub struct ExplorationReport {
     pub navigation: NavigationMap,
     /// The engine's estimate of the body at the end (map frame).
     pub map_t_body: Pose3,
+}
+
+/// Where the decisions' time went (milliseconds, summed over every decision).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DecisionStages {
+    /// The grid and the map cloud brought up to date with the engine's keyframes.
+    pub map: f64,
+    /// The planning grid (inflation, clearance cost) made from it.
+    pub planning: f64,
+    /// The explorer's choice: frontiers, what each would reveal, the walks to them.
+    pub choice: f64,
+    /// The walk's navigator set up on the map (its localisation target, its live layer).
+    pub navigator: f64,
 }
 
 /// One cycle of an exploration, as [`explore`] shows it to its observer.
@@ -131,6 +146,7 @@ struct Exploration {
     cycles: usize,
     decisions: usize,
     decision_ms: Vec<f64>,
+    stages: DecisionStages,
     walked: f64,
     last_position: Option<Vector2<f64>>,
     /// The goal of the last walk, when it ended there.
@@ -148,6 +164,11 @@ struct Walk<'a> {
     known_free_m2: f64,
     /// Where the robot stood at the decision (metres, map frame).
     from: Vector2<f64>,
+}
+
+/// Milliseconds from `a` to `b`.
+fn ms_between(a: Instant, b: Instant) -> f64 {
+    b.duration_since(a).as_secs_f64() * 1e3
 }
 
 /// The floor `occupancy` knows free (square metres).
@@ -187,6 +208,7 @@ impl Exploration {
             cycles: 0,
             decisions: 0,
             decision_ms: Vec::new(),
+            stages: DecisionStages::default(),
             walked: 0.0,
             last_position: None,
             arrived_at: None,
@@ -240,14 +262,20 @@ impl Exploration {
                 .current_lidar_pose()
                 .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
             let (navigation, cloud) = map.update(slam)?;
+            let mapped = Instant::now();
+            self.stages.map += ms_between(started, mapped);
             let planning =
                 PlanningGrid::new(navigation.occupancy(), self.navigator.planning.clone())
                     .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
+            let planned = Instant::now();
+            self.stages.planning += ms_between(mapped, planned);
             let position = map_t_body.translation.vector.xy();
             let decision = self
                 .explorer
                 .decide(navigation.occupancy(), &planning, position);
             self.decisions += 1;
+            let chosen_at = Instant::now();
+            self.stages.choice += ms_between(planned, chosen_at);
             // The robot stood at this goal and the frontier is still there: what lies behind
             // it cannot be seen from where the robot can stand.
             let arrived_at = self.arrived_at.take();
@@ -279,6 +307,7 @@ impl Exploration {
             let mut walker = self
                 .walker(localiser, &cloud, &navigation, planning, map_t_body, robot)
                 .map_err(ExplorationError::Navigation)?;
+            self.stages.navigator += chosen_at.elapsed().as_secs_f64() * 1e3;
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             let walk = Walk {
                 target: &chosen,
@@ -458,6 +487,7 @@ impl Exploration {
             cycles: self.cycles,
             decisions: self.decisions,
             decision_ms: self.decision_ms.clone(),
+            decision_stages: self.stages,
             full_renders,
             walked: self.walked,
             given_up: self.explorer.given_up().to_vec(),

@@ -82,7 +82,9 @@ mod unseen;
 pub use config::{NavigationMapConfig, NavigatorConfig, PlannerKind};
 pub use drive::{DriveCycle, DriveOutcome, DriveReport, drive};
 pub use error::{DriveError, ExplorationError, NavError};
-pub use exploration::{ExplorationCycle, ExplorationOutcome, ExplorationReport, explore};
+pub use exploration::{
+    DecisionStages, ExplorationCycle, ExplorationOutcome, ExplorationReport, explore,
+};
 pub use explorer::{Explorer, FrontierDecision, FrontierGoal, GiveUpReason, GivenUpFrontier};
 pub use explorer_config::{ExplorerConfig, FrontierChoice};
 pub use floor_route::{FloorCell, FloorGraph, FloorRoute, RouteLeg, StairsLink};
