@@ -93,16 +93,7 @@ proptest! {
         // The roomy mask asked for before the change is kept and refreshed with the layer.
         let min_clearance = 0.45;
         let _ = layer.roomy(min_clearance);
-        let (x0, y0) = (rect.0 % w, rect.1 % h);
-        let changed = CellRect { x0, y0, x1: (x0 + rect.2).min(w), y1: (y0 + rect.3).min(h) };
-        let mut r = rng(seed.rotate_left(17));
-        for _ in 0..flips {
-            let s = r();
-            let x = changed.x0 + (s % u64::from(changed.x1 - changed.x0)) as u32;
-            let y = changed.y0 + ((s >> 20) % u64::from(changed.y1 - changed.y0)) as u32;
-            let state = [CellState::Free, CellState::Occupied, CellState::Unknown][(s >> 40) as usize % 3];
-            occupancy.set(Cell::new(x, y), state).unwrap();
-        }
+        let changed = flip_cells_in(&mut occupancy, rect, flips, seed.rotate_left(17));
         let written = layer.refresh(&occupancy, changed).unwrap();
         prop_assert!(written.len() >= changed.len());
         let rebuilt = PlanningGrid::new(&occupancy, cfg).unwrap();
@@ -129,6 +120,34 @@ proptest! {
         let everything = layer.roomy(1e9);
         prop_assert!((0..h).all(|y| (0..w).all(|x| everything.is_blocked(Cell::new(x, y)))));
     }
+}
+
+/// `flips` random cells of the rectangle `rect` (x, y taken modulo the grid, then width and
+/// height, clipped to the grid) set to random states; returns that rectangle.
+pub fn flip_cells_in(
+    occupancy: &mut OccupancyGrid,
+    rect: (u32, u32, u32, u32),
+    flips: usize,
+    seed: u64,
+) -> CellRect {
+    let (w, h) = (occupancy.width(), occupancy.height());
+    let (x0, y0) = (rect.0 % w, rect.1 % h);
+    let changed = CellRect {
+        x0,
+        y0,
+        x1: (x0 + rect.2).min(w),
+        y1: (y0 + rect.3).min(h),
+    };
+    let mut r = rng(seed);
+    for _ in 0..flips {
+        let s = r();
+        let x = changed.x0 + (s % u64::from(changed.x1 - changed.x0)) as u32;
+        let y = changed.y0 + ((s >> 20) % u64::from(changed.y1 - changed.y0)) as u32;
+        let state =
+            [CellState::Free, CellState::Occupied, CellState::Unknown][(s >> 40) as usize % 3];
+        occupancy.set(Cell::new(x, y), state).unwrap();
+    }
+    changed
 }
 
 /// The room's door is 0.9 m wide; on the map its frame cells' centres are 0.9 m apart (8 free

@@ -11,7 +11,7 @@ use nalgebra::Vector2;
 use proptest::prelude::*;
 use slam_core::{BitGrid, Cell, GridGeometry, InvalidSetting};
 
-use crate::planning_grid::random_occupancy;
+use crate::planning_grid::{flip_cells_in, random_occupancy};
 use crate::rng::rng;
 
 const RES: f64 = 0.1;
@@ -150,16 +150,7 @@ proptest! {
         prop_assert_eq!(layer.blocked(), &brute_force_blocked(&occupancy, &walked, &config));
         prop_assert_eq!(layer.walked(), Some(&walked));
         // Obstacles come and go inside a rectangle: a refresh there keeps the walked relief.
-        let (x0, y0) = (rect.0 % w, rect.1 % h);
-        let changed = CellRect { x0, y0, x1: (x0 + rect.2).min(w), y1: (y0 + rect.3).min(h) };
-        let mut r = rng(seed.rotate_left(23));
-        for _ in 0..flips {
-            let s = r();
-            let x = changed.x0 + (s % u64::from(changed.x1 - changed.x0)) as u32;
-            let y = changed.y0 + ((s >> 20) % u64::from(changed.y1 - changed.y0)) as u32;
-            let state = [CellState::Free, CellState::Occupied, CellState::Unknown][(s >> 40) as usize % 3];
-            occupancy.set(Cell::new(x, y), state).unwrap();
-        }
+        let changed = flip_cells_in(&mut occupancy, rect, flips, seed.rotate_left(23));
         layer.refresh(&occupancy, changed).unwrap();
         prop_assert_eq!(layer.blocked(), &brute_force_blocked(&occupancy, &walked, &config));
     }

@@ -185,6 +185,14 @@ pub fn coverage(
     .share()
 }
 
+/// The exploration stopped by itself with at least 97 % of the reachable floor known free and no
+/// collision.
+fn assert_complete(e: &Explored) {
+    assert_eq!(e.report.outcome, ExplorationOutcome::Complete);
+    assert!(e.coverage >= 0.97, "coverage {:.3}", e.coverage);
+    assert_eq!(e.collisions, 0);
+}
+
 fn print(name: &str, e: &Explored) {
     eprintln!(
         "{name}: {:?} after {} scans, {} decisions ({:.0} ms mean, {:.0} ms max); coverage {:.1} %, walked {:.1} m (estimated {:.1} m), {} collisions, {} frontiers given up {:?}, {} unreachable left; {:.1} s",
@@ -218,9 +226,7 @@ fn explores_a_small_building_to_full_coverage() {
     let building = small_building(11);
     let ours = explore_building(&building, FrontierChoice::default(), 3000);
     print("information gain", &ours);
-    assert_eq!(ours.report.outcome, ExplorationOutcome::Complete);
-    assert!(ours.coverage >= 0.97, "coverage {:.3}", ours.coverage);
-    assert_eq!(ours.collisions, 0);
+    assert_complete(&ours);
     assert!(ours.report.last_decision.chosen.is_none());
 }
 
@@ -267,13 +273,7 @@ fn a_closed_door_leaves_its_room_out() {
         open.reachable,
         shut.reachable
     );
-    assert_eq!(explored.report.outcome, ExplorationOutcome::Complete);
-    assert!(
-        explored.coverage >= 0.97,
-        "coverage {:.3}",
-        explored.coverage
-    );
-    assert_eq!(explored.collisions, 0);
+    assert_complete(&explored);
     // Nothing of the room is known free.
     let grid = explored.report.navigation.occupancy();
     let map_t_world = explored.world_t_map.inverse();
@@ -350,13 +350,7 @@ fn a_frontier_shut_off_by_a_dropped_box_is_given_up_and_reported() {
         !given_up.is_empty() || unreachable > 0,
         "no frontier of the shut room reported"
     );
-    assert_eq!(explored.report.outcome, ExplorationOutcome::Complete);
-    assert!(
-        explored.coverage >= 0.97,
-        "coverage {:.3}",
-        explored.coverage
-    );
-    assert_eq!(explored.collisions, 0);
+    assert_complete(&explored);
 }
 
 /// Bad explorer settings are refused by name before the robot moves.
