@@ -88,7 +88,7 @@ pub struct ExplorerConfig {
     /// starts (horizontally), 30 m, and the walk is re-decided once the robot is half of it
     /// from there: setting up the navigator then costs the same at the end of a long
     /// exploration as at its start, where the whole map took 12 ms mean and 25 ms at the end on
-    /// the office floor.
+    /// the office floor. At least twice [`Self::sensor_range`].
     pub localise_within: f64,
 }
 
@@ -111,7 +111,7 @@ impl Default for ExplorerConfig {
 
 impl ExplorerConfig {
     /// Every length finite and positive (the choice's detour or margin not negative), the counts at
-    /// least 1.
+    /// least 1, `localise_within` at least twice `sensor_range`.
     ///
     /// # Errors
     /// [`NavError::InvalidConfig`] naming the first bad setting.
@@ -156,6 +156,14 @@ impl ExplorerConfig {
                 setting,
                 value,
                 "finite and not negative (metres)",
+            ));
+        }
+        // The walk's map must hold what the robot sees of its frontier from where it stands.
+        if self.localise_within < 2.0 * self.sensor_range {
+            return Err(NavError::invalid(
+                "ExplorerConfig::localise_within",
+                self.localise_within,
+                "at least twice sensor_range",
             ));
         }
         Ok(())

@@ -383,6 +383,13 @@ fn bad_exploration_settings_are_refused_by_name() {
         ),
         (
             ExplorerConfig {
+                localise_within: 5.0,
+                ..ExplorerConfig::default()
+            },
+            "ExplorerConfig::localise_within",
+        ),
+        (
+            ExplorerConfig {
                 choice: FrontierChoice::InformationGain { detour: -1.0 },
                 ..ExplorerConfig::default()
             },
