@@ -216,23 +216,42 @@ impl Session {
                 seconds: timeout.as_secs_f64(),
             }),
             Ok(Ok(response)) => Ok(response.into_inner()),
-            Ok(Err(status)) => Err(match status.code() {
-                tonic::Code::Unavailable => SpotError::Unreachable {
-                    method,
-                    address: self.address.clone(),
-                    source: status,
-                },
-                tonic::Code::DeadlineExceeded => SpotError::Timeout {
-                    method,
-                    seconds: timeout.as_secs_f64(),
-                },
-                code => SpotError::Rpc {
-                    method,
-                    code,
-                    source: status,
-                },
-            }),
+            Ok(Err(status)) => Err(status_error(method, &self.address, timeout, status)),
         }
+    }
+}
+
+/// A failed call's status as a [`SpotError`]: "unavailable", and a status made on this side
+/// from a transport error (it carries that error as its source; one the robot sent carries
+/// none), as [`SpotError::Unreachable`]. A connection the robot closes mid-call (HTTP/2
+/// GOAWAY) reaches tonic as `Unknown` with hyper's error as its source, not as `Unavailable`.
+fn status_error(
+    method: &'static str,
+    address: &str,
+    timeout: std::time::Duration,
+    status: tonic::Status,
+) -> SpotError {
+    let local = std::error::Error::source(&status).is_some();
+    match status.code() {
+        tonic::Code::Unavailable => SpotError::Unreachable {
+            method,
+            address: address.to_owned(),
+            source: status,
+        },
+        tonic::Code::Unknown if local => SpotError::Unreachable {
+            method,
+            address: address.to_owned(),
+            source: status,
+        },
+        tonic::Code::DeadlineExceeded => SpotError::Timeout {
+            method,
+            seconds: timeout.as_secs_f64(),
+        },
+        code => SpotError::Rpc {
+            method,
+            code,
+            source: status,
+        },
     }
 }
 
@@ -254,5 +273,56 @@ pub(crate) fn check_header(
             code: 0,
             message: "no error code set in the response header".to_owned(),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    fn classify(status: tonic::Status) -> SpotError {
+        status_error(
+            "GetPointCloud",
+            "10.0.0.3:443",
+            Duration::from_secs(5),
+            status,
+        )
+    }
+
+    /// A connection lost mid-call (tonic makes the status on this side, with the transport's
+    /// error as its source and code `Unknown`) is the robot unreachable, not a gRPC answer; a
+    /// status the robot sent with the same code stays an answer.
+    #[test]
+    fn a_connection_lost_mid_call_is_unreachable_and_a_sent_status_is_an_answer() {
+        let reset = std::io::Error::new(std::io::ErrorKind::ConnectionReset, "GOAWAY");
+        let lost = tonic::Status::from_error(Box::new(reset));
+        assert_eq!(lost.code(), tonic::Code::Unknown);
+        assert!(
+            matches!(classify(lost), SpotError::Unreachable { method: "GetPointCloud", ref address, .. } if address == "10.0.0.3:443")
+        );
+        let sent = tonic::Status::unknown("the robot's own failure");
+        assert!(matches!(
+            classify(sent),
+            SpotError::Rpc {
+                code: tonic::Code::Unknown,
+                ..
+            }
+        ));
+        assert!(matches!(
+            classify(tonic::Status::unavailable("refused")),
+            SpotError::Unreachable { .. }
+        ));
+        assert!(matches!(
+            classify(tonic::Status::deadline_exceeded("late")),
+            SpotError::Timeout { seconds, .. } if (seconds - 5.0).abs() < 1e-12
+        ));
+        assert!(matches!(
+            classify(tonic::Status::permission_denied("no")),
+            SpotError::Rpc {
+                code: tonic::Code::PermissionDenied,
+                ..
+            }
+        ));
     }
 }
