@@ -114,12 +114,13 @@ fn a_kidnapped_start_recovers_on_building_6() {
 }
 
 /// The first `count` of twenty random goals, with two boxes dropped on routes after mapping
-/// (before legs 3 and 11, or 3 and 6 when fewer than 12 are walked): all but one at most reached
-/// within 0.10 m by ground truth, no collision.
+/// (before legs 3 and 11, or 3 and 6 when fewer than 12 are walked): reached within 0.10 m by
+/// ground truth at the rate of 19 in 20 at least (one miss in twenty goals, none in
+/// eight), no collision.
 fn goals_and_two_boxes(seed: u64, count: usize) {
     let second_box = if count > 11 { 11 } else { 6 };
     let (reached, collisions) = random_legs(seed, count, &[3, second_box]);
-    assert!(reached + 1 >= count, "{reached} of {count}");
+    assert!(reached + count / 20 >= count, "{reached} of {count}");
     assert_eq!(collisions, 0);
 }
 
