@@ -13,7 +13,7 @@ use crate::nav::detour::{DetourPolicy, Wait};
 use crate::nav::floor_levelling::level_on_floor;
 use crate::nav::localiser::{LocalisationHealth, LocalisationStatus, Localiser};
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::path::Plan;
+use crate::nav::path::{Plan, dense_path};
 use crate::nav::planner::{NavPlanner, PlannerMemory};
 use crate::nav::step::{Goal, NavigationStep};
 use crate::nav::stuck::{StuckMonitor, StuckState};
@@ -370,12 +370,24 @@ impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
                     .passes_blockage(self.planning.blocked(), &p.path().cells)
             })
         {
-            let clearance = self.config.shortcut_clearance;
-            self.plan
-                .follow_on(&self.planning, clearance, position, target);
-            self.cycles_since_plan = 0;
-            self.detour.path_clear();
-            return Ok(None);
+            // Joined from here by a short plan to the path's nearest cell (none: the path is
+            // out of reach from here, and the fresh plan is taken).
+            if let Some((at, centre)) = self.plan.nearest_cell(self.planning.blocked(), position)
+                && let Some(connection) = dense_path(
+                    &self.planning,
+                    &mut self.planner,
+                    &mut self.memory,
+                    position,
+                    centre,
+                )?
+            {
+                let clearance = self.config.shortcut_clearance;
+                self.plan
+                    .follow_on(&self.planning, clearance, connection, at, target);
+                self.cycles_since_plan = 0;
+                self.detour.path_clear();
+                return Ok(None);
+            }
         }
         let mut waiting = self.waiting_for(position, target, plan.as_ref())?;
         // What blocks the way and this scan does not see (a person who walked past close by,

@@ -103,27 +103,41 @@ impl Plan {
         self.passed = 0;
     }
 
-    /// The path from its cell nearest `position` on, its waypoints made afresh: the route kept,
-    /// as a replan from here along it would give.
+    /// The index and centre (metres) of the path's cell nearest `position`, or `None` without a
+    /// path.
+    pub(crate) fn nearest_cell(
+        &self,
+        grid: &BitGrid,
+        position: Vector2<f64>,
+    ) -> Option<(usize, Vector2<f64>)> {
+        self.path
+            .cells
+            .iter()
+            .map(|c| grid.cell_center(*c))
+            .enumerate()
+            .min_by(|a, b| {
+                let d = |c: &Vector2<f64>| (c - position).norm_squared();
+                d(&a.1).total_cmp(&d(&b.1))
+            })
+    }
+
+    /// The path from the robot on: `connection` (a dense path from the robot's cell to the
+    /// path's cell `at`), then the path after `at`, its waypoints made afresh: the route kept, as
+    /// a replan from here along it would give. Joining the path by a plan, not at its nearest
+    /// cell, matters: the robot walks the straight shortcuts between waypoints, so the nearest
+    /// cell can lie half a metre off, and the first waypoint from there round a corner the
+    /// robot cannot see past.
     pub(crate) fn follow_on(
         &mut self,
         planning: &PlanningGrid,
         shortcut_clearance: f64,
-        position: Vector2<f64>,
+        connection: GridPath,
+        at: usize,
         goal: Vector2<f64>,
     ) {
-        let grid = planning.blocked();
-        let nearest = self
-            .path
-            .cells
-            .iter()
-            .enumerate()
-            .min_by(|a, b| {
-                let d = |c: &Cell| (grid.cell_center(*c) - position).norm_squared();
-                d(a.1).total_cmp(&d(b.1))
-            })
-            .map_or(0, |(k, _)| k);
-        self.path.cells.drain(..nearest);
+        let mut cells = connection.cells;
+        cells.extend_from_slice(self.path.cells.get(at + 1..).unwrap_or_default());
+        self.path.cells = cells;
         self.path.length = cells_length(&self.path.cells);
         self.waypoints = waypoints_along(planning, shortcut_clearance, &self.path, goal);
         self.passed = 0;
@@ -247,6 +261,7 @@ mod tests {
     use super::*;
     use crate::nav::{PlannerKind, PlannerMemory};
     use gridmap::{CellState, OccupancyGrid, PlanningGridConfig};
+    use pathfind::line_of_sight;
     use slam_core::{GridGeometry, PlanError};
 
     /// A planner that answers every query with the same cells (or error).
@@ -369,6 +384,67 @@ mod tests {
         // Nothing free within 10 cells: no start.
         let solid = BitGrid::from_fn(30, 30, |_, _| true).unwrap();
         assert_eq!(nearest_free(&solid, Cell::new(15, 15)), None);
+    }
+
+    #[test]
+    fn following_on_from_off_the_path_joins_it_where_the_robot_can_see() {
+        // 40 x 40 cells of 0.1 m with a block in the middle (cells 14..26 both ways), inflated.
+        let cells = GridGeometry {
+            resolution: 0.1,
+            ..GridGeometry::default()
+        };
+        let mut occupancy = OccupancyGrid::new(40, 40, cells, CellState::Free).unwrap();
+        for x in 14..26 {
+            for y in 14..26 {
+                occupancy.set(Cell::new(x, y), CellState::Occupied).unwrap();
+            }
+        }
+        let planning = PlanningGrid::new(&occupancy, PlanningGridConfig::default()).unwrap();
+        let grid = planning.blocked();
+        let centre = |c: Cell| grid.cell_center(c);
+        // The path runs below the block and up its right side; the robot stands 0.8 m above its
+        // first leg, where a shortcut would have taken it, left of the block.
+        let (turn, goal) = (Cell::new(32, 8), Cell::new(32, 36));
+        let route = vec![Cell::new(3, 8), turn, goal];
+        let mut plan = Plan::search(
+            &planning,
+            &mut Fixed(Ok(route)),
+            &mut (),
+            0.0,
+            centre(Cell::new(3, 8)),
+            centre(goal),
+        )
+        .unwrap()
+        .unwrap();
+        let robot = Cell::new(6, 16);
+        let position = centre(robot);
+        assert!(!grid.is_blocked(robot));
+        let (at, nearest) = plan.nearest_cell(grid, position).unwrap();
+        assert_eq!(grid.cell_at(nearest), Some(Cell::new(6, 8)));
+        // The case this guards: made afresh from the nearest cell, the first waypoint is the
+        // turn below the block's far corner, which the robot cannot see (the block is between).
+        let mut from_nearest = plan.path.clone();
+        from_nearest.cells.drain(..at);
+        let naive = waypoints_along(&planning, 0.0, &from_nearest, centre(goal));
+        let first = grid.cell_at(naive[0]).unwrap();
+        assert!(!line_of_sight(grid, robot, first), "{first:?}");
+        // Joined by a plan from the robot's cell, every waypoint sees the next, the first seen
+        // from the robot; the route (below the block) kept.
+        let join = vec![robot, Cell::new(6, 8)];
+        let connection = dense_path(&planning, &mut Fixed(Ok(join)), &mut (), position, nearest)
+            .unwrap()
+            .unwrap();
+        plan.follow_on(&planning, 0.0, connection, at, centre(goal));
+        assert_eq!(plan.path().cells.first(), Some(&robot));
+        assert_eq!(plan.path().cells.last(), Some(&goal));
+        validate_dense_path(grid, &plan.path().cells).unwrap();
+        let mut from = robot;
+        for w in plan.waypoints() {
+            let cell = grid.cell_at(*w).unwrap();
+            assert!(line_of_sight(grid, from, cell), "{from:?} -> {cell:?}");
+            from = cell;
+        }
+        assert!(plan.path().cells.contains(&turn));
     }
 
     #[test]
