@@ -40,6 +40,26 @@ pub struct SlamSummary {
     /// The floors the walk stood on, lowest first (`gridmap::FloorLevels` over the scans'
     /// poses): one for a walk on one floor, none for a walk too short to cover 5 m on a level.
     pub floors: Vec<FloorSummary>,
+    /// The stairs the walk took between the floors, as links of the floors' grids (empty on
+    /// one floor).
+    pub stairs: Vec<StairsSummary>,
+}
+
+/// A flight of stairs the walk took (`spot_adapter::nav::stairs_links`): where it was entered
+/// on the lower floor and left on the upper one (the walk's last and first cells free on those
+/// floors' grids), and the walk between.
+#[derive(Clone, Debug, Serialize)]
+pub struct StairsSummary {
+    /// The floor of its foot (an index into `floors`).
+    pub lower_floor: usize,
+    /// The floor of its top.
+    pub upper_floor: usize,
+    /// Its foot's cell centre (metres, the map frame).
+    pub foot_m: [f64; 2],
+    /// Its top's cell centre.
+    pub top_m: [f64; 2],
+    /// The walk from foot to top (metres).
+    pub length_m: f64,
 }
 
 /// One floor of the walk.

@@ -12,6 +12,7 @@
 //! `cargo run --release --example slam -- [PATH] [--cloud-topic T] [--odom-topic T | --odom-frame F | --no-odometry] [--base-frame F] [--lidar-frame F] [--calibration tx,ty,tz,qx,qy,qz,qw] [--odometry FILE] [--blank-corridor] [--lidar-range M] [--out DIR] [--ground-truth FILE] [--summary FILE] [--config FILE] [--print-config]`
 
 mod args;
+mod floor_grids;
 mod report;
 
 use std::convert::Infallible;

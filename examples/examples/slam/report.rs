@@ -17,6 +17,7 @@ use spot_nav_examples::summary::{
 use spot_nav_examples::{MappedScans, Mapping, evaluate, out, print_tracking_health, value_name};
 
 use crate::args::Args;
+use crate::floor_grids::FloorGrids;
 use crate::{RunContext, Truth};
 
 /// Obstacles in the grid picture are inflated by Spot's half width and a margin (metres).
@@ -57,8 +58,23 @@ pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let poses = slam.scan_trajectory();
     let floors = split_floors(&poses)?;
     summary.floors = print_floors(slam, &poses, &floors)?;
+    // Several floors: a grid each, and the stairs between them as links of those grids.
+    let floor_grids = if floors.levels().len() > 1 {
+        let grids = FloorGrids::build(slam, args.lidar_height, &floors, &poses, INFLATION)?;
+        summary.stairs = grids.stairs()?;
+        Some(grids)
+    } else {
+        None
+    };
     if let Some(dir) = &args.out {
-        write_outputs(slam, &mapping, dir, args.lidar_height, &summary, &floors)?;
+        write_outputs(
+            slam,
+            &mapping,
+            dir,
+            args.lidar_height,
+            &summary,
+            floor_grids.as_ref(),
+        )?;
     }
     if let Some(path) = &args.summary {
         write_summary(path, &summary)?;
@@ -140,6 +156,7 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         points,
         accuracy,
         floors: Vec::new(),
+        stairs: Vec::new(),
     })
 }
 
@@ -326,56 +343,6 @@ pub(crate) fn print_accuracy(a: &Accuracy) -> Result<()> {
     )
 }
 
-/// A grid per floor in `dir` (`grid_floor{k}.png`, `map_floor{k}.yaml` + `.pgm`), each from
-/// the keyframes at that floor's height with the walk on it drawn; the keyframes between floors
-/// (on the stairs) are in none.
-fn write_floor_grids(
-    scans: &[(Pose3, &slam_core::PointCloud)],
-    mapping: &Mapping,
-    dir: &Path,
-    lidar_height: f64,
-    floors: &FloorLevels,
-) -> Result<()> {
-    let mut written = Vec::new();
-    for k in 0..floors.levels().len() {
-        let on_floor: Vec<(Pose3, &slam_core::PointCloud)> = scans
-            .iter()
-            .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
-            .copied()
-            .collect();
-        let navigation = match NavigationMap::from_scans(
-            &on_floor,
-            lidar_height,
-            &NavigationMapConfig::default(),
-        ) {
-            Ok(navigation) => navigation,
-            Err(e) => {
-                eprintln!("note: no grid for floor {k} ({e:#})");
-                continue;
-            }
-        };
-        let walked = mapping
-            .estimate
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| floors.floor_of(*i) == Some(k))
-            .map(|(_, p)| p);
-        write_grid(
-            &navigation,
-            walked,
-            &dir.join(format!("grid_floor{k}.png")),
-            &dir.join(format!("map_floor{k}.yaml")),
-        )?;
-        written.push(format!("grid_floor{k}.png, map_floor{k}.yaml + .pgm"));
-    }
-    out!(
-        "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, {}, summary.json",
-        dir.display(),
-        written.join(", ")
-    )?;
-    Ok(())
-}
-
 /// `navigation`'s grid as a picture at `png` (obstacles inflated, the `walked` poses drawn) and
 /// as a ROS map at `yaml`.
 fn write_grid<'a>(
@@ -405,7 +372,7 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     dir: &Path,
     lidar_height: f64,
     summary: &SlamSummary,
-    floors: &FloorLevels,
+    floor_grids: Option<&FloorGrids>,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     write_summary(&dir.join("summary.json"), summary)?;
@@ -415,8 +382,8 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
     write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
     let scans: Vec<_> = slam.keyframe_scans().collect();
-    if floors.levels().len() > 1 {
-        return write_floor_grids(&scans, mapping, dir, lidar_height, floors);
+    if let Some(grids) = floor_grids {
+        return grids.write(mapping, dir);
     }
     match NavigationMap::from_scans(&scans, lidar_height, &NavigationMapConfig::default()) {
         Ok(navigation) => {

@@ -240,3 +240,132 @@ fn the_tour_splits_into_its_floors_by_height() {
         assert_eq!(changes, expected, "seed {seed}");
     }
 }
+
+/// The stairs links a tour's walk gives, on each floor's true planning grid (the floor plan
+/// inflated by the navigator's 0.3 m): one link per flight although the tour climbs and comes
+/// back down each, its foot on the lower floor and its top on the upper one, within 0.8 m of the
+/// flight's true foot and top (the oracle: the building's staircases; the ends are the walk's
+/// last free cells before the steps' inflation), its length that of the flight and the walk to
+/// it, and a route over the floors from the start to the top floor goes up every flight.
+#[test]
+fn the_tours_stairs_become_links_between_the_floors_grids() {
+    use gridmap::{FloorLevels, FloorLevelsConfig, inflate};
+    use nalgebra::Vector2;
+    use spot_adapter::nav::{FloorCell, FloorGraph, RouteLeg, stairs_links};
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let (poses, _) = FloorsTour::new(&b).unwrap().walk(0.6, 5.0, 0.5).unwrap();
+        let positions: Vec<Point3<f64>> = poses
+            .iter()
+            .map(|p| Point3::from(p.pose.translation.vector))
+            .collect();
+        let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
+        // Floor k's grid: the plan (the ground floor's obstacles, the first flight's steps
+        // among them), the flight rising from floor k and the stairwell of the one arriving.
+        let floor_grids: Vec<_> = (0..floors)
+            .map(|k| {
+                let mut plan = b.occupancy_grid(0.1).unwrap();
+                for (s, stairs) in b.staircases().iter().enumerate() {
+                    if s == k {
+                        for step in stairs.step_boxes() {
+                            block_rectangle(&mut plan, step.min.xy().coords, step.max.xy().coords);
+                        }
+                    }
+                    if s + 1 == k {
+                        let (min, max) = stairs.stairwell();
+                        block_rectangle(&mut plan, min, max);
+                    }
+                }
+                inflate(&plan, 0.3).unwrap()
+            })
+            .collect();
+        let grids: Vec<_> = floor_grids.iter().collect();
+        let grid = &floor_grids[0];
+        let links = stairs_links(&positions, &split, &grids).unwrap();
+        assert_eq!(links.len(), floors - 1, "seed {seed}: {links:?}");
+        for (k, stairs) in b.staircases().iter().enumerate() {
+            let link = links
+                .iter()
+                .find(|l| l.foot.floor == k)
+                .unwrap_or_else(|| panic!("seed {seed}: no link from floor {k}: {links:?}"));
+            assert_eq!(link.top.floor, k + 1);
+            let (lower, upper) = (grids[k], grids[k + 1]);
+            let foot = lower.cell_center(link.foot.cell);
+            let top = upper.cell_center(link.top.cell);
+            assert!(!lower.is_blocked(link.foot.cell) && !upper.is_blocked(link.top.cell));
+            assert!(
+                (foot - stairs.foot).norm() < 0.8,
+                "seed {seed} floor {k}: foot {foot} against {}",
+                stairs.foot
+            );
+            assert!(
+                (top - stairs.top()).norm() < 0.8,
+                "seed {seed} floor {k}: top {top} against {}",
+                stairs.top()
+            );
+            let flight = stairs.run().hypot(stairs.climb());
+            assert!(
+                link.length > flight && link.length < flight + 2.0,
+                "seed {seed} floor {k}: {} m against a {flight} m flight",
+                link.length
+            );
+        }
+        // From the start to where the tour stood on the top floor.
+        let start = grid
+            .cell_at(Vector2::new(positions[0].x, positions[0].y))
+            .unwrap();
+        let up = (0..positions.len())
+            .find(|&i| split.floor_of(i) == Some(floors - 1))
+            .unwrap();
+        let top_grid = grids[floors - 1];
+        let on_top = (up..positions.len())
+            .filter(|&i| split.floor_of(i) == Some(floors - 1))
+            .filter_map(|i| top_grid.cell_at(Vector2::new(positions[i].x, positions[i].y)))
+            .find(|&c| !top_grid.is_blocked(c))
+            .unwrap();
+        let graph = FloorGraph::new(grids.clone(), links.clone()).unwrap();
+        let route = graph
+            .route(
+                FloorCell {
+                    floor: 0,
+                    cell: start,
+                },
+                FloorCell {
+                    floor: floors - 1,
+                    cell: on_top,
+                },
+            )
+            .unwrap()
+            .unwrap();
+        let ups = route
+            .legs
+            .iter()
+            .filter(|l| matches!(l, RouteLeg::Stairs { up: true, .. }))
+            .count();
+        assert_eq!(ups, floors - 1, "seed {seed}: {route:?}");
+        // Fewer grids than floors, or fewer positions than the walk split, are refused.
+        assert!(stairs_links(&positions, &split, &grids[..1]).is_err());
+        let short = stairs_links(&positions[..positions.len() / 2], &split, &grids);
+        assert!(short.is_err(), "{short:?}");
+    }
+}
+
+/// Blocks every cell of `grid` the plan-view rectangle `min`-`max` touches.
+fn block_rectangle(
+    grid: &mut slam_core::BitGrid,
+    min: nalgebra::Vector2<f64>,
+    max: nalgebra::Vector2<f64>,
+) {
+    let r = grid.geometry().resolution;
+    let (x0, y0) = ((min.x / r).floor() as u32, (min.y / r).floor() as u32);
+    let (x1, y1) = ((max.x / r).ceil() as u32, (max.y / r).ceil() as u32);
+    for y in y0..y1.min(grid.height()) {
+        for x in x0..x1.min(grid.width()) {
+            grid.set(slam_core::Cell::new(x, y), true).unwrap();
+        }
+    }
+}
