@@ -152,19 +152,27 @@ impl Explorer {
                 continue;
             }
             decision.reachable += 1;
-            let gain = self.gain(occupancy, frontier.middle);
             goal_cells.push(goal_cell);
             candidates.push(FrontierGoal {
                 goal,
                 frontier,
                 cost,
-                gain,
+                gain: f64::NAN,
             });
         }
         let nearest = candidates
             .iter()
             .map(|c| c.cost)
             .fold(f64::INFINITY, f64::min);
+        // The gain (a few thousand cells along rays) only where it can decide: within the
+        // detour of the information-gain rule; the chosen frontier's below for the others.
+        if let FrontierChoice::InformationGain { detour } = self.config.choice {
+            for c in &mut candidates {
+                if c.cost <= nearest + detour {
+                    c.gain = self.gain(occupancy, c.frontier.middle);
+                }
+            }
+        }
         let score = |c: &FrontierGoal| match self.config.choice {
             FrontierChoice::InformationGain { detour } => {
                 if c.cost <= nearest + detour {
@@ -186,7 +194,8 @@ impl Explorer {
                     .position(|c| (c.goal - h).norm() <= KEPT_GOAL_MOVES)
             });
             let first = tour_first(blocked, &candidates, &goal_cells, kept, keep_margin);
-            let chosen = candidates.swap_remove(first);
+            let mut chosen = candidates.swap_remove(first);
+            chosen.gain = self.gain(occupancy, chosen.frontier.middle);
             self.heading_for = Some(chosen.goal);
             decision.chosen = Some(chosen);
             return decision;
@@ -197,7 +206,12 @@ impl Explorer {
                 best = Some((s, c));
             }
         }
-        decision.chosen = best.map(|(_, g)| g);
+        decision.chosen = best.map(|(_, mut g)| {
+            if g.gain.is_nan() {
+                g.gain = self.gain(occupancy, g.frontier.middle);
+            }
+            g
+        });
         decision
     }
 
