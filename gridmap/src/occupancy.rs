@@ -3,6 +3,7 @@
 use slam_core::{BitGrid, Cell, GridGeometry};
 
 use crate::error::GridMapError;
+use crate::planning::CellRect;
 
 /// What is known of a cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -93,6 +94,52 @@ impl OccupancyGrid {
         self.occupied.set(cell, state == CellState::Occupied)?;
         self.free.set(cell, state == CellState::Free)?;
         Ok(())
+    }
+
+    /// The smallest rectangle holding every cell whose state differs from `earlier`'s (empty
+    /// when none does): the rectangle a [`crate::PlanningGrid`] built on `earlier` is
+    /// [refreshed](crate::PlanningGrid::refresh) over to match this grid. Word by word, 64 cells
+    /// at a time.
+    ///
+    /// # Errors
+    /// [`GridMapError::GeometryMismatch`] when `earlier` is not the same size and placement.
+    pub fn changed_from(&self, earlier: &Self) -> Result<CellRect, GridMapError> {
+        if (self.width(), self.height()) != (earlier.width(), earlier.height())
+            || self.geometry() != earlier.geometry()
+        {
+            return Err(GridMapError::GeometryMismatch);
+        }
+        let mut changed = CellRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+        for y in 0..self.height() {
+            let pairs = [
+                (self.occupied.row_words(y), earlier.occupied.row_words(y)),
+                (self.free.row_words(y), earlier.free.row_words(y)),
+            ];
+            for (now, then) in pairs {
+                for (i, (a, b)) in now.iter().zip(then).enumerate() {
+                    let diff = a ^ b;
+                    if diff == 0 {
+                        continue;
+                    }
+                    // Bit k of word i is column 64 i + k; the padding past the width is set in
+                    // both grids, so it never differs.
+                    let base = i as u32 * 64;
+                    let row = CellRect {
+                        x0: base + diff.trailing_zeros(),
+                        y0: y,
+                        x1: (base + 64 - diff.leading_zeros()).min(self.width()),
+                        y1: y + 1,
+                    };
+                    changed = changed.union(&row);
+                }
+            }
+        }
+        Ok(changed)
     }
 
     /// Occupied cells as a bit grid (1 = occupied).

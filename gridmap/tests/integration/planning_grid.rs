@@ -122,6 +122,51 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// `changed_from` is the bounding box of the cells whose state differs (the oracle: every
+    /// cell compared), and refreshing over it matches a rebuild.
+    #[test]
+    fn the_changed_rectangle_bounds_every_changed_cell(
+        w in 1u32..150, h in 1u32..60, density in 0u32..15, seed in any::<u64>(),
+        rect in (0u32..150, 0u32..60, 1u32..70, 1u32..30), flips in 0usize..40,
+    ) {
+        let earlier = random_occupancy(w, h, density, 5, seed);
+        let mut now = earlier.clone();
+        flip_cells_in(&mut now, rect, flips, seed.rotate_left(9));
+        let changed = now.changed_from(&earlier).unwrap();
+        let differing: Vec<Cell> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| Cell::new(x, y)))
+            .filter(|&c| now.state(c) != earlier.state(c))
+            .collect();
+        let mut want = CellRect { x0: 0, y0: 0, x1: 0, y1: 0 };
+        for c in &differing {
+            want = want.union(&CellRect::cell(*c));
+        }
+        prop_assert_eq!(changed.is_empty(), differing.is_empty());
+        if !differing.is_empty() {
+            prop_assert_eq!(changed, want);
+        }
+        let cfg = config(seed % 2 == 0, 0.3, 1.0);
+        let mut layer = PlanningGrid::new(&earlier, cfg.clone()).unwrap();
+        layer.refresh(&now, changed).unwrap();
+        let rebuilt = PlanningGrid::new(&now, cfg).unwrap();
+        prop_assert_eq!(layer.blocked(), rebuilt.blocked());
+        prop_assert_eq!(layer.step_costs(), rebuilt.step_costs());
+    }
+}
+
+#[test]
+fn grids_of_another_size_or_place_have_no_changed_rectangle() {
+    let a = random_occupancy(20, 10, 5, 5, 1);
+    let b = random_occupancy(21, 10, 5, 5, 1);
+    assert!(matches!(
+        a.changed_from(&b),
+        Err(GridMapError::GeometryMismatch)
+    ));
+}
+
 /// `flips` random cells of the rectangle `rect` (x, y taken modulo the grid, then width and
 /// height, clipped to the grid) set to random states; returns that rectangle.
 pub fn flip_cells_in(
