@@ -266,7 +266,9 @@ impl Exploration {
             let map_t_body = slam
                 .current_lidar_pose()
                 .map_or_else(Pose3::identity, |p| p * body_t_lidar.inverse());
-            let (navigation, cloud) = map.update(slam)?;
+            let navigation = map.update(slam)?;
+            let position = map_t_body.translation.vector.xy();
+            let cloud = map.cloud_within(position, self.explorer.config().localise_within);
             let mapped = Instant::now();
             self.stages.map += ms_between(started, mapped);
             let planning = self
@@ -274,7 +276,6 @@ impl Exploration {
                 .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
             let planned = Instant::now();
             self.stages.planning += ms_between(mapped, planned);
-            let position = map_t_body.translation.vector.xy();
             let decision = self
                 .explorer
                 .decide(navigation.occupancy(), &planning, position);
@@ -357,8 +358,9 @@ impl Exploration {
     }
 
     /// The navigator of a walk from `map_t_body`: on the planning grid the frontier was picked
-    /// on, localising against the map `cloud` within [`ExplorerConfig::localise_within`] (the
-    /// walk is re-decided before it leaves that), from the odometry of the last sample.
+    /// on, localising against `cloud`, the map's points within
+    /// [`ExplorerConfig::localise_within`] of the robot (the walk is re-decided before it
+    /// leaves that), from the odometry of the last sample.
     fn walker<L: Registrator + Clone, Rb: Robot>(
         &self,
         localiser: &L,
@@ -368,13 +370,9 @@ impl Exploration {
         map_t_body: Pose3,
         robot: &Rb,
     ) -> Result<Navigator<L>, NavError> {
-        let reach = self.explorer.config().localise_within;
-        let at = map_t_body.translation.vector.xy();
-        let near =
-            cloud.filtered(|_, p| (f64::from(p.x) - at.x).hypot(f64::from(p.y) - at.y) <= reach);
         let walker = Navigator::planned(
             localiser.clone(),
-            &near,
+            cloud,
             navigation,
             planning,
             map_t_body,
