@@ -12,8 +12,9 @@ pub struct TravelCosts {
     width: u32,
     /// Metres per cell side.
     resolution: f64,
-    /// Metres from the start per cell, row-major; infinite where it cannot be reached.
-    metres: Vec<f64>,
+    /// Cell sides from the start per cell, row-major; infinite where it cannot be reached
+    /// (metres on lookup: one multiplication there instead of a pass over the grid).
+    sides: Vec<f64>,
 }
 
 impl TravelCosts {
@@ -38,17 +39,19 @@ impl TravelCosts {
     fn search(blocked: &BitGrid, start: Cell, targets: &[Cell]) -> Self {
         let (w, h) = (blocked.width(), blocked.height());
         let resolution = blocked.geometry().resolution;
-        let mut metres = vec![f64::INFINITY; w as usize * h as usize];
+        let mut sides = vec![f64::INFINITY; w as usize * h as usize];
         let index = |c: Cell| c.y as usize * w as usize + c.x as usize;
         let free = |x: i64, y: i64| blocked.is_free_signed(x, y);
         if blocked.get(start) != Some(false) {
             return Self {
                 width: w,
                 resolution,
-                metres,
+                sides,
             };
         }
-        let mut is_target = vec![false; metres.len()];
+        // Only a search for targets needs the flags (a whole-grid search would fill a grid's
+        // worth of `false` for nothing).
+        let mut is_target = vec![false; if targets.is_empty() { 0 } else { sides.len() }];
         let mut unsettled = 0usize;
         for &t in targets {
             if blocked.get(t) == Some(false) && !is_target[index(t)] {
@@ -62,7 +65,7 @@ impl TravelCosts {
         // to the bit, each the least of the same sums). A binary heap's pops cost a third of
         // an explorer's decision on a large building.
         let mut buckets: Vec<Vec<(f64, u32, u32)>> = vec![vec![(0.0, start.x, start.y)]];
-        metres[index(start)] = 0.0;
+        sides[index(start)] = 0.0;
         let mut pending = 1usize;
         let mut current = 0usize;
         let mut settling = Vec::new();
@@ -70,10 +73,10 @@ impl TravelCosts {
             std::mem::swap(&mut settling, &mut buckets[current]);
             pending -= settling.len();
             for &(d, x, y) in &settling {
-                if d > metres[index(Cell::new(x, y))] {
+                if d > sides[index(Cell::new(x, y))] {
                     continue;
                 }
-                if is_target[index(Cell::new(x, y))] {
+                if is_target.get(index(Cell::new(x, y))) == Some(&true) {
                     unsettled -= 1;
                     if unsettled == 0 {
                         break 'search;
@@ -97,8 +100,8 @@ impl TravelCosts {
                     };
                     let next = Cell::new(nx as u32, ny as u32);
                     let nd = d + step;
-                    if nd < metres[index(next)] {
-                        metres[index(next)] = nd;
+                    if nd < sides[index(next)] {
+                        sides[index(next)] = nd;
                         // Finite and below the grid's cell count: the cast is exact enough.
                         let bucket = nd as usize;
                         if bucket >= buckets.len() {
@@ -112,13 +115,10 @@ impl TravelCosts {
             settling.clear();
             current += 1;
         }
-        for m in &mut metres {
-            *m *= resolution;
-        }
         Self {
             width: w,
             resolution,
-            metres,
+            sides,
         }
     }
 
@@ -130,7 +130,10 @@ impl TravelCosts {
             return None;
         }
         let k = cell.y as usize * self.width as usize + cell.x as usize;
-        self.metres.get(k).copied().filter(|m| m.is_finite())
+        self.sides
+            .get(k)
+            .map(|d| d * self.resolution)
+            .filter(|m| m.is_finite())
     }
 
     /// Metres per cell side of the grid it was computed on.
