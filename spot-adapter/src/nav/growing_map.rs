@@ -258,9 +258,16 @@ impl VoxelCentroids {
             (reach * (1.0 - 1e-9)).powi(2),
             (reach * (1.0 + 1e-9)).powi(2),
         );
+        // A voxel whose sum lies a metre beyond the reach on either axis (times its count) is
+        // out without dividing: most of a large map's voxels.
+        let slack = reach + 1.0;
         PointCloud::from_points(
             self.sums
                 .iter()
+                .filter(|(s, n)| {
+                    let n = f64::from(*n);
+                    (s[0] - n * at.x).abs() <= n * slack && (s[1] - n * at.y).abs() <= n * slack
+                })
                 .map(|(s, n)| centroid(s, *n))
                 .filter(|p| {
                     let (dx, dy) = (f64::from(p.x) - at.x, f64::from(p.y) - at.y);

@@ -165,3 +165,33 @@ fn a_map_without_obstacles_is_refused_by_name() {
         "{err:?}"
     );
 }
+
+/// The voxels within reach are the whole cloud's points within reach (the definition: the
+/// horizontal distance of each stored centroid), in the same order, for reaches that cut
+/// through voxels, none and all.
+#[test]
+fn the_cloud_within_reach_is_the_whole_cloud_filtered() {
+    let points: Vec<Point3<f32>> = (0..4000)
+        .map(|i| {
+            let f = i as f32;
+            Point3::new((f * 0.37).sin() * 40.0, (f * 0.11).cos() * 25.0, f * 0.001)
+        })
+        .collect();
+    let mut centroids = VoxelCentroids::new(0.2);
+    centroids
+        .add(&[(Pose3::identity(), &PointCloud::from_points(points))])
+        .unwrap();
+    let whole = centroids.cloud();
+    for (at, reach) in [
+        (Vector2::new(3.0, -2.0), 10.0),
+        (Vector2::new(-30.0, 10.0), 4.5),
+        (Vector2::zeros(), 0.0),
+        (Vector2::zeros(), f64::INFINITY),
+        (Vector2::new(1000.0, 0.0), 30.0),
+    ] {
+        let want =
+            whole.filtered(|_, p| (f64::from(p.x) - at.x).hypot(f64::from(p.y) - at.y) <= reach);
+        let got = centroids.within(at, reach);
+        assert_eq!(got.points(), want.points(), "at {at}, reach {reach}");
+    }
+}
