@@ -22,7 +22,8 @@ struct FloorGrid {
 pub(crate) struct FloorGrids {
     floors: FloorLevels,
     grids: Vec<Option<FloorGrid>>,
-    links: Vec<StairsLink>,
+    /// The stairs, each with its foot's and top's cell centres (metres, the map frame).
+    links: Vec<(StairsLink, Vector2<f64>, Vector2<f64>)>,
 }
 
 impl FloorGrids {
@@ -66,6 +67,7 @@ impl FloorGrids {
             .iter()
             .map(|g| g.as_ref().map(|g| &g.inflated))
             .collect();
+        // Each link with its ends' cell centres (metres), read off the grids it was found on.
         let links = match every {
             Some(planning) => {
                 let positions: Vec<_> = poses
@@ -74,6 +76,13 @@ impl FloorGrids {
                     .collect();
                 stairs_links(&positions, floors, &planning)
                     .context("finding the stairs between the floors")?
+                    .into_iter()
+                    .map(|l| {
+                        let foot = planning[l.foot.floor].cell_center(l.foot.cell);
+                        let top = planning[l.top.floor].cell_center(l.top.cell);
+                        (l, foot, top)
+                    })
+                    .collect()
             }
             None => Vec::new(),
         };
@@ -86,23 +95,15 @@ impl FloorGrids {
 
     /// The stairs as `summary.json` gives them (metres, the map frame); printed.
     pub(crate) fn stairs(&self) -> Result<Vec<StairsSummary>> {
-        let at = |floor: usize, cell: Cell| {
-            self.grids[floor]
-                .as_ref()
-                .map_or(Vector2::zeros(), |g| g.inflated.cell_center(cell))
-        };
         let stairs: Vec<StairsSummary> = self
             .links
             .iter()
-            .map(|l| {
-                let (foot, top) = (at(l.foot.floor, l.foot.cell), at(l.top.floor, l.top.cell));
-                StairsSummary {
-                    lower_floor: l.foot.floor,
-                    upper_floor: l.top.floor,
-                    foot_m: [foot.x, foot.y],
-                    top_m: [top.x, top.y],
-                    length_m: l.length,
-                }
+            .map(|(l, foot, top)| StairsSummary {
+                lower_floor: l.foot.floor,
+                upper_floor: l.top.floor,
+                foot_m: [foot.x, foot.y],
+                top_m: [top.x, top.y],
+                length_m: l.length,
             })
             .collect();
         let each: Vec<String> = stairs
@@ -123,7 +124,9 @@ impl FloorGrids {
         out!(
             "stairs      {} flight(s) between the floors' grids: {}",
             stairs.len(),
-            if each.is_empty() {
+            if self.grids.iter().any(Option::is_none) {
+                "not found (a floor has no grid)".to_string()
+            } else if each.is_empty() {
                 "none (no change of floor has a free cell at both ends)".to_string()
             } else {
                 each.join("; ")
@@ -151,7 +154,7 @@ impl FloorGrids {
             let ends: Vec<Cell> = self
                 .links
                 .iter()
-                .flat_map(|l| [l.foot, l.top])
+                .flat_map(|(l, _, _)| [l.foot, l.top])
                 .filter(|end| end.floor == k)
                 .map(|end| end.cell)
                 .collect();

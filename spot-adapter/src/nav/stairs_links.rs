@@ -95,10 +95,9 @@ pub fn stairs_links(
         };
         let link = StairsLink { foot, top, length };
         let near = |x: FloorCell, y: FloorCell| {
-            x.floor == y.floor && {
-                let (gx, gy) = (grids[x.floor], grids[y.floor]);
-                (gx.cell_center(x.cell) - gy.cell_center(y.cell)).norm() <= SAME_FLIGHT
-            }
+            let grid = grids[x.floor];
+            x.floor == y.floor
+                && (grid.cell_center(x.cell) - grid.cell_center(y.cell)).norm() <= SAME_FLIGHT
         };
         match links
             .iter_mut()

@@ -351,6 +351,15 @@ fn the_tours_stairs_become_links_between_the_floors_grids() {
         assert!(stairs_links(&positions, &split, &grids[..1]).is_err());
         let short = stairs_links(&positions[..positions.len() / 2], &split, &grids);
         assert!(short.is_err(), "{short:?}");
+        // A position on the flight that is not finite: the walk's length cannot be taken.
+        let change = split.changes()[0];
+        let mut broken = positions.clone();
+        broken[(change.left_at + change.arrived_at) / 2] = Point3::new(f64::NAN, 0.0, 1.0);
+        let bad = stairs_links(&broken, &split, &grids);
+        assert!(
+            matches!(&bad, Err(spot_adapter::nav::NavError::InvalidConfig(e)) if e.setting == "stairs_links positions"),
+            "{bad:?}"
+        );
     }
 }
 
