@@ -249,40 +249,10 @@ fn the_tour_splits_into_its_floors_by_height() {
 /// it, and a route over the floors from the start to the top floor goes up every flight.
 #[test]
 fn the_tours_stairs_become_links_between_the_floors_grids() {
-    use gridmap::{FloorLevels, FloorLevelsConfig, inflate};
     use nalgebra::Vector2;
     use spot_adapter::nav::{FloorCell, FloorGraph, RouteLeg, stairs_links};
     for (seed, floors) in [(5, 2), (11, 3)] {
-        let config = BuildingConfig {
-            floors,
-            ..BuildingConfig::default()
-        };
-        let b = Building::generate(seed, &config).unwrap();
-        let (poses, _) = FloorsTour::new(&b).unwrap().walk(0.6, 5.0, 0.5).unwrap();
-        let positions: Vec<Point3<f64>> = poses
-            .iter()
-            .map(|p| Point3::from(p.pose.translation.vector))
-            .collect();
-        let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
-        // Floor k's grid: the plan (the ground floor's obstacles, the first flight's steps
-        // among them), the flight rising from floor k and the stairwell of the one arriving.
-        let floor_grids: Vec<_> = (0..floors)
-            .map(|k| {
-                let mut plan = b.occupancy_grid(0.1).unwrap();
-                for (s, stairs) in b.staircases().iter().enumerate() {
-                    if s == k {
-                        for step in stairs.step_boxes() {
-                            block_rectangle(&mut plan, step.min.xy().coords, step.max.xy().coords);
-                        }
-                    }
-                    if s + 1 == k {
-                        let (min, max) = stairs.stairwell();
-                        block_rectangle(&mut plan, min, max);
-                    }
-                }
-                inflate(&plan, 0.3).unwrap()
-            })
-            .collect();
+        let (b, positions, split, floor_grids) = tour_on_true_grids(seed, floors);
         let grids: Vec<_> = floor_grids.iter().collect();
         let grid = &floor_grids[0];
         let links = stairs_links(&positions, &split, &grids).unwrap();
@@ -347,20 +317,73 @@ fn the_tours_stairs_become_links_between_the_floors_grids() {
             .filter(|l| matches!(l, RouteLeg::Stairs { up: true, .. }))
             .count();
         assert_eq!(ups, floors - 1, "seed {seed}: {route:?}");
-        // Fewer grids than floors, or fewer positions than the walk split, are refused.
-        assert!(stairs_links(&positions, &split, &grids[..1]).is_err());
-        let short = stairs_links(&positions[..positions.len() / 2], &split, &grids);
-        assert!(short.is_err(), "{short:?}");
-        // A position on the flight that is not finite: the walk's length cannot be taken.
-        let change = split.changes()[0];
-        let mut broken = positions.clone();
-        broken[(change.left_at + change.arrived_at) / 2] = Point3::new(f64::NAN, 0.0, 1.0);
-        let bad = stairs_links(&broken, &split, &grids);
-        assert!(
-            matches!(&bad, Err(spot_adapter::nav::NavError::InvalidConfig(e)) if e.setting == "stairs_links positions"),
-            "{bad:?}"
-        );
     }
+}
+
+/// Fewer grids than floors, fewer positions than the walk split, and a position on a flight
+/// that is not finite are refused by name.
+#[test]
+fn stairs_from_a_walk_that_does_not_fit_are_refused() {
+    use spot_adapter::nav::{NavError, stairs_links};
+    let (_, positions, split, floor_grids) = tour_on_true_grids(5, 2);
+    let grids: Vec<_> = floor_grids.iter().collect();
+    assert!(matches!(
+        stairs_links(&positions, &split, &grids[..1]),
+        Err(NavError::NoSuchFloor { .. })
+    ));
+    let named = |r: &Result<_, NavError>| matches!(r, Err(NavError::InvalidConfig(e)) if e.setting == "stairs_links positions");
+    let short = stairs_links(&positions[..positions.len() / 2], &split, &grids);
+    assert!(named(&short), "{short:?}");
+    let change = split.changes()[0];
+    let mut broken = positions.clone();
+    broken[usize::midpoint(change.left_at, change.arrived_at)] = Point3::new(f64::NAN, 0.0, 1.0);
+    let bad = stairs_links(&broken, &split, &grids);
+    assert!(named(&bad), "{bad:?}");
+}
+
+/// The floors tour of building `seed` with `floors` floors: the building, the tour's body
+/// positions, their split into floors, and each floor's true planning grid (the plan: the
+/// ground floor's obstacles, the first flight's steps among them; plus the flight rising from
+/// that floor and the stairwell of the one arriving; inflated by 0.3 m).
+fn tour_on_true_grids(
+    seed: u64,
+    floors: usize,
+) -> (
+    Building,
+    Vec<Point3<f64>>,
+    gridmap::FloorLevels,
+    Vec<slam_core::BitGrid>,
+) {
+    use gridmap::{FloorLevels, FloorLevelsConfig, inflate};
+    let config = BuildingConfig {
+        floors,
+        ..BuildingConfig::default()
+    };
+    let b = Building::generate(seed, &config).unwrap();
+    let (poses, _) = FloorsTour::new(&b).unwrap().walk(0.6, 5.0, 0.5).unwrap();
+    let positions: Vec<Point3<f64>> = poses
+        .iter()
+        .map(|p| Point3::from(p.pose.translation.vector))
+        .collect();
+    let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
+    let grids = (0..floors)
+        .map(|k| {
+            let mut plan = b.occupancy_grid(0.1).unwrap();
+            for (s, stairs) in b.staircases().iter().enumerate() {
+                if s == k {
+                    for step in stairs.step_boxes() {
+                        block_rectangle(&mut plan, step.min.xy().coords, step.max.xy().coords);
+                    }
+                }
+                if s + 1 == k {
+                    let (min, max) = stairs.stairwell();
+                    block_rectangle(&mut plan, min, max);
+                }
+            }
+            inflate(&plan, 0.3).unwrap()
+        })
+        .collect();
+    (b, positions, split, grids)
 }
 
 /// Blocks every cell of `grid` the plan-view rectangle `min`-`max` touches.
