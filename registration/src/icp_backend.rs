@@ -100,6 +100,12 @@ macro_rules! icp_backend {
             fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
                 map.remove_part(key);
             }
+
+            /// The map's k-d tree (rebuilt after each change of an in-place map) built on one
+            /// core while `beside` runs on the other.
+            fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
+                map.index_beside(beside);
+            }
         }
     };
 }

@@ -214,6 +214,21 @@ impl PreparedTarget {
 }
 
 impl PreparedTarget {
+    /// Builds the index (when an in-place map changed since the last one) on a thread of its
+    /// own while `beside` runs on this one. The index is the one the first query would build;
+    /// an error stays for that query to report.
+    pub(crate) fn index_beside(&mut self, beside: &mut (dyn FnMut() + Send)) {
+        let target = &mut *self;
+        // A thread of its own, not the pool's: the pool's idle worker did not take the other
+        // half of a `rayon::join` begun outside the pool before the first half was done.
+        std::thread::scope(|s| {
+            s.spawn(move || {
+                let _ = target.index();
+            });
+            beside();
+        });
+    }
+
     /// Keeps `matcher`, the neighbour cache an alignment of `points` (`pair_points` a pair,
     /// within `max_distance`) built against this target, for [`Self::take_matcher`].
     pub(crate) fn keep_matcher(

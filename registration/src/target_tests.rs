@@ -132,6 +132,37 @@ fn an_in_place_map_aligns_as_the_map_built_whole() {
 }
 
 #[test]
+fn a_map_readied_beside_other_work_aligns_as_one_indexed_on_first_use() {
+    use slam_core::{MapRegistrator, Registrator};
+    let icp = crate::PointToPlaneIcp::default();
+    let room = room_with(&[]);
+    let source = icp.prepare_source(&room).unwrap();
+    let (mut readied, mut lazy) = (icp.empty_map().unwrap(), icp.empty_map().unwrap());
+    let guess = Pose3::new(
+        nalgebra::Vector3::new(0.08, -0.04, 0.02),
+        nalgebra::Vector3::new(0.0, 0.0, 0.02),
+    );
+    let mut ran = 0;
+    for k in 0u32..4 {
+        let pose = Pose3::translation(0.03 * f64::from(k), 0.0, 0.0);
+        for map in [&mut readied, &mut lazy] {
+            icp.add_to_map(map, k, &source, &pose);
+            if let Some(old) = k.checked_sub(2) {
+                icp.remove_from_map(map, old);
+            }
+        }
+        assert!(readied.index.get().is_none(), "a change drops the index");
+        icp.ready_map_beside(&mut readied, &mut || ran += 1);
+        assert!(matches!(readied.index.get(), Some(Ok(_))), "keyframe {k}");
+        assert!(lazy.index.get().is_none());
+        let a = icp.align(&source, &readied, &guess).unwrap();
+        let b = icp.align(&source, &lazy, &guess).unwrap();
+        assert_eq!(a, b, "keyframe {k}");
+    }
+    assert_eq!(ran, 4, "the work beside ran once a call");
+}
+
+#[test]
 fn without_a_target_voxel_the_map_is_built_whole() {
     use slam_core::MapRegistrator;
     let mut icp = crate::PointToPlaneIcp::default();

@@ -222,6 +222,17 @@ pub trait MapRegistrator: Registrator {
     /// Removes from `map` what was added under `key`. A backend whose `empty_map` is `None` is
     /// never asked.
     fn remove_from_map(&self, map: &mut Self::Target, key: u32);
+
+    /// Runs `beside` (the caller's own work, which does not touch `map`) while `map` is made
+    /// ready for the next alignment, on another core where the backend can: a map updated in
+    /// place is indexed again on its first query after a change, and a caller that knows an
+    /// alignment comes next can hide that rebuild behind other work. Nothing a later alignment
+    /// returns may change. The default runs `beside` alone (the map is then made ready on its
+    /// first query, as without this call).
+    fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
+        let _ = map;
+        beside();
+    }
 }
 
 /// A registrator that builds maps only whole: implementing this one method gives it
