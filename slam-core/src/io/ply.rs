@@ -170,6 +170,128 @@ fn vertex_slots(el: &Element) -> Result<Vec<VertexSlot>, FormatError> {
     Ok(slots)
 }
 
+/// The layout of an element whose properties are all scalars: its record's size and the
+/// (index, offset, type) of each property a channel reads.
+struct FixedRecord {
+    size: usize,
+    fields: Vec<(usize, usize, Scalar)>,
+}
+
+/// `el`'s fixed layout for `slots`, `None` when it has a list property.
+fn fixed_record(el: &Element, slots: &[VertexSlot]) -> Option<FixedRecord> {
+    let mut size = 0;
+    let mut fields = Vec::with_capacity(slots.len());
+    for (i, p) in el.properties.iter().enumerate() {
+        let Property::Scalar { scalar, .. } = *p else {
+            return None;
+        };
+        if slots.iter().any(|s| s.property == i) {
+            fields.push((i, size, scalar));
+        }
+        size += scalar.size();
+    }
+    (size > 0).then_some(FixedRecord { size, fields })
+}
+
+/// Calls `put(record, value)` with the value of the `scalar` at `offset` of each `size`-byte
+/// record of `data`, stopping at the first error (the record's index).
+// Every integer type up to 64 bits is read as f64, as `Scalar::read` does.
+#[allow(clippy::cast_lossless)]
+fn for_each_value(
+    data: &[u8],
+    size: usize,
+    offset: usize,
+    scalar: Scalar,
+    little_endian: bool,
+    mut put: impl FnMut(usize, f64) -> Result<(), usize>,
+) -> Result<(), usize> {
+    macro_rules! column {
+        ($t:ty) => {{
+            const N: usize = std::mem::size_of::<$t>();
+            for (r, b) in data.chunks_exact(size).enumerate() {
+                let mut a = [0u8; N];
+                a.copy_from_slice(&b[offset..offset + N]);
+                let v = if little_endian {
+                    <$t>::from_le_bytes(a)
+                } else {
+                    <$t>::from_be_bytes(a)
+                };
+                put(r, v as f64)?;
+            }
+        }};
+    }
+    match scalar {
+        Scalar::I8 => column!(i8),
+        Scalar::U8 => column!(u8),
+        Scalar::I16 => column!(i16),
+        Scalar::U16 => column!(u16),
+        Scalar::I32 => column!(i32),
+        Scalar::U32 => column!(u32),
+        Scalar::I64 => column!(i64),
+        Scalar::U64 => column!(u64),
+        Scalar::F32 => column!(f32),
+        Scalar::F64 => column!(f64),
+    }
+    Ok(())
+}
+
+/// The records of `data` (laid out as `record`) into `sink`, a column at a time; the index of
+/// the first record whose ring is not a whole number in `0..=65535`.
+fn read_columns(
+    sink: &mut ChannelSink,
+    slots: &[VertexSlot],
+    record: &FixedRecord,
+    data: &[u8],
+    little_endian: bool,
+) -> Result<(), usize> {
+    let n = data.len() / record.size;
+    let first = sink.xyz.len();
+    sink.xyz
+        .resize(first + n, nalgebra::Point3::new(0.0, 0.0, 0.0));
+    for s in slots {
+        let Some(&(_, offset, scalar)) = record.fields.iter().find(|f| f.0 == s.property) else {
+            continue;
+        };
+        match s.channel {
+            Channel::X | Channel::Y | Channel::Z => {
+                let axis = match s.channel {
+                    Channel::X => 0,
+                    Channel::Y => 1,
+                    _ => 2,
+                };
+                let xyz = &mut sink.xyz[first..];
+                for_each_value(data, record.size, offset, scalar, little_endian, |r, v| {
+                    xyz[r][axis] = v as f32;
+                    Ok(())
+                })?;
+            }
+            Channel::Intensity | Channel::Time => {
+                let Some(out) = (if s.channel == Channel::Time {
+                    sink.time.as_mut()
+                } else {
+                    sink.intensity.as_mut()
+                }) else {
+                    continue;
+                };
+                for_each_value(data, record.size, offset, scalar, little_endian, |_, v| {
+                    out.push(v as f32);
+                    Ok(())
+                })?;
+            }
+            Channel::Ring => {
+                let Some(out) = sink.ring.as_mut() else {
+                    continue;
+                };
+                for_each_value(data, record.size, offset, scalar, little_endian, |r, v| {
+                    out.push(ring_value(v).ok_or(r)?);
+                    Ok(())
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn store(sink: &mut ChannelSink, slots: &[VertexSlot], values: &[f64]) -> Option<()> {
     let mut p = [0f32; 3];
     for s in slots {
@@ -267,6 +389,26 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
                 } else {
                     el.count
                 };
+                if ei == vi
+                    && let Some(record) = fixed_record(el, &slots)
+                {
+                    // Scalars only: every record has the same layout, so each channel is read
+                    // as a column at its offset, one type at a time.
+                    let end = records
+                        .checked_mul(record.size)
+                        .and_then(|n| n.checked_add(pos))
+                        .filter(|&end| end <= bytes.len())
+                        .ok_or_else(|| byte_err(pos, format!("{} data truncated", el.name)))?;
+                    read_columns(&mut sink, &slots, &record, &bytes[pos..end], little_endian)
+                        .map_err(|r| {
+                            byte_err(
+                                pos + (r + 1) * record.size,
+                                "ring value is not a whole number in 0..=65535",
+                            )
+                        })?;
+                    pos = end;
+                    continue;
+                }
                 for _ in 0..records {
                     values.clear();
                     for p in &el.properties {

@@ -315,6 +315,107 @@ fn binary_compressed_pcd() {
     assert!(matches!(parse_pcd(&bad), Err(FormatError::Byte { .. })));
 }
 
+/// The same vertices with mixed property types (some no channel reads) read alike from text,
+/// from little- and big-endian records of one fixed size, and from records that also carry a
+/// list (read one by one).
+#[test]
+fn ply_binary_records_read_as_their_text() {
+    use std::fmt::Write as _;
+    // (x f64, extra i32, y f32, z f32, ring u8, intensity f32, time f64)
+    let rows: Vec<(f64, i32, f32, f32, u8, f32, f64)> = (0..300)
+        .map(|i| {
+            let f = f64::from(i);
+            (
+                (f * 0.37).sin() * 40.0,
+                i * 7 - 900,
+                (f * 0.11).cos() as f32 * 12.5,
+                -1.25 + (i % 13) as f32 * 0.5,
+                (i % 128) as u8,
+                (i % 255) as f32,
+                f * 1e-4,
+            )
+        })
+        .collect();
+    let props = "property double x\nproperty int extra\nproperty float y\nproperty float z\n\
+property uchar ring\nproperty float intensity\nproperty double time\n";
+    let header = |format: &str, list: bool| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex {}\n{props}{}end_header\n",
+            rows.len(),
+            if list {
+                "property list uchar int idx\n"
+            } else {
+                ""
+            }
+        )
+    };
+    let mut text = header("ascii", false);
+    for r in &rows {
+        writeln!(
+            text,
+            "{} {} {} {} {} {} {}",
+            r.0, r.1, r.2, r.3, r.4, r.5, r.6
+        )
+        .unwrap();
+    }
+    let from_text = parse_ply(text.as_bytes()).unwrap();
+    for (format, list) in [
+        ("binary_little_endian", false),
+        ("binary_big_endian", false),
+        ("binary_little_endian", true),
+    ] {
+        let little = format == "binary_little_endian";
+        let mut b = header(format, list).into_bytes();
+        macro_rules! put {
+            ($v:expr) => {
+                if little {
+                    b.extend_from_slice(&$v.to_le_bytes())
+                } else {
+                    b.extend_from_slice(&$v.to_be_bytes())
+                }
+            };
+        }
+        for r in &rows {
+            put!(r.0);
+            put!(r.1);
+            put!(r.2);
+            put!(r.3);
+            put!(r.4);
+            put!(r.5);
+            put!(r.6);
+            if list {
+                put!(2u8);
+                put!(5i32);
+                put!(-6i32);
+            }
+        }
+        let from_binary = parse_ply(&b).unwrap();
+        assert_same(&from_text, &from_binary);
+        // One byte short is an error with a byte offset, not a shorter cloud.
+        assert!(matches!(
+            parse_ply(&b[..b.len() - 1]),
+            Err(FormatError::Byte { .. })
+        ));
+    }
+    assert_eq!(from_text.len(), rows.len());
+    assert_eq!(from_text.ring().unwrap()[129], 1);
+    // A ring that is no whole number in 0..=65535 is refused at the end of its record.
+    let head = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n\
+property float y\nproperty float z\nproperty int ring\nend_header\n";
+    let mut b = head.as_bytes().to_vec();
+    for ring in [0i32, 5, -1, 7] {
+        for v in [1.0f32, 2.0, 3.0] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(&ring.to_le_bytes());
+    }
+    let at = head.len() + 3 * 16;
+    assert!(matches!(
+        parse_ply(&b),
+        Err(FormatError::Byte { offset, .. }) if offset == at
+    ));
+}
+
 #[test]
 fn ply_skips_other_elements_and_lists() {
     let text = "ply\nformat ascii 1.0\nelement camera 1\nproperty float fov\nelement vertex 2\n\
