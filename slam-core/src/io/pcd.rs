@@ -8,7 +8,9 @@ use std::path::Path;
 use super::lzf::lzf_decompress;
 use super::point_record::{write_ascii_records, write_binary_records};
 use super::reading::{byte_err, line_err, next_header_line, require_xyz};
-use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
+use super::scalar::{
+    Channel, ChannelSink, Column, Scalar, create_file, parse_f64, read_file, ring_value,
+};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
 
@@ -325,20 +327,26 @@ fn parse_binary(header: &Header, layout: &Layout, data: &[u8]) -> Result<PointCl
         ));
     }
     let mut sink = sink_for(layout, n);
-    for (i, rec) in data.chunks_exact(layout.record_size).take(n).enumerate() {
-        let at = || {
-            byte_err(
-                header.data_offset + i * layout.record_size,
-                "ring value is not a u16",
-            )
-        };
-        push_point(
-            &mut sink,
-            layout,
-            |s| Ok(s.scalar.read(&rec[s.offset..], true)),
-            at,
-        )?;
-    }
+    // Every record has the same layout: each channel is read as a column at its offset.
+    let columns: Vec<(Channel, Column<'_>)> = layout
+        .slots
+        .iter()
+        .map(|s| {
+            let column = Column {
+                data: &data[..need],
+                stride: layout.record_size,
+                offset: s.offset,
+                scalar: s.scalar,
+            };
+            (s.channel, column)
+        })
+        .collect();
+    sink.extend_columns(n, &columns, true).map_err(|i| {
+        byte_err(
+            header.data_offset + i * layout.record_size,
+            "ring value is not a u16",
+        )
+    })?;
     sink.finish()
 }
 
@@ -374,19 +382,25 @@ fn parse_compressed(
         acc += f.scalar.size() * f.count * n;
     }
     let mut sink = sink_for(layout, n);
-    for i in 0..n {
-        let at = || byte_err(header.data_offset, "ring value is not a u16");
-        push_point(
-            &mut sink,
-            layout,
-            |s| {
-                let f = &header.fields[s.field_index];
-                let off = field_start[s.field_index] + i * f.scalar.size() * f.count;
-                Ok(s.scalar.read(&raw[off..], true))
-            },
-            at,
-        )?;
-    }
+    // Each field's block is a column of `n` values (`count` of them a point; the first read).
+    let columns: Vec<(Channel, Column<'_>)> = layout
+        .slots
+        .iter()
+        .map(|s| {
+            let f = &header.fields[s.field_index];
+            let stride = f.scalar.size() * f.count;
+            let start = field_start[s.field_index];
+            let column = Column {
+                data: &raw[start..start + stride * n],
+                stride,
+                offset: 0,
+                scalar: s.scalar,
+            };
+            (s.channel, column)
+        })
+        .collect();
+    sink.extend_columns(n, &columns, true)
+        .map_err(|_| byte_err(header.data_offset, "ring value is not a u16"))?;
     sink.finish()
 }
 

@@ -7,7 +7,9 @@ use std::path::Path;
 
 use super::point_record::{write_ascii_records, write_binary_records};
 use super::reading::{byte_err, line_err, next_header_line, require_xyz};
-use super::scalar::{Channel, ChannelSink, Scalar, create_file, parse_f64, read_file, ring_value};
+use super::scalar::{
+    Channel, ChannelSink, Column, Scalar, create_file, parse_f64, read_file, ring_value,
+};
 use crate::cloud::PointCloud;
 use crate::error::FormatError;
 
@@ -193,105 +195,6 @@ fn fixed_record(el: &Element, slots: &[VertexSlot]) -> Option<FixedRecord> {
     (size > 0).then_some(FixedRecord { size, fields })
 }
 
-/// Calls `put(record, value)` with the value of the `scalar` at `offset` of each `size`-byte
-/// record of `data`, stopping at the first error (the record's index).
-// Every integer type up to 64 bits is read as f64, as `Scalar::read` does.
-#[allow(clippy::cast_lossless)]
-fn for_each_value(
-    data: &[u8],
-    size: usize,
-    offset: usize,
-    scalar: Scalar,
-    little_endian: bool,
-    mut put: impl FnMut(usize, f64) -> Result<(), usize>,
-) -> Result<(), usize> {
-    macro_rules! column {
-        ($t:ty) => {{
-            const N: usize = std::mem::size_of::<$t>();
-            for (r, b) in data.chunks_exact(size).enumerate() {
-                let mut a = [0u8; N];
-                a.copy_from_slice(&b[offset..offset + N]);
-                let v = if little_endian {
-                    <$t>::from_le_bytes(a)
-                } else {
-                    <$t>::from_be_bytes(a)
-                };
-                put(r, v as f64)?;
-            }
-        }};
-    }
-    match scalar {
-        Scalar::I8 => column!(i8),
-        Scalar::U8 => column!(u8),
-        Scalar::I16 => column!(i16),
-        Scalar::U16 => column!(u16),
-        Scalar::I32 => column!(i32),
-        Scalar::U32 => column!(u32),
-        Scalar::I64 => column!(i64),
-        Scalar::U64 => column!(u64),
-        Scalar::F32 => column!(f32),
-        Scalar::F64 => column!(f64),
-    }
-    Ok(())
-}
-
-/// The records of `data` (laid out as `record`) into `sink`, a column at a time; the index of
-/// the first record whose ring is not a whole number in `0..=65535`.
-fn read_columns(
-    sink: &mut ChannelSink,
-    slots: &[VertexSlot],
-    record: &FixedRecord,
-    data: &[u8],
-    little_endian: bool,
-) -> Result<(), usize> {
-    let n = data.len() / record.size;
-    let first = sink.xyz.len();
-    sink.xyz
-        .resize(first + n, nalgebra::Point3::new(0.0, 0.0, 0.0));
-    for s in slots {
-        let Some(&(_, offset, scalar)) = record.fields.iter().find(|f| f.0 == s.property) else {
-            continue;
-        };
-        match s.channel {
-            Channel::X | Channel::Y | Channel::Z => {
-                let axis = match s.channel {
-                    Channel::X => 0,
-                    Channel::Y => 1,
-                    _ => 2,
-                };
-                let xyz = &mut sink.xyz[first..];
-                for_each_value(data, record.size, offset, scalar, little_endian, |r, v| {
-                    xyz[r][axis] = v as f32;
-                    Ok(())
-                })?;
-            }
-            Channel::Intensity | Channel::Time => {
-                let Some(out) = (if s.channel == Channel::Time {
-                    sink.time.as_mut()
-                } else {
-                    sink.intensity.as_mut()
-                }) else {
-                    continue;
-                };
-                for_each_value(data, record.size, offset, scalar, little_endian, |_, v| {
-                    out.push(v as f32);
-                    Ok(())
-                })?;
-            }
-            Channel::Ring => {
-                let Some(out) = sink.ring.as_mut() else {
-                    continue;
-                };
-                for_each_value(data, record.size, offset, scalar, little_endian, |r, v| {
-                    out.push(ring_value(v).ok_or(r)?);
-                    Ok(())
-                })?;
-            }
-        }
-    }
-    Ok(())
-}
-
 fn store(sink: &mut ChannelSink, slots: &[VertexSlot], values: &[f64]) -> Option<()> {
     let mut p = [0f32; 3];
     for s in slots {
@@ -399,7 +302,25 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PointCloud, FormatError> {
                         .and_then(|n| n.checked_add(pos))
                         .filter(|&end| end <= bytes.len())
                         .ok_or_else(|| byte_err(pos, format!("{} data truncated", el.name)))?;
-                    read_columns(&mut sink, &slots, &record, &bytes[pos..end], little_endian)
+                    let columns: Vec<(Channel, Column<'_>)> = slots
+                        .iter()
+                        .filter_map(|s| {
+                            let &(_, offset, scalar) =
+                                record.fields.iter().find(|f| f.0 == s.property)?;
+                            let data = &bytes[pos..end];
+                            let stride = record.size;
+                            Some((
+                                s.channel,
+                                Column {
+                                    data,
+                                    stride,
+                                    offset,
+                                    scalar,
+                                },
+                            ))
+                        })
+                        .collect();
+                    sink.extend_columns(records, &columns, little_endian)
                         .map_err(|r| {
                             byte_err(
                                 pos + (r + 1) * record.size,

@@ -122,6 +122,58 @@ impl Channel {
 }
 
 /// Collects decoded values per channel and builds the cloud.
+/// One field's values in binary records: the `scalar` at `offset` of each `stride`-byte record
+/// of `data`.
+pub(crate) struct Column<'a> {
+    pub(crate) data: &'a [u8],
+    pub(crate) stride: usize,
+    pub(crate) offset: usize,
+    pub(crate) scalar: Scalar,
+}
+
+impl Column<'_> {
+    /// Calls `put(record, value)` for the first `n` records, stopping at the first error (the
+    /// record's index); one loop per type, not a match per value.
+    // Every integer type up to 64 bits is read as f64, as `Scalar::read` does.
+    #[allow(clippy::cast_lossless)]
+    fn for_each(
+        &self,
+        n: usize,
+        little_endian: bool,
+        mut put: impl FnMut(usize, f64) -> Result<(), usize>,
+    ) -> Result<(), usize> {
+        let offset = self.offset;
+        macro_rules! column {
+            ($t:ty) => {{
+                const N: usize = std::mem::size_of::<$t>();
+                for (r, b) in self.data.chunks_exact(self.stride).take(n).enumerate() {
+                    let mut a = [0u8; N];
+                    a.copy_from_slice(&b[offset..offset + N]);
+                    let v = if little_endian {
+                        <$t>::from_le_bytes(a)
+                    } else {
+                        <$t>::from_be_bytes(a)
+                    };
+                    put(r, v as f64)?;
+                }
+            }};
+        }
+        match self.scalar {
+            Scalar::I8 => column!(i8),
+            Scalar::U8 => column!(u8),
+            Scalar::I16 => column!(i16),
+            Scalar::U16 => column!(u16),
+            Scalar::I32 => column!(i32),
+            Scalar::U32 => column!(u32),
+            Scalar::I64 => column!(i64),
+            Scalar::U64 => column!(u64),
+            Scalar::F32 => column!(f32),
+            Scalar::F64 => column!(f64),
+        }
+        Ok(())
+    }
+}
+
 #[derive(Default)]
 pub(crate) struct ChannelSink {
     pub(crate) xyz: Vec<nalgebra::Point3<f32>>,
@@ -139,6 +191,58 @@ impl ChannelSink {
             intensity: intensity.then(|| Vec::with_capacity(n)),
             time: time.then(|| Vec::with_capacity(n)),
         }
+    }
+
+    /// Appends `n` points read a column at a time, each channel from its `Column` (values of
+    /// channels the sink does not hold are skipped); the index of the first point whose ring is
+    /// not a whole number in `0..=65535`. Every column holds `n` values.
+    pub(crate) fn extend_columns(
+        &mut self,
+        n: usize,
+        columns: &[(Channel, Column<'_>)],
+        little_endian: bool,
+    ) -> Result<(), usize> {
+        let first = self.xyz.len();
+        self.xyz
+            .resize(first + n, nalgebra::Point3::new(0.0, 0.0, 0.0));
+        for (channel, column) in columns {
+            match channel {
+                Channel::X | Channel::Y | Channel::Z => {
+                    let axis = match channel {
+                        Channel::X => 0,
+                        Channel::Y => 1,
+                        _ => 2,
+                    };
+                    let xyz = &mut self.xyz[first..];
+                    column.for_each(n, little_endian, |r, v| {
+                        xyz[r][axis] = v as f32;
+                        Ok(())
+                    })?;
+                }
+                Channel::Intensity | Channel::Time => {
+                    let out = if *channel == Channel::Time {
+                        self.time.as_mut()
+                    } else {
+                        self.intensity.as_mut()
+                    };
+                    if let Some(out) = out {
+                        column.for_each(n, little_endian, |_, v| {
+                            out.push(v as f32);
+                            Ok(())
+                        })?;
+                    }
+                }
+                Channel::Ring => {
+                    if let Some(out) = self.ring.as_mut() {
+                        column.for_each(n, little_endian, |r, v| {
+                            out.push(ring_value(v).ok_or(r)?);
+                            Ok(())
+                        })?;
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The finished cloud.

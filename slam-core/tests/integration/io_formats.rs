@@ -276,6 +276,82 @@ fn pcd_errors_name_the_place() {
     ));
 }
 
+/// The same points with mixed field types (one of three values, some no channel reads) read
+/// alike from `ascii`, `binary` and `binary_compressed` data (the compressed blocks as LZF literal
+/// runs).
+#[test]
+fn pcd_binary_and_compressed_points_read_as_their_ascii() {
+    use std::fmt::Write as _;
+    let n = 200usize;
+    // x F8, extra I4, normal F4 x3, y F4, z F4, ring U2, intensity F4, t F8
+    let head = |data: &str| {
+        format!(
+            "FIELDS x extra normal y z ring intensity t\nSIZE 8 4 4 4 4 2 4 8\n\
+TYPE F I F F F U F F\nCOUNT 1 1 3 1 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nPOINTS {n}\nDATA {data}\n"
+        )
+    };
+    let row = |i: usize| {
+        let f = i as f64;
+        (
+            (f * 0.31).sin() * 30.0,
+            i as i32 * 5 - 400,
+            [0.5f32, -0.25, f as f32],
+            (f * 0.07).cos() as f32 * 9.0,
+            -2.0 + (i % 11) as f32 * 0.25,
+            (i % 64) as u16,
+            (i % 200) as f32,
+            f * 1e-4,
+        )
+    };
+    let mut text = head("ascii");
+    for i in 0..n {
+        let r = row(i);
+        writeln!(
+            text,
+            "{} {} {} {} {} {} {} {} {} {}",
+            r.0, r.1, r.2[0], r.2[1], r.2[2], r.3, r.4, r.5, r.6, r.7
+        )
+        .unwrap();
+    }
+    let from_text = parse_pcd(text.as_bytes()).unwrap();
+    // One record a point ...
+    let mut binary = head("binary").into_bytes();
+    // ... or one block a field.
+    let mut blocks: Vec<Vec<u8>> = vec![Vec::new(); 8];
+    for i in 0..n {
+        let r = row(i);
+        let fields: [Vec<u8>; 8] = [
+            r.0.to_le_bytes().to_vec(),
+            r.1.to_le_bytes().to_vec(),
+            r.2.iter().flat_map(|v| v.to_le_bytes()).collect(),
+            r.3.to_le_bytes().to_vec(),
+            r.4.to_le_bytes().to_vec(),
+            r.5.to_le_bytes().to_vec(),
+            r.6.to_le_bytes().to_vec(),
+            r.7.to_le_bytes().to_vec(),
+        ];
+        for (block, f) in blocks.iter_mut().zip(&fields) {
+            binary.extend_from_slice(f);
+            block.extend_from_slice(f);
+        }
+    }
+    let raw: Vec<u8> = blocks.concat();
+    let mut lzf = Vec::new();
+    for run in raw.chunks(32) {
+        lzf.push((run.len() - 1) as u8);
+        lzf.extend_from_slice(run);
+    }
+    let mut compressed = head("binary_compressed").into_bytes();
+    compressed.extend_from_slice(&(lzf.len() as u32).to_le_bytes());
+    compressed.extend_from_slice(&(raw.len() as u32).to_le_bytes());
+    compressed.extend_from_slice(&lzf);
+    assert_same(&from_text, &parse_pcd(&binary).unwrap());
+    assert_same(&from_text, &parse_pcd(&compressed).unwrap());
+    assert_eq!(from_text.len(), n);
+    assert_eq!(from_text.ring().unwrap()[65], 1);
+    assert!((from_text.points()[3].z - (-1.25)).abs() < 1e-6);
+}
+
 #[test]
 fn binary_compressed_pcd() {
     let head = b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA binary_compressed\n";
