@@ -149,6 +149,13 @@ pub struct GraphSlamConfig {
     /// 800 m walk, and 0.4 m of height from walking forward on it). Leave it off for odometry
     /// whose frame is not level. Scans without odometry are registered in all six degrees.
     pub odometry_gravity: bool,
+    /// With [`Self::odometry_gravity`], the standard deviation (radians, 0.01 degrees) of the
+    /// relative tilt of an odometry edge whose two keyframes were both levelled on the
+    /// odometry's gravity: their roll and pitch come from one IMU, so the edge's rotations about
+    /// its x and y axes are known that well, whatever its own information says. Without it the
+    /// optimiser could spread a loop's height mismatch as a tilt of the chain (a floor climbed
+    /// to by stairs ended tilted, 7.6 cm low at its far end against 4.6 cm with it).
+    pub gravity_tilt_sigma: f64,
     /// Deskew keyframe scans that carry a per-point `time` channel, with the LiDAR velocity the
     /// odometry showed between the previous scan and this one (constant over the sweep). Scans
     /// without times, and scans more than a second after the previous one, are used as they
@@ -222,6 +229,7 @@ impl Default for GraphSlamConfig {
             map_voxel_size: 0.05,
             min_scan_points: 100,
             odometry_gravity: true,
+            gravity_tilt_sigma: 0.01f64.to_radians(),
             deskew: true,
             sweep_motion: true,
             sweep_min_gain: 0.05,
@@ -324,6 +332,14 @@ impl GraphSlamConfig {
                 "finite and not negative",
             )?;
         }
+        InvalidSetting::check(
+            self.gravity_tilt_sigma.is_finite()
+                && self.gravity_tilt_sigma > 0.0
+                && (1.0 / (self.gravity_tilt_sigma * self.gravity_tilt_sigma)).is_finite(),
+            "GraphSlamConfig::gravity_tilt_sigma",
+            self.gravity_tilt_sigma,
+            "finite and positive (with a finite 1 / sigma^2)",
+        )?;
         InvalidSetting::check(
             (0.0..1.0).contains(&self.sweep_min_gain),
             "GraphSlamConfig::sweep_min_gain",

@@ -8,7 +8,7 @@ use nalgebra::{Matrix6, UnitQuaternion};
 
 use super::config::GraphSlamConfig;
 use super::gravity::level_on_gravity;
-use super::information::edge_information;
+use super::information::{edge_information, with_tilt};
 use super::keyframes::{Keyframe, Link, ScanPose};
 use super::local_map::{LocalMap, LocalWindow};
 use super::loop_closure::LoopQueue;
@@ -454,6 +454,27 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         Ok(())
     }
 
+    /// The odometry edge from keyframe `from` to a new keyframe at `pose` (with its
+    /// registration's information, and its odometry when it had some).
+    fn odometry_edge(
+        &self,
+        from: usize,
+        pose: &Pose3,
+        reg_info: Option<&Matrix6<f64>>,
+        odom_t_lidar: Option<Pose3>,
+    ) -> (u64, Pose3, Matrix6<f64>) {
+        let step = self.keyframe_pose(from).inverse() * pose;
+        let mut info = edge_information(self.config.odometry_information, reg_info, pose);
+        // Both ends levelled on the odometry's gravity: their relative tilt is the IMU's.
+        if self.config.odometry_gravity
+            && odom_t_lidar.is_some()
+            && self.keyframes[from].odom_t_lidar.is_some()
+        {
+            info = with_tilt(info, self.config.gravity_tilt_sigma);
+        }
+        (from as u64, step, info)
+    }
+
     /// Adds `prepared` as a keyframe at `pose` (with its `registration`'s information for its
     /// odometry edge, and the share of the scan it matched), queues its loop candidate and runs a loop-closure step when
     /// inline.
@@ -507,11 +528,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // The odometry edge comes from the reference: the last keyframe, or on a revisit the old
         // keyframe the walk rode on.
         let parent = self.reference().map(|r| r.keyframe);
-        let edge = parent.map(|from| {
-            let step = self.keyframe_pose(from).inverse() * pose;
-            let info = edge_information(self.config.odometry_information, reg_info, &pose);
-            (from as u64, step, info)
-        });
+        let edge = parent.map(|from| self.odometry_edge(from, &pose, reg_info, odom_t_lidar));
         if self.insert_node(id, pose, edge.as_ref()).is_err() {
             return self.skip(SkipReason::NonFinitePose, started);
         }

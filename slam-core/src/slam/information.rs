@@ -64,6 +64,16 @@ pub(crate) fn edge_information(
 }
 
 /// Diagonal information from standard deviations (tangent order `[rho; phi]`).
+/// `info` (an edge's, in its own frame) with the edge's relative tilt measured too: the
+/// rotations about its x and y axes, each with standard deviation `sigma` (radians), added as
+/// an independent measurement.
+pub(crate) fn with_tilt(mut info: Matrix6<f64>, sigma: f64) -> Matrix6<f64> {
+    let w = 1.0 / (sigma * sigma);
+    info[(3, 3)] += w;
+    info[(4, 4)] += w;
+    info
+}
+
 pub(crate) fn fixed_information(translation_sigma: f64, rotation_sigma: f64) -> Matrix6<f64> {
     let (t, r) = (
         1.0 / (translation_sigma * translation_sigma),

@@ -46,7 +46,28 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 14] = [
+    let cases: [(GraphSlamConfig, &str); 17] = [
+        (
+            GraphSlamConfig {
+                gravity_tilt_sigma: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::gravity_tilt_sigma",
+        ),
+        (
+            GraphSlamConfig {
+                gravity_tilt_sigma: 0.0,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::gravity_tilt_sigma",
+        ),
+        (
+            GraphSlamConfig {
+                gravity_tilt_sigma: -1e-4,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::gravity_tilt_sigma",
+        ),
         (
             GraphSlamConfig {
                 sweep_min_gain: f64::NAN,
