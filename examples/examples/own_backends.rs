@@ -195,6 +195,10 @@ impl MapRegistrator for CountingIcp {
     fn remove_from_map(&self, map: &mut Self::Target, key: u32) {
         self.icp.remove_from_map(map, key);
     }
+
+    fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
+        self.icp.ready_map_beside(map, beside);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -227,12 +227,9 @@ pub trait MapRegistrator: Registrator {
     /// ready for the next alignment, on another core where the backend can: a map updated in
     /// place is indexed again on its first query after a change, and a caller that knows an
     /// alignment comes next can hide that rebuild behind other work. Nothing a later alignment
-    /// returns may change. The default runs `beside` alone (the map is then made ready on its
-    /// first query, as without this call).
-    fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
-        let _ = map;
-        beside();
-    }
+    /// returns may change. A backend with nothing to prepare runs `beside` alone; a wrapper
+    /// forwards it (required, as the others are, so that a wrapper cannot lose it unnoticed).
+    fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send));
 }
 
 /// A registrator that builds maps only whole: implementing this one method gives it
@@ -315,4 +312,9 @@ impl<R: WholeMapRegistrator> MapRegistrator for R {
     }
 
     fn remove_from_map(&self, _map: &mut Self::Target, _key: u32) {}
+
+    /// A map built whole is ready when built: `beside` alone.
+    fn ready_map_beside(&self, _map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
+        beside();
+    }
 }

@@ -99,6 +99,9 @@ impl MapRegistrator for InPlaceIcp {
         );
         map.refresh(&self.0);
     }
+    fn ready_map_beside(&self, _map: &mut InPlaceMap, beside: &mut (dyn FnMut() + Send)) {
+        beside();
+    }
 }
 
 /// A local map slid in place (one keyframe in, the oldest out) must hold exactly the window a
