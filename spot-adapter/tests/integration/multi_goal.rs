@@ -67,7 +67,9 @@ fn random_legs(seed: u64, count: usize, boxes_before: &[usize]) -> (usize, usize
 }
 
 /// Navigation starts with the estimate 0.5 m and 10 degrees off the truth: the localiser finds
-/// the robot again within 10 s (50 scans) and it reaches its goal, in every building.
+/// the robot again within 10 s (50 scans: the estimate within 5 cm), stays within 0.10 m from
+/// then on (the navigation tests' bar; building 5's estimate wanders up to 5.2 cm in the last
+/// half metre before its goal) and the robot reaches its goal, in every building.
 fn kidnapped(seed: u64) {
     let (building, map, navigation) = mapped(seed);
     let start = building.corridor_loop()[0];
@@ -93,6 +95,11 @@ fn kidnapped(seed: u64) {
     eprintln!("seed {seed} kidnapped: {leg:?}");
     let after = leg.localised_after.unwrap();
     assert!(after <= 50, "localised after {after} scans");
+    assert!(
+        leg.worst_after_localised < 0.10,
+        "{} m off once localised",
+        leg.worst_after_localised
+    );
     assert_eq!(leg.outcome, DriveOutcome::Arrived);
     assert!(leg.error <= 0.10, "{} m off", leg.error);
     assert_eq!(leg.collisions, 0);

@@ -91,8 +91,10 @@ pub struct Leg {
     pub walked: f64,
     /// Largest localisation error on the leg (metres) above 5 cm, or 0.
     pub worst_localisation: f64,
-    /// The cycle from which the localisation error stayed under 5 cm, if it did.
+    /// The first cycle whose localisation error was under 5 cm, if one was.
     pub localised_after: Option<usize>,
+    /// The largest localisation error from that cycle on (metres).
+    pub worst_after_localised: f64,
 }
 
 /// Where a run starts: the true position and heading, and how far the navigator's first
@@ -175,16 +177,18 @@ pub fn run_legs(
         let (mut worst, mut walked) = (0.0f64, 0.0);
         let mut last: Option<Vector2<f64>> = None;
         let (mut cycle_count, mut localised_from) = (0usize, None);
+        let mut worst_after = 0.0f64;
         let report = drive(&mut spot, &mut nav, goal, cycles, |cycle| {
             cycle_count += 1;
             let truth = cycle.sample.ground_truth.unwrap().translation.vector.xy();
             let error = (cycle.estimate.translation.vector.xy() - truth).norm();
-            // Localised from the first cycle after which the error stays under 5 cm.
             if error < 0.05 {
                 localised_from.get_or_insert(cycle_count);
             } else {
-                localised_from = None;
                 worst = worst.max(error);
+            }
+            if localised_from.is_some() {
+                worst_after = worst_after.max(error);
             }
             walked += last.map_or(0.0, |p| (truth - p).norm());
             last = Some(truth);
@@ -199,6 +203,7 @@ pub fn run_legs(
             walked,
             worst_localisation: worst,
             localised_after: localised_from,
+            worst_after_localised: worst_after,
         });
     }
     assert_eq!(pending, 0, "no room for every box on the routes");
