@@ -185,6 +185,9 @@ mod tests {
             e.contains("2 KITTI poses for 1 scans") && e.contains("b.tum"),
             "{e}"
         );
+        for file in [tum, kitti] {
+            let _ = std::fs::remove_file(file);
+        }
     }
 
     #[test]
@@ -210,10 +213,9 @@ mod tests {
             ),
         ];
         for (name, text, expect) in cases {
-            let e = format!(
-                "{:#}",
-                GroundTruthFile::read(&written(name, text)).unwrap_err()
-            );
+            let file = written(name, text);
+            let e = format!("{:#}", GroundTruthFile::read(&file).unwrap_err());
+            let _ = std::fs::remove_file(&file);
             assert!(e.contains(name) && e.contains(expect), "{name}: {e}");
         }
         let missing = std::env::temp_dir().join("spot-nav-no-such-ground-truth.tum");

@@ -61,6 +61,9 @@ fn a_scan_folder_without_calibration_or_odometry_is_mapped() {
     ] {
         assert!(out.join(file).is_file(), "{file} missing:\n{stdout}");
     }
+    for dir in [&scans, &out] {
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }
 
 #[test]
@@ -71,6 +74,7 @@ fn a_broken_bag_fails_naming_it_and_writes_nothing() {
     // The MCAP magic and then nothing: a recording cut short.
     std::fs::write(&bag, b"\x89MCAP0\r\n\x01\x10\x00\x00").expect("write");
     slam_fails_leaving_nothing(&[bag.as_os_str()], &dir.join("out"), &["cut.mcap"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `slam ARGS --out OUT` fails (status 1) naming each of `names` on stderr, and leaves no OUT.

@@ -66,6 +66,7 @@ fn a_static_scan_folder_runs_lidar_only_without_drifting() {
         assert!(angle < 1e-3, "scan {i}: {angle} rad");
     }
     assert_eq!(slam.report().fallbacks(), 0, "{:?}", slam.report().tracking);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -151,6 +152,7 @@ fn a_folder_with_odometry_takes_it_at_each_scan_stamp() {
     std::fs::copy(garage_scan(), scans.join("12.0.pcd")).unwrap();
     let err = open_recording(&scans, &config).unwrap_err();
     assert!(err.to_string().contains("odometry.tum"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -173,6 +175,7 @@ fn kitti_no_return_points_are_removed_and_counted() {
     let s = samples.next().unwrap().unwrap();
     assert_eq!(s.cloud.len(), 50);
     assert_eq!(samples.dropped_points().no_return, 8);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -211,6 +214,7 @@ fn nanosecond_times_in_scan_files_are_read_as_seconds() {
     // The unit was decided on the first scan: a later one in seconds no longer fits it.
     let err = samples.next().unwrap().unwrap_err();
     assert!(err.to_string().contains("1.1.pcd"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
     // Times that fit no unit are an error naming the file.
     let dir = temp_dir("bad-times");
     let five: Vec<f32> = (0..100).map(|i| i as f32 * 0.05).collect();
@@ -226,4 +230,5 @@ fn nanosecond_times_in_scan_files_are_read_as_seconds() {
         .samples;
     let err = samples.next().unwrap().unwrap_err();
     assert!(err.to_string().contains("no unit"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
