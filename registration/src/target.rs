@@ -218,6 +218,11 @@ impl PreparedTarget {
     /// own while `beside` runs on this one. The index is the one the first query would build;
     /// an error stays for that query to report.
     pub(crate) fn index_beside(&mut self, beside: &mut (dyn FnMut() + Send)) {
+        // Built already (the map did not change since): no thread for nothing.
+        if self.index.get().is_some() {
+            beside();
+            return;
+        }
         let target = &mut *self;
         // A thread of its own, not the pool's: the pool's idle worker did not take the other
         // half of a `rayon::join` begun outside the pool before the first half was done.

@@ -154,12 +154,14 @@ fn a_map_readied_beside_other_work_aligns_as_one_indexed_on_first_use() {
         assert!(readied.index.get().is_none(), "a change drops the index");
         icp.ready_map_beside(&mut readied, &mut || ran += 1);
         assert!(matches!(readied.index.get(), Some(Ok(_))), "keyframe {k}");
+        // Ready already: the work runs all the same.
+        icp.ready_map_beside(&mut readied, &mut || ran += 1);
         assert!(lazy.index.get().is_none());
         let a = icp.align(&source, &readied, &guess).unwrap();
         let b = icp.align(&source, &lazy, &guess).unwrap();
         assert_eq!(a, b, "keyframe {k}");
     }
-    assert_eq!(ran, 4, "the work beside ran once a call");
+    assert_eq!(ran, 8, "the work beside ran once a call");
 }
 
 #[test]
