@@ -73,6 +73,9 @@ pub struct FloorSummary {
     pub scans: usize,
     /// The keyframes at its height.
     pub keyframes: usize,
+    /// Cells of its grid marked as stairs (the flights rising from it and its stairwells);
+    /// `None` without a grid per floor.
+    pub stairs_cells: Option<usize>,
 }
 
 /// What was mapped.

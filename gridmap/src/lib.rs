@@ -33,6 +33,11 @@
 //! - [`fuse_local_grid`]: merge a robot-centred local grid (Spot's `no_step` or
 //!   `obstacle_distance` grids) into the global grid, adding obstacles and clearing what it sees
 //!   free.
+//! - [`stairs_cells`]: the cells of a flight of stairs, from the walk over it and the map's
+//!   points (treads near the height the robot's feet passed at, with room above them);
+//!   [`OccupancyGrid::mark_stairs`] marks them [`CellState::Stairs`] on both floors' grids:
+//!   neither a wall (the lower floor's band sees the steps) nor free (the upper floor's
+//!   stairwell), and blocked to a planner on the floor.
 //! - [`write_ros_map`] / [`read_ros_map`]: ROS `map_server` YAML + trinary PGM (unknown cells as
 //!   205); [`write_png`]: pictures with inflation, paths and waypoints.
 //!
@@ -106,6 +111,7 @@ mod picture;
 mod planning;
 mod rays;
 mod ros_map;
+mod stairs;
 mod walked;
 
 pub use band::ObstacleBandConfig;
@@ -124,4 +130,5 @@ pub use planning::{
     CellRect, ClearanceCostConfig, PlanningGrid, PlanningGridConfig, clearance_step_costs,
 };
 pub use ros_map::{RosMapYaml, read_ros_map, ros_map_pgm, ros_map_yaml, write_ros_map};
+pub use stairs::{Climb, StairsConfig, stairs_cells};
 pub use walked::walked_cells;

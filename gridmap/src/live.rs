@@ -366,13 +366,17 @@ impl LiveLayer {
         stamp: f64,
         report: &mut LiveUpdate,
     ) -> Result<(), GridMapError> {
+        if self.static_map.state(cell) == CellState::Stairs {
+            // A flight stays stairs: its steps read as obstacles and its stairwell as free.
+            return Ok(());
+        }
         let now = self.combined.state(cell);
         if now != seen {
             self.combined.set(cell, seen)?;
             match seen {
                 CellState::Occupied => report.added += 1,
                 CellState::Free => report.cleared += 1,
-                CellState::Unknown => {}
+                CellState::Unknown | CellState::Stairs => {}
             }
             grow(&mut report.changed, cell);
             grow(&mut report.observed, cell);

@@ -1,4 +1,4 @@
-//! `OccupancyGrid`: free, occupied or unknown per cell, over two bit grids.
+//! `OccupancyGrid`: free, occupied, stairs or unknown per cell, over three bit grids.
 
 use slam_core::{BitGrid, Cell, GridGeometry};
 
@@ -15,6 +15,9 @@ pub enum CellState {
     Occupied,
     /// Never observed.
     Unknown,
+    /// A flight of stairs (see [`crate::stairs_cells`]): neither a wall nor floor to walk on.
+    /// Planners on this floor treat it as an obstacle; a stairs controller crosses it.
+    Stairs,
 }
 
 /// How a planner should treat unknown cells.
@@ -34,6 +37,7 @@ pub enum UnknownCells {
 pub struct OccupancyGrid {
     occupied: BitGrid,
     free: BitGrid,
+    stairs: BitGrid,
 }
 
 impl OccupancyGrid {
@@ -51,7 +55,13 @@ impl OccupancyGrid {
             .with_geometry(geometry);
         let free = BitGrid::from_fn(width, height, |_, _| fill == CellState::Free)?
             .with_geometry(geometry);
-        Ok(Self { occupied, free })
+        let stairs = BitGrid::from_fn(width, height, |_, _| fill == CellState::Stairs)?
+            .with_geometry(geometry);
+        Ok(Self {
+            occupied,
+            free,
+            stairs,
+        })
     }
 
     /// Columns.
@@ -81,6 +91,8 @@ impl OccupancyGrid {
             CellState::Occupied
         } else if self.free.is_blocked(cell) {
             CellState::Free
+        } else if self.stairs.is_blocked(cell) {
+            CellState::Stairs
         } else {
             CellState::Unknown
         }
@@ -93,6 +105,7 @@ impl OccupancyGrid {
     pub fn set(&mut self, cell: Cell, state: CellState) -> Result<(), GridMapError> {
         self.occupied.set(cell, state == CellState::Occupied)?;
         self.free.set(cell, state == CellState::Free)?;
+        self.stairs.set(cell, state == CellState::Stairs)?;
         Ok(())
     }
 
@@ -119,6 +132,7 @@ impl OccupancyGrid {
             let pairs = [
                 (self.occupied.row_words(y), earlier.occupied.row_words(y)),
                 (self.free.row_words(y), earlier.free.row_words(y)),
+                (self.stairs.row_words(y), earlier.stairs.row_words(y)),
             ];
             for (now, then) in pairs {
                 for (i, (a, b)) in now.iter().zip(then).enumerate() {
@@ -154,28 +168,73 @@ impl OccupancyGrid {
         &self.free
     }
 
-    /// The grid a planner searches: occupied cells blocked, unknown cells as `unknown` says.
+    /// Mark the cells set in `stairs` (a grid of this one's size and placement, e.g. from
+    /// [`crate::stairs_cells`]) as [`CellState::Stairs`], whatever they were. Word by word.
+    ///
+    /// # Errors
+    /// [`GridMapError::GeometryMismatch`] when `stairs` is not the size and placement of this
+    /// grid.
+    pub fn mark_stairs(&mut self, stairs: &BitGrid) -> Result<(), GridMapError> {
+        if (stairs.width(), stairs.height()) != (self.width(), self.height())
+            || stairs.geometry() != self.geometry()
+        {
+            return Err(GridMapError::GeometryMismatch);
+        }
+        for y in 0..self.height() {
+            let marks = stairs.row_words(y);
+            for (s, m) in self.stairs.row_words_mut(y).iter_mut().zip(marks) {
+                *s |= *m;
+            }
+            for (o, m) in self.occupied.row_words_mut(y).iter_mut().zip(marks) {
+                *o &= !*m;
+            }
+            for (f, m) in self.free.row_words_mut(y).iter_mut().zip(marks) {
+                *f &= !*m;
+            }
+        }
+        // The padding past the width: as the other grids keep it.
+        self.stairs.restore_padding();
+        self.occupied.restore_padding();
+        self.free.restore_padding();
+        Ok(())
+    }
+
+    /// Stairs cells as a bit grid (1 = stairs).
+    #[must_use]
+    pub fn stairs(&self) -> &BitGrid {
+        &self.stairs
+    }
+
+    /// The grid a planner on this floor searches: occupied and stairs cells blocked, unknown
+    /// cells as `unknown` says.
     #[must_use]
     pub fn to_planning_grid(&self, unknown: UnknownCells) -> BitGrid {
         let mut out = self.occupied.clone();
-        if unknown == UnknownCells::Blocked {
-            for y in 0..self.height() {
-                let free = self.free.row_words(y).to_vec();
-                for (o, f) in out.row_words_mut(y).iter_mut().zip(free) {
-                    // Blocked unless known free; occupied stays blocked.
+        for y in 0..self.height() {
+            let (free, stairs) = (self.free.row_words(y), self.stairs.row_words(y));
+            for ((o, f), s) in out.row_words_mut(y).iter_mut().zip(free).zip(stairs) {
+                // Blocked unless known free when unknown is blocked; occupied stays blocked.
+                *o |= *s;
+                if unknown == UnknownCells::Blocked {
                     *o |= !f;
                 }
             }
-            out.restore_padding();
         }
+        out.restore_padding();
         out
     }
 
-    /// Number of cells in each state: (free, occupied, unknown).
+    /// Number of cells in each state: (free, occupied, unknown); stairs cells are in none of
+    /// them ([`BitGrid::count_blocked`] of [`Self::stairs`] counts them).
     #[must_use]
     pub fn counts(&self) -> (usize, usize, usize) {
         let occupied = self.occupied.count_blocked();
         let free = self.free.count_blocked();
-        (free, occupied, self.occupied.len() - free - occupied)
+        let stairs = self.stairs.count_blocked();
+        (
+            free,
+            occupied,
+            self.occupied.len() - free - occupied - stairs,
+        )
     }
 }

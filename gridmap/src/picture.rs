@@ -1,4 +1,4 @@
-//! PNG pictures of occupancy grids, with optional inflation, path and waypoints.
+//! PNG pictures of occupancy grids (stairs included), with optional inflation, path and waypoints.
 
 use std::path::Path;
 
@@ -18,13 +18,15 @@ pub mod colours {
     pub const UNKNOWN: [u8; 3] = [160, 160, 160];
     /// Free cells blocked by inflation: light orange.
     pub const INFLATED: [u8; 3] = [255, 200, 140];
+    /// Stairs cells: teal.
+    pub const STAIRS: [u8; 3] = [0, 160, 160];
     /// Path cells: blue.
     pub const PATH: [u8; 3] = [30, 90, 255];
     /// Waypoints: red.
     pub const WAYPOINT: [u8; 3] = [230, 20, 20];
 }
 
-/// A picture of `grid` (top row = highest y): free, occupied, unknown, and the cells `inflated`
+/// A picture of `grid` (top row = highest y): free, occupied, unknown, stairs, and the cells `inflated`
 /// adds, with `path` cells and `waypoints` drawn on top.
 #[must_use]
 pub fn render(
@@ -38,6 +40,7 @@ pub fn render(
         let c = Cell::new(px, h - 1 - py);
         Rgb(match grid.state(c) {
             CellState::Occupied => colours::OCCUPIED,
+            CellState::Stairs => colours::STAIRS,
             _ if inflated.is_some_and(|g| g.is_blocked(c)) => colours::INFLATED,
             CellState::Free => colours::FREE,
             CellState::Unknown => colours::UNKNOWN,

@@ -166,12 +166,14 @@ fn obstacles(
     let (w, h) = (rect.x1 - rect.x0, rect.y1 - rect.y0);
     let mut sub = BitGrid::new(w, h)?;
     let (occupied, free) = (occupancy.occupied(), occupancy.known_free());
+    let stairs = occupancy.stairs();
     for y in 0..h {
         let row = sub.row_words_mut(y);
         for (k, word) in row.iter_mut().enumerate() {
             let x = rect.x0 + 64 * k as u32;
             // Cells past the source's east edge read as blocked; the padding is restored below.
-            let occ = occupied.word_at(x, rect.y0 + y);
+            // Stairs are no floor to walk on here.
+            let occ = occupied.word_at(x, rect.y0 + y) | stairs.word_at(x, rect.y0 + y);
             *word = if unknown == UnknownCells::Blocked {
                 occ | !free.word_at(x, rect.y0 + y)
             } else {

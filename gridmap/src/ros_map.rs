@@ -218,7 +218,9 @@ fn quote_if_needed(name: &str) -> String {
     }
 }
 
-/// The binary greyscale PGM (P5, the form `map_server` and `map_saver` use) of `grid`.
+/// The binary greyscale PGM (P5, the form `map_server` and `map_saver` use) of `grid`. Stairs
+/// cells are written occupied: the format has no stairs, and a 2D planner must not walk onto
+/// a flight.
 ///
 /// # Errors
 /// [`GridMapError::Image`] (naming `name`) when the encoder fails.
@@ -227,7 +229,8 @@ pub fn ros_map_pgm(grid: &OccupancyGrid, name: &Path) -> Result<Vec<u8>, GridMap
     let img = GrayImage::from_fn(w, h, |px, py| {
         let cell = Cell::new(px, h - 1 - py);
         Luma([match grid.state(cell) {
-            CellState::Occupied => OCCUPIED,
+            // A 2D planner reading the map must not walk onto a flight.
+            CellState::Occupied | CellState::Stairs => OCCUPIED,
             CellState::Free => FREE,
             CellState::Unknown => UNKNOWN,
         }])

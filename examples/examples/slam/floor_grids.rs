@@ -1,36 +1,31 @@
-//! A walk over several floors: a grid per floor from the keyframes at its height, and the
-//! stairs the walk took between them as links of those grids (`spot_adapter::nav::stairs_links`).
+//! A walk over several floors: a grid per floor from the keyframes at its height, the flights
+//! marked as stairs on them, and the stairs the walk took as links of those grids
+//! (`spot_adapter::nav::FloorMaps`).
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use gridmap::{FloorLevels, UnknownCells, inflate};
-use nalgebra::Vector2;
+use gridmap::FloorLevels;
+use nalgebra::{Point3, Vector2};
 use slam_core::io::StampedPose;
-use slam_core::{BitGrid, Cell, GraphSlam, MapRegistrator, Optimizer, Pose3};
-use spot_adapter::nav::{NavigationMap, NavigationMapConfig, StairsLink, stairs_links};
+use slam_core::{Cell, GraphSlam, MapRegistrator, Optimizer};
+use spot_adapter::nav::{FloorMaps, NavigationMapConfig, StairsLink};
 use spot_nav_examples::summary::StairsSummary;
 use spot_nav_examples::{Mapping, out};
 
-/// One floor's grid: the map from its keyframes and the planning grid inflated from it.
-struct FloorGrid {
-    navigation: NavigationMap,
-    inflated: BitGrid,
-}
-
-/// A grid per floor (`None` where the floor's keyframes gave none) and the stairs between them.
+/// A grid per floor and the stairs between them.
 pub(crate) struct FloorGrids {
-    floors: FloorLevels,
-    grids: Vec<Option<FloorGrid>>,
+    maps: FloorMaps,
     /// The stairs, each with its foot's and top's cell centres (metres, the map frame).
     links: Vec<(StairsLink, Vector2<f64>, Vector2<f64>)>,
 }
 
 impl FloorGrids {
     /// Each floor's grid from the keyframes at its height (those between floors, on the stairs,
-    /// are in none), obstacles inflated by `inflation` metres, and the stairs the walk through
-    /// `poses` (the scans' LiDAR poses `floors` was split from) took; printed.
-    pub(crate) fn build<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    /// are in none), the flights marked as stairs on both floors they join, obstacles inflated
+    /// by `inflation` metres, and the stairs the walk through `poses` (the scans' LiDAR poses
+    /// `floors` was split from) took; printed.
+    pub(crate) fn build<R: MapRegistrator, C: MapRegistrator, O: Optimizer<slam_core::Pose3>>(
         slam: &GraphSlam<R, C, O>,
         lidar_height: f64,
         floors: &FloorLevels,
@@ -38,59 +33,43 @@ impl FloorGrids {
         inflation: f64,
     ) -> Result<Self> {
         let scans: Vec<_> = slam.keyframe_scans().collect();
-        let mut grids = Vec::new();
-        for k in 0..floors.levels().len() {
-            let on_floor: Vec<(Pose3, &slam_core::PointCloud)> = scans
-                .iter()
-                .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
-                .copied()
-                .collect();
-            let config = NavigationMapConfig::default();
-            grids.push(
-                match NavigationMap::from_scans(&on_floor, lidar_height, &config) {
-                    Ok(navigation) => {
-                        let planning = navigation.occupancy().to_planning_grid(UnknownCells::Free);
-                        let inflated = inflate(&planning, inflation)?;
-                        Some(FloorGrid {
-                            navigation,
-                            inflated,
-                        })
-                    }
-                    Err(e) => {
-                        eprintln!("note: no grid for floor {k} ({e:#})");
-                        None
-                    }
-                },
-            );
-        }
-        let every: Option<Vec<&BitGrid>> = grids
+        let positions: Vec<Point3<f64>> = poses
             .iter()
-            .map(|g| g.as_ref().map(|g| &g.inflated))
+            .map(|p| Point3::from(p.pose.translation.vector))
             .collect();
-        // Each link with its ends' cell centres (metres), read off the grids it was found on.
-        let links = match every {
-            Some(planning) => {
-                let positions: Vec<_> = poses
-                    .iter()
-                    .map(|p| nalgebra::Point3::from(p.pose.translation.vector))
-                    .collect();
-                stairs_links(&positions, floors, &planning)
-                    .context("finding the stairs between the floors")?
-                    .into_iter()
-                    .map(|l| {
-                        let foot = planning[l.foot.floor].cell_center(l.foot.cell);
-                        let top = planning[l.top.floor].cell_center(l.top.cell);
-                        (l, foot, top)
-                    })
-                    .collect()
+        let maps = FloorMaps::build(
+            &scans,
+            &positions,
+            floors,
+            lidar_height,
+            &NavigationMapConfig::default(),
+            inflation,
+        )
+        .context("building a grid per floor and finding the stairs between them")?;
+        for k in 0..floors.levels().len() {
+            if let Some(Err(e)) = maps.map(k) {
+                eprintln!("note: no grid for floor {k} ({e:#})");
             }
-            None => Vec::new(),
-        };
-        Ok(Self {
-            floors: floors.clone(),
-            grids,
-            links,
-        })
+        }
+        // Each link with its ends' cell centres (metres), read off the grids it was found on.
+        let links = maps
+            .links()
+            .iter()
+            .filter_map(|l| {
+                let foot = maps.planning(l.foot.floor)?.cell_center(l.foot.cell);
+                let top = maps.planning(l.top.floor)?.cell_center(l.top.cell);
+                Some((*l, foot, top))
+            })
+            .collect();
+        Ok(Self { maps, links })
+    }
+
+    /// The cells of floor `k`'s grid marked as stairs; `None` when it has no grid.
+    pub(crate) fn stairs_cells(&self, k: usize) -> Option<usize> {
+        match self.maps.map(k)? {
+            Ok(map) => Some(map.occupancy().stairs().count_blocked()),
+            Err(_) => None,
+        }
     }
 
     /// The stairs as `summary.json` gives them (metres, the map frame); printed.
@@ -124,7 +103,7 @@ impl FloorGrids {
         out!(
             "stairs      {} flight(s) between the floors' grids: {}",
             stairs.len(),
-            if self.grids.iter().any(Option::is_none) {
+            if (0..self.maps.floors().levels().len()).any(|k| self.maps.planning(k).is_none()) {
                 "not found (a floor has no grid)".to_string()
             } else if each.is_empty() {
                 "none (no change of floor has a free cell at both ends)".to_string()
@@ -139,16 +118,19 @@ impl FloorGrids {
     /// `.pgm`) with the walk on it and the stairs' ends marked.
     pub(crate) fn write(&self, mapping: &Mapping, dir: &Path) -> Result<()> {
         let mut written = Vec::new();
-        for (k, grid) in self.grids.iter().enumerate() {
-            let Some(grid) = grid else { continue };
+        let floors = self.maps.floors();
+        for k in 0..floors.levels().len() {
+            let (Some(Ok(map)), Some(planning)) = (self.maps.map(k), self.maps.planning(k)) else {
+                continue;
+            };
             let walked: Vec<Cell> = mapping
                 .estimate
                 .iter()
                 .enumerate()
-                .filter(|(i, _)| self.floors.floor_of(*i) == Some(k))
+                .filter(|(i, _)| floors.floor_of(*i) == Some(k))
                 .filter_map(|(_, p)| {
                     let t = p.pose.translation.vector;
-                    grid.inflated.cell_at(Vector2::new(t.x, t.y))
+                    planning.cell_at(Vector2::new(t.x, t.y))
                 })
                 .collect();
             let ends: Vec<Cell> = self
@@ -158,9 +140,9 @@ impl FloorGrids {
                 .filter(|end| end.floor == k)
                 .map(|end| end.cell)
                 .collect();
-            let occupancy = grid.navigation.occupancy();
+            let occupancy = map.occupancy();
             let png = dir.join(format!("grid_floor{k}.png"));
-            gridmap::write_png(&png, occupancy, Some(&grid.inflated), &walked, &ends)?;
+            gridmap::write_png(&png, occupancy, Some(planning), &walked, &ends)?;
             gridmap::write_ros_map(occupancy, dir.join(format!("map_floor{k}.yaml")))?;
             written.push(format!("grid_floor{k}.png, map_floor{k}.yaml + .pgm"));
         }

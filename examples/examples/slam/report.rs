@@ -62,6 +62,9 @@ pub(crate) fn finish<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let floor_grids = if floors.levels().len() > 1 {
         let grids = FloorGrids::build(slam, args.lidar_height, &floors, &poses, INFLATION)?;
         summary.stairs = grids.stairs()?;
+        for (k, floor) in summary.floors.iter_mut().enumerate() {
+            floor.stairs_cells = grids.stairs_cells(k);
+        }
         Some(grids)
     } else {
         None
@@ -190,6 +193,7 @@ fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
             walked_m: level.walked,
             scans: level.poses,
             keyframes: keyframe_floors.iter().filter(|f| **f == Some(k)).count(),
+            stairs_cells: None,
         })
         .collect();
     if summaries.len() > 1 {

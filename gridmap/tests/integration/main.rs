@@ -9,4 +9,5 @@ mod gridmap;
 mod live_layer;
 mod planning_grid;
 mod rng;
+mod stairs;
 mod walked;

@@ -70,7 +70,7 @@ fn brute_force_blocked(
 ) -> BitGrid {
     let (w, h) = (occupancy.width(), occupancy.height());
     let obstacle = |c: Cell| match occupancy.state(c) {
-        CellState::Occupied => true,
+        CellState::Occupied | CellState::Stairs => true,
         CellState::Unknown => config.unknown == UnknownCells::Blocked,
         CellState::Free => false,
     };

@@ -2,6 +2,7 @@
 
 use gridmap::{
     FloorConfig, LiveLayerConfig, ObstacleBandConfig, OccupancyGridConfig, PlanningGridConfig,
+    StairsConfig,
 };
 
 use crate::nav::NavError;
@@ -148,6 +149,7 @@ impl NavigatorConfig {
             grid: self.grid.clone(),
             floor: self.floor.clone(),
             band: self.band.clone(),
+            stairs: StairsConfig::default(),
         }
     }
 }
@@ -185,15 +187,20 @@ pub struct NavigationMapConfig {
     /// The obstacle band above the floor: from 0.08 m to 0.94 m (Spot with its LiDAR plus
     /// 0.10 m).
     pub band: ObstacleBandConfig,
+    /// How the flights of stairs a walk over several floors took are found on the floors'
+    /// grids ([`crate::nav::FloorMaps`]).
+    pub stairs: StairsConfig,
 }
 
 impl NavigationMapConfig {
-    /// The floor's and the band's settings valid (the grid's are checked when it is built).
+    /// The floor's, the band's and the stairs' settings valid (the grid's are checked when it
+    /// is built).
     ///
     /// # Errors
     /// [`NavError::NavigationGrid`] with gridmap's error for a bad setting.
     pub fn validate(&self) -> Result<(), NavError> {
-        validate_floor_band(&self.floor, &self.band)
+        validate_floor_band(&self.floor, &self.band)?;
+        self.stairs.validate().map_err(NavError::NavigationGrid)
     }
 }
 

@@ -65,6 +65,7 @@ mod exploration;
 mod explorer;
 mod explorer_config;
 mod floor_levelling;
+mod floor_maps;
 mod floor_route;
 mod frontier;
 mod frontier_tour;
@@ -88,6 +89,7 @@ pub use exploration::{
 };
 pub use explorer::{Explorer, FrontierDecision, FrontierGoal, GiveUpReason, GivenUpFrontier};
 pub use explorer_config::{ExplorerConfig, FrontierChoice};
+pub use floor_maps::{Flight, FloorMaps};
 pub use floor_route::{FloorCell, FloorGraph, FloorRoute, RouteLeg, StairsLink};
 pub use frontier::{Frontier, find_frontiers, is_frontier_cell};
 pub use localiser::{LocalisationHealth, LocalisationStatus, LocaliserConfig};

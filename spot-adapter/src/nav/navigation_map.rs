@@ -3,7 +3,7 @@
 //! cells where no beam went.
 
 use gridmap::{FloorMap, OccupancyGrid, OccupancyGridBuilder, floor_hints_below};
-use slam_core::{PointCloud, Pose3};
+use slam_core::{BitGrid, PointCloud, Pose3};
 
 use crate::nav::NavError;
 use crate::nav::config::NavigationMapConfig;
@@ -68,7 +68,18 @@ impl NavigationMap {
         Self { occupancy, floor }
     }
 
-    /// The occupancy grid (occupied, free, unknown).
+    /// This map with the cells set in `stairs` (e.g. from [`gridmap::stairs_cells`]) marked as
+    /// stairs: blocked to the planners on this floor, neither wall nor floor.
+    ///
+    /// # Errors
+    /// [`NavError::NavigationGrid`] when `stairs` is not the size and placement of the grid.
+    pub fn mark_stairs(&mut self, stairs: &BitGrid) -> Result<(), NavError> {
+        self.occupancy
+            .mark_stairs(stairs)
+            .map_err(NavError::NavigationGrid)
+    }
+
+    /// The occupancy grid (occupied, free, unknown, stairs).
     #[must_use]
     pub fn occupancy(&self) -> &OccupancyGrid {
         &self.occupancy

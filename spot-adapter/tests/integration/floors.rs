@@ -423,3 +423,141 @@ fn block_rectangle(
         }
     }
 }
+
+/// The flights of a tour, found from scans along it (at the true poses, so that the test is of
+/// the stairs' marking, not of SLAM) and marked on the grids of both floors each joins: against
+/// the building's staircases (the oracle), every cell whose centre lies on a flight at least a
+/// cell in from its edges is stairs on both grids (neither a wall nor floor), no stairs cell
+/// lies more than 0.2 m off a flight, and the floors' planning grids block the flights while
+/// the links between them still join the floors near each flight's foot and top.
+#[test]
+fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
+    use gridmap::{CellState, FloorLevels, FloorLevelsConfig};
+    use nalgebra::Vector2;
+    use slam_core::{PointCloud, Pose3};
+    use spot_adapter::nav::{FloorMaps, NavigationMapConfig};
+    use spot_adapter::robot::SpotGeometry;
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let geometry = SpotGeometry::default();
+        let (poses, _) = FloorsTour::new(&b)
+            .unwrap()
+            .walk(0.6, 5.0, geometry.body_height)
+            .unwrap();
+        let lidar_poses: Vec<Pose3> = poses
+            .iter()
+            .map(|p| p.pose * geometry.body_t_lidar)
+            .collect();
+        let positions: Vec<Point3<f64>> = lidar_poses
+            .iter()
+            .map(|p| Point3::from(p.translation.vector))
+            .collect();
+        let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
+        let scans = scans_near_stairs(&b, &lidar_poses, seed);
+        let keyframes: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
+        let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
+        let maps = FloorMaps::build(
+            &keyframes,
+            &positions,
+            &split,
+            lidar_height,
+            &NavigationMapConfig::default(),
+            0.3,
+        )
+        .unwrap();
+        assert_eq!(maps.flights().len(), floors - 1, "seed {seed}");
+        assert_eq!(maps.links().len(), floors - 1, "seed {seed}");
+        for (s, flight) in b.staircases().iter().enumerate() {
+            let outside = |c: Vector2<f64>| outside_flight(flight, c);
+            for k in [s, s + 1] {
+                let grid = maps.map(k).unwrap().unwrap().occupancy();
+                let planning = maps.planning(k).unwrap();
+                let (mut inner, mut marked) = (0, 0);
+                for y in 0..grid.height() {
+                    for x in 0..grid.width() {
+                        let cell = slam_core::Cell::new(x, y);
+                        let centre = grid.geometry().cell_center(cell);
+                        let off = outside(centre);
+                        let stairs = grid.state(cell) == CellState::Stairs;
+                        if off <= -0.1 {
+                            inner += 1;
+                            marked += usize::from(stairs);
+                            assert!(planning.is_blocked(cell));
+                        }
+                        // Another flight's cells are that flight's.
+                        let other = b
+                            .staircases()
+                            .iter()
+                            .enumerate()
+                            .any(|(o, f)| o != s && outside_flight(f, centre) <= 0.2);
+                        if stairs && !other {
+                            assert!(
+                                off <= 0.2,
+                                "seed {seed} flight {s} floor {k}: stairs {off:.2} m off the flight at {centre}"
+                            );
+                        }
+                    }
+                }
+                assert!(inner > 300, "seed {seed}: {inner} cells on flight {s}");
+                assert_eq!(
+                    marked, inner,
+                    "seed {seed} flight {s} floor {k}: {marked} of {inner} cells on the flight marked"
+                );
+            }
+            let link = maps.links().iter().find(|l| l.foot.floor == s).unwrap();
+            assert_eq!(link.top.floor, s + 1);
+            let foot = maps.planning(s).unwrap().cell_center(link.foot.cell);
+            let top = maps.planning(s + 1).unwrap().cell_center(link.top.cell);
+            // The walk's last and first cells free of the flight's inflation and of the unseen
+            // (these scans are a few, 0.5 m apart).
+            assert!(
+                (foot - flight.foot).norm() < 2.0,
+                "seed {seed}: foot {foot}"
+            );
+            assert!((top - flight.top()).norm() < 2.0, "seed {seed}: top {top}");
+        }
+    }
+}
+
+/// Plan-view distance of `c` outside `flight`'s rectangle, from its foot to its top and its
+/// width across (metres, negative inside).
+fn outside_flight(flight: &spot_adapter::sim::Staircase, c: nalgebra::Vector2<f64>) -> f64 {
+    let across = nalgebra::Vector2::new(-flight.up.y, flight.up.x);
+    let d = c - flight.foot;
+    let along = d.dot(&flight.up);
+    let side = d.dot(&across).abs();
+    (-along)
+        .max(along - flight.run())
+        .max(side - 0.5 * flight.width)
+}
+
+/// Scans of `b` from `lidar_poses` (true, `world_T_lidar`), one every 0.5 m of the walk within
+/// 10 m of a flight's foot.
+fn scans_near_stairs(
+    b: &Building,
+    lidar_poses: &[slam_core::Pose3],
+    seed: u64,
+) -> Vec<(slam_core::Pose3, slam_core::PointCloud)> {
+    use spot_adapter::sim::{LidarConfig, SimRng, SpinningLidar};
+    let lidar = SpinningLidar::new(LidarConfig::vlp16()).unwrap();
+    let mut rng = SimRng::new(seed, 7);
+    let near_stairs = |p: &Point3<f64>| {
+        b.staircases()
+            .iter()
+            .any(|s| (p.xy().coords - s.foot).norm() < 10.0)
+    };
+    let mut last: Option<Point3<f64>> = None;
+    let mut scans = Vec::new();
+    for pose in lidar_poses {
+        let p = Point3::from(pose.translation.vector);
+        if near_stairs(&p) && last.is_none_or(|q| (p - q).norm() >= 0.5) {
+            scans.push((*pose, lidar.scan(b, pose, &mut rng)));
+            last = Some(p);
+        }
+    }
+    scans
+}
