@@ -27,9 +27,15 @@ fn se2_velocity(x: f64, y: f64, angular: f64) -> api::Se2Velocity {
     }
 }
 
-/// The limits as the robot's own velocity limit.
-fn mobility_params(limits: &MotionLimits) -> prost_types::Any {
+/// The limits as the robot's own velocity limit, and the stairs mode on for a walk over a
+/// flight (left unset otherwise: the robot's default).
+fn mobility_params(limits: &MotionLimits, stairs: bool) -> prost_types::Any {
     let params = api::spot::MobilityParams {
+        stairs_mode: if stairs {
+            api::spot::mobility_params::StairsMode::On as i32
+        } else {
+            0
+        },
         vel_limit: Some(api::Se2VelocityLimit {
             max_vel: Some(se2_velocity(
                 limits.max_forward_speed,
@@ -52,24 +58,27 @@ fn mobility_params(limits: &MotionLimits) -> prost_types::Any {
 fn mobility(
     command: api::mobility_command::request::Command,
     limits: &MotionLimits,
+    stairs: bool,
 ) -> api::RobotCommand {
     api::RobotCommand {
         command: Some(api::robot_command::Command::SynchronizedCommand(
             api::synchronized_command::Request {
                 mobility_command: Some(api::mobility_command::Request {
                     command: Some(command),
-                    params: Some(mobility_params(limits)),
+                    params: Some(mobility_params(limits, stairs)),
                 }),
             },
         )),
     }
 }
 
-/// `command` clamped to `limits`, held until robot time `end_time`.
+/// `command` clamped to `limits`, held until robot time `end_time`, with the stairs mode on
+/// when `stairs`.
 pub(crate) fn velocity_command(
     command: &VelocityCommand,
     limits: &MotionLimits,
     end_time: f64,
+    stairs: bool,
 ) -> api::RobotCommand {
     let clamp = |v: f64, max: f64| v.clamp(-max, max);
     mobility(
@@ -86,6 +95,7 @@ pub(crate) fn velocity_command(
             },
         ),
         limits,
+        stairs,
     )
 }
 
@@ -123,6 +133,7 @@ pub(crate) fn trajectory_command(
             },
         ),
         limits,
+        false,
     )
 }
 
@@ -147,7 +158,7 @@ impl Session {
         let lease = self.lease_for_command()?;
         let (robot_now, clock_identifier) = self.robot_now()?;
         let message = match command {
-            MobilityCommand::Velocity(v) => {
+            MobilityCommand::Velocity(v) | MobilityCommand::Stairs(v) => {
                 if !v.is_finite() {
                     return Err(SpotError::CommandRefused {
                         status: "NOT_SENT_NON_FINITE_VELOCITY",
@@ -158,6 +169,7 @@ impl Session {
                     v,
                     limits,
                     robot_now + self.config.velocity_hold.as_secs_f64(),
+                    matches!(command, MobilityCommand::Stairs(_)),
                 )
             }
             MobilityCommand::Trajectory(t) => {

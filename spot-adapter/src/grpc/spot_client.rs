@@ -341,7 +341,7 @@ impl SpotClient {
     /// Note whether `command` asks the robot to move (starting the stall clock).
     fn note_motion(&mut self, command: &MobilityCommand) {
         let moving = match command {
-            MobilityCommand::Velocity(v) => {
+            MobilityCommand::Velocity(v) | MobilityCommand::Stairs(v) => {
                 v.forward.abs().max(v.lateral.abs()).max(v.yaw_rate.abs()) > MOVING_SPEED
             }
             MobilityCommand::Trajectory(_) => true,

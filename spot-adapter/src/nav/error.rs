@@ -75,6 +75,18 @@ pub enum NavError {
         /// The cell given.
         cell: slam_core::Cell,
     },
+    /// A point off its floor's map.
+    #[error("{what} ({x}, {y}) is off floor {floor}'s map")]
+    OffFloorMap {
+        /// What it is (`the start`, `the goal`).
+        what: &'static str,
+        /// The floor.
+        floor: usize,
+        /// Its x (metres, the map frame).
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
 }
 
 /// Why [`drive`](super::drive) stopped early; the robot was sent a stop first.

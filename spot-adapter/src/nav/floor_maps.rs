@@ -11,7 +11,7 @@ use crate::nav::config::NavigationMapConfig;
 use crate::nav::floor_route::StairsLink;
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::stairs_links::SAME_FLIGHT;
-use crate::nav::stairs_links::stairs_links;
+use crate::nav::stairs_links::stairs_links_with_walks;
 
 /// The walk over a flight is looked at from this far (in plan view) before it leaves one floor
 /// to this far after it reaches the other (metres): the poses between two floors' height bands
@@ -59,6 +59,7 @@ pub struct FloorMaps {
     planning: Vec<Option<BitGrid>>,
     flights: Vec<Flight>,
     links: Vec<StairsLink>,
+    walks: Vec<Vec<Point3<f64>>>,
 }
 
 impl FloorMaps {
@@ -73,7 +74,7 @@ impl FloorMaps {
     ///
     /// # Errors
     /// [`NavError::NavigationGrid`] for bad settings or an inflation that is not finite and
-    /// non-negative; as [`stairs_links`] for positions that do not fit `floors`.
+    /// non-negative; as [`stairs_links`](crate::nav::stairs_links) for positions that do not fit `floors`.
     pub fn build(
         keyframes: &[(Pose3, &PointCloud)],
         positions: &[Point3<f64>],
@@ -162,13 +163,15 @@ impl FloorMaps {
                 Err(_) => Ok(None),
             })
             .collect::<Result<_, _>>()?;
-        let links = match planning
+        let (links, walks) = match planning
             .iter()
             .map(Option::as_ref)
             .collect::<Option<Vec<_>>>()
         {
-            Some(grids) => stairs_links(positions, floors, &grids)?,
-            None => Vec::new(),
+            Some(grids) => stairs_links_with_walks(positions, floors, &grids)?
+                .into_iter()
+                .unzip(),
+            None => (Vec::new(), Vec::new()),
         };
         Ok(Self {
             floors: floors.clone(),
@@ -176,6 +179,7 @@ impl FloorMaps {
             planning,
             flights,
             links,
+            walks,
         })
     }
 
@@ -205,8 +209,15 @@ impl FloorMaps {
         &self.flights
     }
 
-    /// The stairs as links between the floors' planning grids ([`stairs_links`]); none when a
-    /// floor has no map.
+    /// The walk over link `i` (the LiDAR's positions, map frame) from its foot to its top: the
+    /// way a stairs controller takes over the flight ([`crate::nav::StairsClimb`]).
+    #[must_use]
+    pub fn link_walk(&self, i: usize) -> Option<&[Point3<f64>]> {
+        self.walks.get(i).map(Vec::as_slice)
+    }
+
+    /// The stairs as links between the floors' planning grids
+    /// ([`stairs_links`](crate::nav::stairs_links)); none when a floor has no map.
     #[must_use]
     pub fn links(&self) -> &[StairsLink] {
         &self.links

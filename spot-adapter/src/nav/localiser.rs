@@ -416,17 +416,55 @@ impl<R: Registrator> Localiser<R> {
         }
     }
 
+    /// Search the seeds within `radius` of the estimate in x and y, `step` apart, at its
+    /// heading, with `sample`'s full scan, and take the best-matching pose when it is good
+    /// enough (see [`LocaliserConfig::relocalise_min_inlier_ratio`]). For an estimate known to
+    /// be off by up to `radius` (dead reckoning over a flight of stairs), whose error can lie
+    /// beyond a registration's reach: a registration started 0.15 m off in a stair room can
+    /// settle 0.2 m off, where the flight's risers line up.
+    pub(crate) fn search_near(&mut self, sample: &Sample, radius: f64, step: f64) -> bool {
+        let Ok(source) = self.registrator.prepare_source(&sample.cloud) else {
+            return false;
+        };
+        let found = self.search_with(sample, &source, (radius, step), (0.0, 1.0));
+        if let Some(pose) = found {
+            self.last_odom_t_body = Some(sample.odom_t_body);
+            self.accept(pose, LocalisationStatus::Relocalised);
+            true
+        } else {
+            false
+        }
+    }
+
     /// The best-matching body pose among seeds around the estimate, when it is good enough.
     fn search(&self, sample: &Sample, source: &R::Source) -> Option<Pose3> {
+        let c = &self.config;
+        self.search_with(
+            sample,
+            source,
+            (c.search_radius, c.search_step),
+            (c.search_angle, c.search_angle_step),
+        )
+    }
+
+    /// [`Self::search`] over seeds within `radius` in x and y `step` apart and headings within
+    /// `angle` `angle_step` apart.
+    fn search_with(
+        &self,
+        sample: &Sample,
+        source: &R::Source,
+        (radius, step): (f64, f64),
+        (angle, angle_step): (f64, f64),
+    ) -> Option<Pose3> {
         let c = &self.config;
         let steps = |half: f64, step: f64| {
             let n = (half / step).floor() as i64;
             (-n..=n).map(move |k| k as f64 * step)
         };
         let mut best: Option<(f64, f64, Pose3)> = None;
-        for dx in steps(c.search_radius, c.search_step) {
-            for dy in steps(c.search_radius, c.search_step) {
-                for da in steps(c.search_angle, c.search_angle_step) {
+        for dx in steps(radius, step) {
+            for dy in steps(radius, step) {
+                for da in steps(angle, angle_step) {
                     let t = self.map_t_body.translation.vector + Vector3::new(dx, dy, 0.0);
                     let seed = Pose3::from_parts(
                         Translation3::from(t),

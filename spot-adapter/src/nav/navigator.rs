@@ -228,6 +228,18 @@ impl<R: Registrator> Navigator<R> {
 }
 
 impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
+    /// Localise on `sample` by a search of the seeds within `radius` metres of the estimate in
+    /// x and y, `step` apart, at its heading, with the full scan; the best match is taken when
+    /// it is good enough. For a start known to be off by up to `radius`, such as the pose a
+    /// climb over a flight of stairs arrives at by dead reckoning. Returns whether a pose was
+    /// taken.
+    pub fn relocalise_near(&mut self, sample: &Sample, radius: f64, step: f64) -> bool {
+        radius.is_finite()
+            && step.is_finite()
+            && step > 0.0
+            && self.localiser.search_near(sample, radius.max(0.0), step)
+    }
+
     /// One cycle for the scan and odometry in `sample`, toward `goal` (map frame: a position,
     /// or a [`Goal`] with a final heading).
     ///

@@ -37,6 +37,22 @@ pub fn stairs_links(
     floors: &FloorLevels,
     grids: &[&BitGrid],
 ) -> Result<Vec<StairsLink>, NavError> {
+    Ok(stairs_links_with_walks(positions, floors, grids)?
+        .into_iter()
+        .map(|(link, _)| link)
+        .collect())
+}
+
+/// A link and the walk over it from its foot to its top.
+pub(crate) type LinkWithWalk = (StairsLink, Vec<Point3<f64>>);
+
+/// [`stairs_links`], each link with the walk over it from its foot to its top (the positions
+/// of the walk between its ends, reversed for a walk down).
+pub(crate) fn stairs_links_with_walks(
+    positions: &[Point3<f64>],
+    floors: &FloorLevels,
+    grids: &[&BitGrid],
+) -> Result<Vec<LinkWithWalk>, NavError> {
     let levels = floors.levels();
     if grids.len() < levels.len() {
         return Err(NavError::NoSuchFloor {
@@ -45,7 +61,7 @@ pub fn stairs_links(
             floors: grids.len(),
         });
     }
-    let mut links: Vec<StairsLink> = Vec::new();
+    let mut links: Vec<LinkWithWalk> = Vec::new();
     for change in floors.changes() {
         if change.arrived_at >= positions.len() {
             return Err(bad_positions(
@@ -94,6 +110,10 @@ pub fn stairs_links(
             (to, from)
         };
         let link = StairsLink { foot, top, length };
+        let mut walk = positions[a..=b].to_vec();
+        if foot != from {
+            walk.reverse();
+        }
         let near = |x: FloorCell, y: FloorCell| {
             let grid = grids[x.floor];
             x.floor == y.floor
@@ -101,11 +121,11 @@ pub fn stairs_links(
         };
         match links
             .iter_mut()
-            .find(|l| near(l.foot, link.foot) && near(l.top, link.top))
+            .find(|(l, _)| near(l.foot, link.foot) && near(l.top, link.top))
         {
-            Some(same) if link.length < same.length => *same = link,
+            Some(same) if link.length < same.0.length => *same = (link, walk),
             Some(_) => {}
-            None => links.push(link),
+            None => links.push((link, walk)),
         }
     }
     Ok(links)

@@ -158,6 +158,9 @@ impl Se2Trajectory {
 pub enum MobilityCommand {
     /// Hold a body velocity.
     Velocity(VelocityCommand),
+    /// Hold a body velocity with the stairs mode on (Spot's `MobilityParams.stairs_mode =
+    /// STAIRS_MODE_ON`): walk up or down the flight ahead, facing along it.
+    Stairs(VelocityCommand),
     /// Track a trajectory whose reference time is when the command is sent.
     Trajectory(Se2Trajectory),
 }

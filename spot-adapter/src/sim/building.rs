@@ -244,6 +244,15 @@ impl Building {
         k as f64 * self.storey_height
     }
 
+    /// The floor nearest height `z` (metres).
+    #[must_use]
+    pub fn floor_of_height(&self, z: f64) -> usize {
+        if self.floors <= 1 || self.storey_height <= 0.0 {
+            return 0;
+        }
+        ((z / self.storey_height).round().max(0.0) as usize).min(self.floors - 1)
+    }
+
     /// Height of the top floor's ceiling (metres): the ceiling plane rays reach through
     /// stairwells; [`Building::ceiling_height`] with one floor.
     #[must_use]

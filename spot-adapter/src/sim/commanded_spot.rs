@@ -48,7 +48,8 @@ impl Walker {
 /// The command a [`CommandedSpot`] is carrying out.
 #[derive(Clone, Debug)]
 enum Active {
-    Velocity(VelocityCommand),
+    /// A velocity, with the stairs mode on or off.
+    Velocity(VelocityCommand, bool),
     /// A trajectory in the odometry frame, with the stamp it was sent at.
     Trajectory(Se2Trajectory, f64),
 }
@@ -93,7 +94,25 @@ pub struct CommandedSpot {
     active: Active,
     sensed: bool,
     walkers: Vec<Walker>,
+    /// The floor the robot stands on (the lower one while on a flight).
+    floor: usize,
+    /// Height of the ground under the body (metres) and the body's pitch (radians, nose up
+    /// positive) on a flight.
+    ground: f64,
+    pitch: f64,
 }
+
+/// Where a step puts the robot: the floor it is on, the ground under it and its pitch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Footing {
+    floor: usize,
+    ground: f64,
+    pitch: f64,
+}
+
+/// On a flight, the body's centre keeps this far inside the flight's sides (metres): its feet
+/// stay on the steps.
+const FLIGHT_SIDE_MARGIN: f64 = 0.2;
 
 impl CommandedSpot {
     /// Spot standing at plan-view `position` (metres) facing `yaw` (radians) in `building`, with
@@ -132,9 +151,12 @@ impl CommandedSpot {
             world_t_body: Pose2::new(position, yaw),
             odom_t_body: Pose3::identity(),
             collisions: 0,
-            active: Active::Velocity(VelocityCommand::default()),
+            active: Active::Velocity(VelocityCommand::default(), false),
             sensed: false,
             walkers: Vec::new(),
+            floor: 0,
+            ground: 0.0,
+            pitch: 0.0,
             lidar,
         })
     }
@@ -164,6 +186,19 @@ impl CommandedSpot {
     /// command describes, unless that would bring it closer than half its width to an
     /// obstacle: then it only turns and a collision is counted.
     pub fn step(&mut self, command: VelocityCommand) -> Sample {
+        self.step_with(command, false)
+    }
+
+    /// [`CommandedSpot::step`] with the stairs mode on: the robot may walk onto a flight of
+    /// stairs rising from or arriving at its floor, facing along it, its body centre at least
+    /// [`FLIGHT_SIDE_MARGIN`] inside the flight's sides; on the flight its body rises with the
+    /// steps and pitches with them, and past the flight's top (or foot) it stands on the floor
+    /// there.
+    pub fn step_on_stairs(&mut self, command: VelocityCommand) -> Sample {
+        self.step_with(command, true)
+    }
+
+    fn step_with(&mut self, command: VelocityCommand, stairs: bool) -> Sample {
         let limits = &self.description.limits;
         let (v, u, w) = if command.is_finite() {
             (
@@ -197,8 +232,21 @@ impl CommandedSpot {
             + chord(v) * Vector2::new(c, s)
             + chord(u) * Vector2::new(-s, c);
         let half_width = self.description.geometry.half_width;
-        if self.building.clearance(next) >= half_width {
+        let footing = if self.building.floors() > 1 {
+            self.footing(next, stairs)
+        } else {
+            (self.building.clearance(next) >= half_width).then_some(Footing {
+                floor: 0,
+                ground: 0.0,
+                pitch: 0.0,
+            })
+        };
+        if let Some(footing) = footing {
             self.world_t_body = Pose2::new(next, yaw + dyaw);
+            self.floor = footing.floor;
+            self.ground = footing.ground;
+            // The body pitches with the slope along its heading.
+            self.pitch = footing.pitch;
         } else {
             self.world_t_body = Pose2::new(self.world_t_body.translation.vector, yaw + dyaw);
             self.collisions += 1;
@@ -216,6 +264,73 @@ impl CommandedSpot {
         }
         self.stamp += dt;
         self.sense()
+    }
+
+    /// Where the robot stands at plan-view `next` in a building of several floors, or `None`
+    /// when it cannot stand there: on a flight (stairs mode only) or on its floor, clear of the
+    /// floor's obstacles by half its width.
+    fn footing(&self, next: Vector2<f64>, stairs: bool) -> Option<Footing> {
+        let half_width = self.description.geometry.half_width;
+        let heading = self.world_t_body.rotation.angle();
+        if stairs {
+            for (i, f) in self.building.staircases().iter().enumerate() {
+                let lower = self.building.floor_of_height(f.base_z);
+                let upper = lower + 1;
+                if self.floor != lower && self.floor != upper {
+                    continue;
+                }
+                let across = Vector2::new(-f.up.y, f.up.x);
+                let d = next - f.foot;
+                let (u, side) = (d.dot(&f.up), d.dot(&across));
+                // Up to a body length before the foot and past the top: walking onto it.
+                if side.abs() > 0.5 * f.width - FLIGHT_SIDE_MARGIN || u < -1.0 || u > f.run() + 1.0
+                {
+                    continue;
+                }
+                let on_floor = if u <= 0.0 {
+                    lower
+                } else if u >= f.run() {
+                    upper
+                } else {
+                    lower
+                };
+                let clear = if u > 0.0 && u < f.run() {
+                    true
+                } else {
+                    self.building.clearance_on(on_floor, next, Some(i)) >= half_width
+                };
+                if !clear {
+                    return None;
+                }
+                // The ground follows a line through the step tops, from half a tread before
+                // the foot to half a tread past the top (as the floors tour's walk does).
+                let (s0, s1) = (-0.5 * f.tread, f.run() + 0.5 * f.tread);
+                let t = ((u - s0) / (s1 - s0)).clamp(0.0, 1.0);
+                let ground = f.base_z + f.climb() * t;
+                let slope = if (0.0..1.0).contains(&t) && t > 0.0 {
+                    f.climb() / (s1 - s0)
+                } else {
+                    0.0
+                };
+                let along = Vector2::new(heading.cos(), heading.sin()).dot(&f.up);
+                return Some(Footing {
+                    floor: if t >= 1.0 { upper } else { on_floor },
+                    ground,
+                    pitch: (slope * along).atan(),
+                });
+            }
+        }
+        (self.building.clearance_on(self.floor, next, None) >= half_width).then(|| Footing {
+            floor: self.floor,
+            ground: self.building.floor_height(self.floor),
+            pitch: 0.0,
+        })
+    }
+
+    /// The floor the robot stands on (the lower one while on a flight).
+    #[must_use]
+    pub fn floor(&self) -> usize {
+        self.floor
     }
 
     /// A person-sized box (`half_size` half extents in x and y, `height` tall) that walks to and
@@ -281,9 +396,15 @@ impl CommandedSpot {
     #[must_use]
     pub fn body_pose(&self) -> Pose3 {
         let p = self.world_t_body.translation.vector;
+        // Nose up is a negative turn about the body's y axis.
         Pose3::from_parts(
-            Translation3::new(p.x, p.y, self.description.geometry.body_height),
-            UnitQuaternion::from_euler_angles(0.0, 0.0, self.world_t_body.rotation.angle()),
+            Translation3::new(
+                p.x,
+                p.y,
+                self.ground + self.description.geometry.body_height,
+            ),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, self.world_t_body.rotation.angle())
+                * UnitQuaternion::from_euler_angles(0.0, -self.pitch, 0.0),
         )
     }
 
@@ -328,16 +449,17 @@ impl Robot for CommandedSpot {
         if !self.sensed {
             return Ok(self.sense());
         }
-        let command = match &self.active {
-            Active::Velocity(command) => *command,
-            Active::Trajectory(trajectory, sent) => self.track(trajectory, *sent),
+        let (command, stairs) = match &self.active {
+            Active::Velocity(command, stairs) => (*command, *stairs),
+            Active::Trajectory(trajectory, sent) => (self.track(trajectory, *sent), false),
         };
-        Ok(self.step(command))
+        Ok(self.step_with(command, stairs))
     }
 
     fn send(&mut self, command: &MobilityCommand) -> Result<(), SimError> {
         self.active = match command {
-            MobilityCommand::Velocity(v) => Active::Velocity(*v),
+            MobilityCommand::Velocity(v) => Active::Velocity(*v, false),
+            MobilityCommand::Stairs(v) => Active::Velocity(*v, true),
             MobilityCommand::Trajectory(t) => match t.frame() {
                 TrajectoryFrame::Odom => Active::Trajectory(t.clone(), self.stamp),
                 other => {
@@ -351,7 +473,7 @@ impl Robot for CommandedSpot {
     }
 
     fn stop(&mut self) -> Result<(), SimError> {
-        self.active = Active::Velocity(VelocityCommand::default());
+        self.active = Active::Velocity(VelocityCommand::default(), false);
         Ok(())
     }
 }

@@ -45,6 +45,51 @@ impl Building {
             .fold(outline, f64::min)
     }
 
+    /// Distance (metres) from `p` to the nearest obstacle of floor `floor` (its walls and
+    /// furniture, a flight rising from it, the stairwell of a flight arriving at it) or to the
+    /// building's outline, the flights in `except` (indices into
+    /// [`Building::staircases`]) left out; zero inside an obstacle. Floor 0 with no flight
+    /// left out is [`Building::clearance`].
+    #[must_use]
+    pub fn clearance_on(&self, floor: usize, p: Vector2<f64>, except: Option<usize>) -> f64 {
+        let z = self.floor_height(floor);
+        let outline =
+            p.x.min(p.y)
+                .min(self.size.x - p.x)
+                .min(self.size.y - p.y)
+                .max(0.0);
+        let to_rect = |min: Vector2<f64>, max: Vector2<f64>| {
+            let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
+            let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
+            dx.hypot(dy)
+        };
+        let skipped = except.map(|i| self.staircases[i]);
+        let own_step = |b: &crate::sim::SolidBox| {
+            skipped.is_some_and(|f| {
+                b.kind == crate::sim::BoxKind::Step
+                    && (b.min.z - f.base_z).abs() < 1e-9
+                    && f.step_boxes().iter().any(|s| s == b)
+            })
+        };
+        let boxes = self
+            .boxes
+            .iter()
+            .filter(|b| b.min.z < z + OBSTACLE_HEIGHT && b.max.z > z + 0.01 && !own_step(b))
+            .map(|b| to_rect(b.min.xy().coords, b.max.xy().coords));
+        let wells = self
+            .staircases
+            .iter()
+            .enumerate()
+            .filter(|(i, f)| {
+                Some(*i) != except && (f.base_z + f.climb() - z).abs() < 0.5 * OBSTACLE_HEIGHT
+            })
+            .map(|(_, f)| {
+                let (min, max) = f.stairwell();
+                to_rect(min, max)
+            });
+        boxes.chain(wells).fold(outline, f64::min)
+    }
+
     /// The ground-truth occupancy grid at `resolution` metres per cell, covering the building
     /// with its corner at the world origin. A cell is blocked when any obstacle footprint
     /// overlaps it (conservative, so thin walls are never lost) or it lies outside the building.

@@ -432,32 +432,20 @@ fn block_rectangle(
 /// the links between them still join the floors near each flight's foot and top.
 #[test]
 fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
-    use gridmap::{CellState, FloorLevels, FloorLevelsConfig};
+    use gridmap::CellState;
     use nalgebra::Vector2;
     use slam_core::{PointCloud, Pose3};
     use spot_adapter::nav::{FloorMaps, NavigationMapConfig};
     use spot_adapter::robot::SpotGeometry;
     for (seed, floors) in [(5, 2), (11, 3)] {
-        let config = BuildingConfig {
-            floors,
-            ..BuildingConfig::default()
-        };
-        let b = Building::generate(seed, &config).unwrap();
+        let TourWalk {
+            building: b,
+            lidar_poses,
+            positions,
+            split,
+        } = tour_walk(seed, floors);
         let geometry = SpotGeometry::default();
-        let (poses, _) = FloorsTour::new(&b)
-            .unwrap()
-            .walk(0.6, 5.0, geometry.body_height)
-            .unwrap();
-        let lidar_poses: Vec<Pose3> = poses
-            .iter()
-            .map(|p| p.pose * geometry.body_t_lidar)
-            .collect();
-        let positions: Vec<Point3<f64>> = lidar_poses
-            .iter()
-            .map(|p| Point3::from(p.translation.vector))
-            .collect();
-        let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
-        let scans = scans_near_stairs(&b, &lidar_poses, seed);
+        let scans = scans_along(&b, &lidar_poses, seed, 0.5, Some(10.0));
         let keyframes: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
         let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
         let maps = FloorMaps::build(
@@ -535,26 +523,69 @@ fn outside_flight(flight: &spot_adapter::sim::Staircase, c: nalgebra::Vector2<f6
         .max(side - 0.5 * flight.width)
 }
 
-/// Scans of `b` from `lidar_poses` (true, `world_T_lidar`), one every 0.5 m of the walk within
-/// 10 m of a flight's foot.
-fn scans_near_stairs(
+/// A floors tour of building `seed` with `floors` floors: the building, the tour's true
+/// LiDAR poses (`world_T_lidar`, 5 Hz at 0.6 m/s), their positions and their split into floors.
+pub(crate) struct TourWalk {
+    pub building: Building,
+    pub lidar_poses: Vec<slam_core::Pose3>,
+    pub positions: Vec<Point3<f64>>,
+    pub split: gridmap::FloorLevels,
+}
+
+/// [`TourWalk`] of building `seed` with `floors` floors.
+pub(crate) fn tour_walk(seed: u64, floors: usize) -> TourWalk {
+    use gridmap::{FloorLevels, FloorLevelsConfig};
+    let config = BuildingConfig {
+        floors,
+        ..BuildingConfig::default()
+    };
+    let building = Building::generate(seed, &config).unwrap();
+    let geometry = spot_adapter::robot::SpotGeometry::default();
+    let (poses, _) = FloorsTour::new(&building)
+        .unwrap()
+        .walk(0.6, 5.0, geometry.body_height)
+        .unwrap();
+    let lidar_poses: Vec<slam_core::Pose3> = poses
+        .iter()
+        .map(|p| p.pose * geometry.body_t_lidar)
+        .collect();
+    let positions: Vec<Point3<f64>> = lidar_poses
+        .iter()
+        .map(|p| Point3::from(p.translation.vector))
+        .collect();
+    let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
+    TourWalk {
+        building,
+        lidar_poses,
+        positions,
+        split,
+    }
+}
+
+/// Scans of `b` from `lidar_poses` (true, `world_T_lidar`), one every `spacing` metres of the
+/// walk (within `near_stairs` metres of a flight's foot when given).
+pub(crate) fn scans_along(
     b: &Building,
     lidar_poses: &[slam_core::Pose3],
     seed: u64,
+    spacing: f64,
+    near_stairs: Option<f64>,
 ) -> Vec<(slam_core::Pose3, slam_core::PointCloud)> {
     use spot_adapter::sim::{LidarConfig, SimRng, SpinningLidar};
     let lidar = SpinningLidar::new(LidarConfig::vlp16()).unwrap();
     let mut rng = SimRng::new(seed, 7);
-    let near_stairs = |p: &Point3<f64>| {
-        b.staircases()
-            .iter()
-            .any(|s| (p.xy().coords - s.foot).norm() < 10.0)
+    let near = |p: &Point3<f64>| {
+        near_stairs.is_none_or(|reach| {
+            b.staircases()
+                .iter()
+                .any(|s| (p.xy().coords - s.foot).norm() < reach)
+        })
     };
     let mut last: Option<Point3<f64>> = None;
     let mut scans = Vec::new();
     for pose in lidar_poses {
         let p = Point3::from(pose.translation.vector);
-        if near_stairs(&p) && last.is_none_or(|q| (p - q).norm() >= 0.5) {
+        if near(&p) && last.is_none_or(|q| (p - q).norm() >= spacing) {
             scans.push((*pose, lidar.scan(b, pose, &mut rng)));
             last = Some(p);
         }

@@ -17,6 +17,7 @@ mod config;
 mod evaluation;
 mod exploration;
 mod floors;
+mod floors_walk;
 mod lidar_models;
 mod lidar_only;
 mod motion_profiles;
