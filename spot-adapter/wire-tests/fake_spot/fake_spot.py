@@ -684,7 +684,8 @@ class LocalGrids(local_grid_service_pb2_grpc.LocalGridServiceServicer):
 
 def command_times(command):
     """End time, reference time (robot clock seconds) and point times of a mobility command,
-    and the velocity limit of its MobilityParams, as the official classes decode them."""
+    and the velocity limit and stairs mode of its MobilityParams, as the official classes
+    decode them."""
     mobility = command.synchronized_command.mobility_command
     kind = mobility.WhichOneof("command")
     out = {"kind": kind or command.WhichOneof("command")}
@@ -700,6 +701,7 @@ def command_times(command):
         if mobility.params.Unpack(params):
             limit = params.vel_limit.max_vel
             out["max_vel"] = [limit.linear.x, limit.linear.y, limit.angular]
+            out["stairs_mode"] = spot_command_pb2.MobilityParams.StairsMode.Name(params.stairs_mode)
     return out
 
 

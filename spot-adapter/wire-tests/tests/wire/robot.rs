@@ -144,10 +144,13 @@ fn commands_reach_the_robot_with_frames_end_times_limits_and_the_lease() {
     )
     .unwrap();
     spot.send(&MobilityCommand::Trajectory(trajectory)).unwrap();
+    // Up a flight: the stairs mode on.
+    spot.send(&MobilityCommand::Stairs(VelocityCommand::new(0.3, 0.0)))
+        .unwrap();
     spot.stop().unwrap();
 
     let commands = fake.requests_of("RobotCommand");
-    assert_eq!(commands.len(), 4);
+    assert_eq!(commands.len(), 5);
     let lease = &fake.requests_of("AcquireLease");
     assert_eq!(lease.len(), 1);
     let retained_lease = serde_json::json!({"resource": "body", "sequence": [1]});
@@ -203,7 +206,13 @@ fn commands_reach_the_robot_with_frames_end_times_limits_and_the_lease() {
         "2.5 s of points and 1 s slack"
     );
 
-    assert!(commands[3]["request"]["command"]["full_body_command"]["stop_request"].is_object());
+    // The official decoder reads the stairs mode: on for the flight, unset otherwise.
+    assert_eq!(commands[0]["decoded"]["stairs_mode"], "STAIRS_MODE_UNKNOWN");
+    assert_eq!(commands[3]["decoded"]["stairs_mode"], "STAIRS_MODE_ON");
+    let stairs = mobility(&commands[3])["se2_velocity_request"]["velocity"].clone();
+    assert_eq!(f(&stairs["linear"]["x"]), 0.3);
+
+    assert!(commands[4]["request"]["command"]["full_body_command"]["stop_request"].is_object());
 }
 
 #[test]
