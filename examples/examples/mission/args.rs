@@ -64,6 +64,11 @@ pub(crate) struct Args {
     /// of exploring.
     #[arg(long)]
     pub(crate) lap: bool,
+    /// Floors of the simulated office (1 to 3). Above one, Spot maps by a scripted tour of
+    /// every floor by the stairs (a lap of each floor, up and back down), then walks to the
+    /// goals, each on another floor than the one before, by the stairs.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub(crate) floors: usize,
     /// The rule the explorer picks the next frontier by [default: the settings'
     /// `explorer.choice`, information gain].
     #[arg(long, value_enum, conflicts_with = "lap")]
@@ -200,8 +205,11 @@ impl BuildingSize {
     /// `--building`, else the small building when exploring (it takes seconds) and the office
     /// on the lap.
     pub(crate) fn chosen(args: &Args) -> Self {
-        args.building
-            .unwrap_or(if args.lap { Self::Office } else { Self::Small })
+        args.building.unwrap_or(if args.lap || args.floors > 1 {
+            Self::Office
+        } else {
+            Self::Small
+        })
     }
 
     pub(crate) fn config(self) -> BuildingConfig {

@@ -14,6 +14,13 @@
 //!    the robot can reach (after an exploration: rooms included). Boxes are dropped on the
 //!    routes of some legs after mapping.
 //!
+//! With `--floors N` (2 or 3) the office has N floors joined by stairs: Spot maps it by a
+//! scripted tour of every floor (a lap of each, up the stairs and back down), the map splits
+//! into a grid per floor with the flights marked as stairs on both floors they join, and each
+//! goal lies on another floor than the one before: the navigator walks to the flight, a stairs
+//! controller climbs or descends it (Spot's stairs mode), and the next floor's navigator
+//! localises against that floor's map and walks on.
+//!
 //! Prints the mapping's figures (coverage of the reachable floor, distance, loops, ATE) and
 //! each leg's result against the simulator's ground truth and writes them to `--out` (default
 //! `mission-out/`): `map.ply`, `grid.png`, `map.yaml` + `map.pgm` (ROS `map_server`),
@@ -23,6 +30,7 @@
 
 mod args;
 mod exploring;
+mod floors;
 mod legs;
 mod mapped;
 mod mapping;
@@ -94,10 +102,16 @@ fn mission(args: &Args) -> Result<()> {
         explorer_config.validate()?;
     }
     let config = SimulationConfig {
-        building: BuildingSize::chosen(args).config(),
+        building: spot_adapter::sim::BuildingConfig {
+            floors: args.floors,
+            ..BuildingSize::chosen(args).config()
+        },
         lidar,
         ..SimulationConfig::with_seed(seed)
     };
+    if args.floors > 1 {
+        return floors::floors_mission(&config, slam_settings, &nav_config, args.goals, &args.out);
+    }
     let mapping = MappingSettings {
         registration: args.registration,
         slam: slam_settings,

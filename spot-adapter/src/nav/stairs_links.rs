@@ -17,13 +17,13 @@ pub const SAME_FLIGHT: f64 = 1.5;
 
 /// The stairs the walk through `positions` (in walking order, z up, the poses `floors` was
 /// split from) took: for each change of floor, the link from the walk's last pose before it
-/// whose cell is free on the grid of the floor it left (the foot of the flight, short of the
-/// steps, which that floor's grid holds as an obstacle) to its first pose after it free on the
-/// grid of the floor it reached, with the walk's length between the two (metres, in 3D). The
-/// link's `foot` is on the lower of the two floors by height, whichever way the walk went.
-/// Crossings of the same flight ([`SAME_FLIGHT`]) give one link, the shorter walk kept. A
-/// change whose ends have no free cell on their floors, within the walk on those floors, gives
-/// no link (no route could use it).
+/// whose cell is free on the grid of the floor it left, the cells around it too (the foot of
+/// the flight, short of the steps, which that floor's grid holds as an obstacle) to its first
+/// such pose after it on the grid of the floor it reached, with the walk's length between the
+/// two (metres, in 3D). The link's `foot` is on the lower of the two floors by height,
+/// whichever way the walk went. Crossings of the same flight ([`SAME_FLIGHT`]) give one link,
+/// the shorter walk kept. A change whose ends have no free cell on their floors, within the
+/// walk on those floors, gives no link (no route could use it).
 ///
 /// `grids[k]` is floor `k`'s planning grid (blocked cells the robot cannot stand on), in the
 /// frame of `positions`.
@@ -76,7 +76,7 @@ pub(crate) fn stairs_links_with_walks(
             }
             let grid = grids[floor];
             grid.cell_at(Vector2::new(p.x, p.y))
-                .filter(|&c| !grid.is_blocked(c))
+                .filter(|&c| free_around(grid, c, END_MARGIN_CELLS))
         };
         // Back along the floor left, then on along the floor reached, to the first free cells.
         let left = (0..=change.left_at)
@@ -129,6 +129,18 @@ pub(crate) fn stairs_links_with_walks(
         }
     }
     Ok(links)
+}
+
+/// A link's end is a cell free with this many cells around it free too: on the edge of the
+/// inflation a navigator's own grid (its live layer, its cost) may read it blocked.
+const END_MARGIN_CELLS: u32 = 1;
+
+/// Whether `c` and every cell within `margin` cells of it (on the grid) are free.
+fn free_around(grid: &BitGrid, c: Cell, margin: u32) -> bool {
+    let (x0, y0) = (c.x.saturating_sub(margin), c.y.saturating_sub(margin));
+    let x1 = (c.x + margin).min(grid.width() - 1);
+    let y1 = (c.y + margin).min(grid.height() - 1);
+    (y0..=y1).all(|y| (x0..=x1).all(|x| !grid.is_blocked(Cell::new(x, y))))
 }
 
 /// The error for `positions` that do not fit the walk.

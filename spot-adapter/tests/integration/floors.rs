@@ -265,10 +265,11 @@ fn the_tour_splits_into_its_floors_by_height() {
 
 /// The stairs links a tour's walk gives, on each floor's true planning grid (the floor plan
 /// inflated by the navigator's 0.3 m): one link per flight although the tour climbs and comes
-/// back down each, its foot on the lower floor and its top on the upper one, within 0.8 m of the
+/// back down each, its foot on the lower floor and its top on the upper one, within 1.2 m of the
 /// flight's true foot and top (the oracle: the building's staircases; the ends are the walk's
-/// last free cells before the steps' inflation), its length that of the flight and the walk to
-/// it, and a route over the floors from the start to the top floor goes up every flight.
+/// last cells a cell clear of the steps' inflation), its length that of the flight and the walk
+/// to it (under 3 m), and a route over the floors from the start to the top floor goes up every
+/// flight.
 #[test]
 fn the_tours_stairs_become_links_between_the_floors_grids() {
     use nalgebra::Vector2;
@@ -290,18 +291,18 @@ fn the_tours_stairs_become_links_between_the_floors_grids() {
             let top = upper.cell_center(link.top.cell);
             assert!(!lower.is_blocked(link.foot.cell) && !upper.is_blocked(link.top.cell));
             assert!(
-                (foot - stairs.foot).norm() < 0.8,
+                (foot - stairs.foot).norm() < 1.2,
                 "seed {seed} floor {k}: foot {foot} against {}",
                 stairs.foot
             );
             assert!(
-                (top - stairs.top()).norm() < 0.8,
+                (top - stairs.top()).norm() < 1.2,
                 "seed {seed} floor {k}: top {top} against {}",
                 stairs.top()
             );
             let flight = stairs.run().hypot(stairs.climb());
             assert!(
-                link.length > flight && link.length < flight + 2.0,
+                link.length > flight && link.length < flight + 3.0,
                 "seed {seed} floor {k}: {} m against a {flight} m flight",
                 link.length
             );

@@ -7,10 +7,11 @@
 
 use crate::floors::{TourWalk, scans_along, tour_walk};
 use nalgebra::{Point3, Vector2};
+use slam_core::Cell;
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::nav::{
-    DriveOutcome, FloorMaps, FloorPoint, NavigationMapConfig, NavigatorConfig, StairsClimbConfig,
-    drive_across_floors,
+    DriveOutcome, FloorCell, FloorGraph, FloorMaps, FloorPoint, NavigationMapConfig,
+    NavigatorConfig, StairsClimbConfig, drive_across_floors,
 };
 use spot_adapter::pipelines::point_to_plane_localiser;
 use spot_adapter::robot::SpotGeometry;
@@ -115,7 +116,8 @@ fn a_goal_upstairs_is_reached_over_the_stairs_and_one_downstairs_on_the_way_back
 }
 
 /// A goal off every floor's map, on a floor the maps do not have, or not finite is refused by
-/// name before the robot moves.
+/// name before the robot moves; one that no walk and no stairs reach is no path, before it
+/// moves.
 #[test]
 fn a_goal_that_is_on_no_floor_is_refused_before_moving() {
     use spot_adapter::nav::{DriveError, NavError};
@@ -176,6 +178,39 @@ fn a_goal_that_is_on_no_floor_is_refused_before_moving() {
         ),
         "{missing:?}"
     );
+    // A free cell upstairs that no walk and no stairs reach (a pocket the inflation closes):
+    // no path, before the robot moves.
+    let grids: Vec<_> = (0..2).map(|k| maps.planning(k).unwrap()).collect();
+    let graph = FloorGraph::new(grids.clone(), maps.links().to_vec()).unwrap();
+    let start = FloorCell {
+        floor: 0,
+        cell: grids[0].cell_at(pose.translation.vector.xy()).unwrap(),
+    };
+    let upstairs = grids[1];
+    let pocket = (0..upstairs.height())
+        .step_by(3)
+        .flat_map(|y| {
+            (0..upstairs.width())
+                .step_by(3)
+                .map(move |x| Cell::new(x, y))
+        })
+        .filter(|&c| !upstairs.is_blocked(c))
+        .take(400)
+        .find(|&c| {
+            graph
+                .route(start, FloorCell { floor: 1, cell: c })
+                .unwrap()
+                .is_none()
+        })
+        .expect("a free cell upstairs that no route reaches");
+    let cut_off = to(FloorPoint {
+        floor: 1,
+        at: upstairs.cell_center(pocket),
+    })
+    .unwrap();
+    assert_eq!(cut_off.outcome, DriveOutcome::NoPath);
+    assert!(cut_off.route.is_none());
+    assert_eq!(cut_off.cycles, 0);
     assert!((spot.body_pose().translation.vector - pose.translation.vector).norm() < 1e-9);
 }
 
