@@ -110,6 +110,19 @@ fn mission(args: &Args) -> Result<()> {
         ..SimulationConfig::with_seed(seed)
     };
     if args.floors > 1 {
+        if !args.goal.is_empty()
+            || args.kidnap.is_some()
+            || args.frontier.is_some()
+            || args.obstacles != 1
+            || args.registration != spot_nav_examples::Registration::PointToPlane
+        {
+            bail!(
+                "--floors {} maps by the floors tour with point-to-plane ICP and walks random goals \
+                 across floors with no boxes dropped: --goal, --kidnap, --frontier, --obstacles \
+                 and --registration loam are for one floor",
+                args.floors
+            );
+        }
         return floors::floors_mission(&config, slam_settings, &nav_config, args.goals, &args.out);
     }
     let mapping = MappingSettings {

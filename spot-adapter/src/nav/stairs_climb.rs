@@ -20,7 +20,8 @@ pub struct StairsClimbConfig {
     /// Plan-view speed on the flight, 0.3 m/s (Spot's stairs mode climbs at 0.3-0.5 m/s
     /// along the slope).
     pub speed: f64,
-    /// The point of the walk steered at lies this far ahead, 0.5 m.
+    /// The point of the walk steered at lies this far ahead, 0.3 m (short: the walk turns on
+    /// the landings, beside the stairwell).
     pub lookahead: f64,
     /// Done within this plan-view distance of the walk's end, 0.15 m, once at or past it.
     pub arrive: f64,
@@ -41,7 +42,7 @@ impl Default for StairsClimbConfig {
     fn default() -> Self {
         Self {
             speed: 0.3,
-            lookahead: 0.5,
+            lookahead: 0.3,
             arrive: 0.15,
             run_out: 0.3,
             face: 0.3,
