@@ -324,6 +324,27 @@ impl FloorMap {
         ty * self.width as usize + tx
     }
 
+    /// This floor with every tile's height kept within `lo`..=`hi` (metres): for a floor known
+    /// to lie at one level (a storey of a building), whose estimate a stairwell drags down (over
+    /// a flight the lowest dense band is a step, and the tiles beside it follow).
+    ///
+    /// # Errors
+    /// [`GridMapError::InvalidConfig`] naming `FloorMap::clamped` for bounds that are not finite
+    /// or not in order.
+    pub fn clamped(mut self, lo: f64, hi: f64) -> Result<Self, GridMapError> {
+        check(lo.is_finite(), "FloorMap::clamped lo", lo, "finite")?;
+        check(
+            hi.is_finite() && hi >= lo,
+            "FloorMap::clamped hi",
+            hi,
+            "finite and at least lo",
+        )?;
+        for z in &mut self.floors {
+            *z = z.clamp(lo, hi);
+        }
+        Ok(self)
+    }
+
     /// The floor height (metres, map frame z) under map point (x, y): that of the tile containing
     /// it, or of the nearest tile outside the tiles.
     #[inline]

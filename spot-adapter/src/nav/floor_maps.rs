@@ -17,6 +17,12 @@ use crate::nav::stairs_links::stairs_links_with_walks;
 /// to this far after it reaches the other (metres): the poses between two floors' height bands
 /// cover the middle of a flight, the first and last steps lie beyond them.
 const FLIGHT_ENDS: f64 = 1.0;
+/// A storey's floor lies within this of its level's height (metres): the floor estimate's
+/// tiles are kept within it ([`NavigationMap::from_scans_at_level`]). Beside a stairwell the
+/// estimate sank 0.1-0.2 m (to the top steps and the last riser), and the floor's own returns
+/// rose into the obstacle band: 4 % of an upper floor's occupied cells were none.
+const FLOOR_LEVEL_TOLERANCE: f64 = 0.05;
+
 /// Points up to this far below and above the walk's ground on a flight are read for its
 /// treads and what stands over them (metres): more than the headroom looked at.
 const STOREY_MARGIN: f64 = 1.5;
@@ -224,8 +230,9 @@ impl FloorMaps {
     }
 }
 
-/// Floor `k`'s map from the keyframes at its height (those on the stairs are in none), or why
-/// there is none, for each floor.
+/// Floor `k`'s map from the keyframes at its height (those on the stairs are in none), its
+/// floor within [`FLOOR_LEVEL_TOLERANCE`] of the level's height, or why there is none, for each
+/// floor.
 fn maps_by_floor(
     keyframes: &[(Pose3, &PointCloud)],
     floors: &FloorLevels,
@@ -239,7 +246,13 @@ fn maps_by_floor(
                 .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
                 .copied()
                 .collect();
-            NavigationMap::from_scans(&on_floor, lidar_height, config)
+            let level = floors.levels()[k].height - lidar_height;
+            NavigationMap::from_scans_at_level(
+                &on_floor,
+                lidar_height,
+                (level, FLOOR_LEVEL_TOLERANCE),
+                config,
+            )
         })
         .collect()
 }

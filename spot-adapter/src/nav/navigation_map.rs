@@ -30,10 +30,48 @@ impl NavigationMap {
         lidar_height: f64,
         config: &NavigationMapConfig,
     ) -> Result<Self, NavError> {
+        Self::scanned(scans, lidar_height, None, config)
+    }
+
+    /// [`NavigationMap::from_scans`] for one storey of a building whose floor lies within
+    /// `tolerance` metres of height `level` (the map frame's z, e.g. a [`gridmap::FloorLevel`]'s
+    /// height less the LiDAR's): the floor's tiles kept within it, so that a stairwell does not
+    /// drag the floor beside it down (over a flight the lowest points are a step's) and lift
+    /// the floor's own returns into the obstacle band.
+    ///
+    /// # Errors
+    /// As [`NavigationMap::from_scans`]; [`NavError::NavigationGrid`] for a level or tolerance
+    /// that is not finite (or a negative tolerance).
+    pub fn from_scans_at_level(
+        scans: &[(Pose3, &PointCloud)],
+        lidar_height: f64,
+        (level, tolerance): (f64, f64),
+        config: &NavigationMapConfig,
+    ) -> Result<Self, NavError> {
+        Self::scanned(
+            scans,
+            lidar_height,
+            Some((level - tolerance, level + tolerance)),
+            config,
+        )
+    }
+
+    /// [`NavigationMap::from_scans`], the floor's tiles kept within `level` (lowest, highest)
+    /// when given.
+    fn scanned(
+        scans: &[(Pose3, &PointCloud)],
+        lidar_height: f64,
+        level: Option<(f64, f64)>,
+        config: &NavigationMapConfig,
+    ) -> Result<Self, NavError> {
         config.validate()?;
         let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
         let hints = floor_hints_below(&poses, lidar_height);
         let floor = FloorMap::estimate_from_scans(scans, &hints, &config.floor)
+            .and_then(|f| match level {
+                Some((lo, hi)) => f.clamped(lo, hi),
+                None => Ok(f),
+            })
             .map_err(NavError::NavigationGrid)?;
         let occupancy = OccupancyGridBuilder::new(config.grid.clone())
             .and_then(|b| b.build_floor_band_from_scans(scans, &floor, &config.band))

@@ -320,3 +320,45 @@ fn a_stairs_climb_refuses_a_walk_too_short_or_not_finite_and_bad_settings() {
         named(StairsClimb::new(&walk, id, id, bad), name);
     }
 }
+
+/// Each floor's grid against that floor's true plan (the oracle: the building's boxes on that
+/// floor, `Building::clearance_on`): occupied cells lie within 0.15 m of a true obstacle and
+/// known-free cells outside every one, on the upper floors as on the ground floor (whose grid
+/// is made as a single floor's is). Before each storey's floor was held to its level, 4 % of
+/// an upper floor's occupied cells were its own floor, beside the stairwell.
+#[test]
+fn each_floors_grid_matches_its_floor_plan() {
+    use gridmap::CellState;
+    let (b, maps, _) = mapped(11, 3);
+    let mut figures = Vec::new();
+    for k in 0..3 {
+        let grid = maps.map(k).unwrap().unwrap().occupancy();
+        let (mut occupied, mut near, mut free, mut outside) = (0_usize, 0_usize, 0_usize, 0_usize);
+        for y in 0..grid.height() {
+            for x in 0..grid.width() {
+                let cell = Cell::new(x, y);
+                let clearance = b.clearance_on(k, grid.geometry().cell_center(cell), None);
+                match grid.state(cell) {
+                    CellState::Occupied => {
+                        occupied += 1;
+                        near += usize::from(clearance <= 0.15);
+                    }
+                    CellState::Free => {
+                        free += 1;
+                        outside += usize::from(clearance > 0.0);
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let share = |a: usize, b: usize| a as f64 / b as f64;
+        figures.push((share(near, occupied), share(outside, free)));
+        assert!(free > 100_000, "floor {k}: {free} free cells");
+    }
+    let (ground_near, ground_outside) = figures[0];
+    assert!(ground_near > 0.995 && ground_outside > 0.98, "{figures:?}");
+    for &(near, outside) in &figures[1..] {
+        assert!(near > ground_near - 0.005, "{figures:?}");
+        assert!(outside > ground_outside - 0.005, "{figures:?}");
+    }
+}
