@@ -146,7 +146,7 @@ pub(crate) fn floors_mission(
         .context("the tour gave the engine no scan")?
         .pose;
     let goals = floor_goals(&building, &maps, &frames, goals, config.seed)?;
-    write_grids(&maps, &goals, out_dir)?;
+    write_grids(&maps, &clouds, &goals, out_dir)?;
     let legs = walk_goals(
         &mut spot, &maps, &clouds, nav_config, &frames, &goals, map_t_body,
     )?;
@@ -180,7 +180,7 @@ fn finish(summary: &FloorsSummary, out_dir: &Path) -> Result<()> {
     std::fs::write(out_dir.join("summary.json"), json)
         .with_context(|| format!("writing {}", out_dir.join("summary.json").display()))?;
     out!(
-        "wrote       {}: grid_floor{{k}}.png, map_floor{{k}}.yaml + .pgm, summary.json",
+        "wrote       {}: grid_floor{{k}}.png, map_floor{{k}}.yaml + .pgm, map_floor{{k}}.ply, summary.json",
         out_dir.display()
     )?;
     if reached < summary.legs.len() || collisions > 0 {
@@ -278,10 +278,16 @@ fn print_floors(maps: &FloorMaps) -> Result<Vec<usize>> {
 }
 
 /// A picture (`grid_floor{k}.png`: the stairs teal, the inflation orange, the stairs' ends and
-/// the floor's goals red) and a ROS map (`map_floor{k}.yaml` + `.pgm`) per floor in `dir`.
-fn write_grids(maps: &FloorMaps, goals: &[FloorPoint], dir: &Path) -> Result<()> {
+/// the floor's goals red), a ROS map (`map_floor{k}.yaml` + `.pgm`) and the map cloud
+/// (`map_floor{k}.ply`, from `clouds`) per floor in `dir`.
+fn write_grids(
+    maps: &FloorMaps,
+    clouds: &[PointCloud],
+    goals: &[FloorPoint],
+    dir: &Path,
+) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    for k in 0..maps.floors().levels().len() {
+    for (k, cloud) in clouds.iter().enumerate() {
         let (Some(Ok(map)), Some(planning)) = (maps.map(k), maps.planning(k)) else {
             continue;
         };
@@ -307,6 +313,11 @@ fn write_grids(maps: &FloorMaps, goals: &[FloorPoint], dir: &Path) -> Result<()>
             &marks,
         )?;
         gridmap::write_ros_map(occupancy, dir.join(format!("map_floor{k}.yaml")))?;
+        slam_core::io::write_ply(
+            dir.join(format!("map_floor{k}.ply")),
+            cloud,
+            slam_core::io::PlyEncoding::BinaryLittleEndian,
+        )?;
     }
     Ok(())
 }

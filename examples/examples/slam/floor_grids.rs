@@ -16,6 +16,8 @@ use spot_nav_examples::{Mapping, out};
 /// A grid per floor and the stairs between them.
 pub(crate) struct FloorGrids {
     maps: FloorMaps,
+    /// Each floor's map cloud: the keyframes at its height, 5 cm voxels.
+    clouds: Vec<slam_core::PointCloud>,
     /// The stairs, each with its foot's and top's cell centres (metres, the map frame).
     links: Vec<(StairsLink, Vector2<f64>, Vector2<f64>)>,
 }
@@ -61,7 +63,22 @@ impl FloorGrids {
                 Some((*l, foot, top))
             })
             .collect();
-        Ok(Self { maps, links })
+        let clouds = (0..floors.levels().len())
+            .map(|k| {
+                let points: Vec<Point3<f32>> = scans
+                    .iter()
+                    .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
+                    .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
+                    .collect();
+                slam_core::PointCloud::from_points(points).voxel_downsample(0.05)
+            })
+            .collect::<Result<_, _>>()
+            .context("each floor's map cloud")?;
+        Ok(Self {
+            maps,
+            clouds,
+            links,
+        })
     }
 
     /// The cells of floor `k`'s grid marked as stairs; `None` when it has no grid.
@@ -114,8 +131,9 @@ impl FloorGrids {
         Ok(stairs)
     }
 
-    /// A picture and a ROS map per floor in `dir` (`grid_floor{k}.png`, `map_floor{k}.yaml` +
-    /// `.pgm`) with the walk on it and the stairs' ends marked.
+    /// A picture, a ROS map and a map cloud per floor in `dir` (`grid_floor{k}.png`,
+    /// `map_floor{k}.yaml` + `.pgm`, `map_floor{k}.ply`), the picture with the walk on it, the
+    /// stairs (teal) and the stairs' ends marked.
     pub(crate) fn write(&self, mapping: &Mapping, dir: &Path) -> Result<()> {
         let mut written = Vec::new();
         let floors = self.maps.floors();
@@ -144,7 +162,14 @@ impl FloorGrids {
             let png = dir.join(format!("grid_floor{k}.png"));
             gridmap::write_png(&png, occupancy, Some(planning), &walked, &ends)?;
             gridmap::write_ros_map(occupancy, dir.join(format!("map_floor{k}.yaml")))?;
-            written.push(format!("grid_floor{k}.png, map_floor{k}.yaml + .pgm"));
+            slam_core::io::write_ply(
+                dir.join(format!("map_floor{k}.ply")),
+                &self.clouds[k],
+                slam_core::io::PlyEncoding::BinaryLittleEndian,
+            )?;
+            written.push(format!(
+                "grid_floor{k}.png, map_floor{k}.yaml + .pgm, map_floor{k}.ply"
+            ));
         }
         out!(
             "wrote       {}: map.ply, map.pcd, trajectory.tum, graph.g2o, {}, summary.json",

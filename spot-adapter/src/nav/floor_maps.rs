@@ -143,6 +143,14 @@ impl FloorMaps {
                     &config.stairs,
                 )
                 .map_err(NavError::NavigationGrid)?;
+                // On the floor it reaches the flight is a hole in the slab, wider than the
+                // steps (a gap between their sides and the slab's edge, which reads as neither
+                // floor nor step): its edge, a cell round the steps, is the stairwell too.
+                let cells = if floor == upper {
+                    grown_by_a_cell(&cells)
+                } else {
+                    cells
+                };
                 let before = map.occupancy().stairs().count_blocked();
                 map.mark_stairs(&cells)?;
                 marks[at].cells[n] += map.occupancy().stairs().count_blocked() - before;
@@ -228,6 +236,26 @@ impl FloorMaps {
     pub fn links(&self) -> &[StairsLink] {
         &self.links
     }
+}
+
+/// `cells` and every cell next to one (8-neighbourhood).
+fn grown_by_a_cell(cells: &BitGrid) -> BitGrid {
+    let mut grown = cells.clone();
+    let (w, h) = (cells.width(), cells.height());
+    for y in 0..h {
+        for x in 0..w {
+            if !cells.is_blocked(slam_core::Cell::new(x, y)) {
+                continue;
+            }
+            for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+                for nx in x.saturating_sub(1)..=(x + 1).min(w - 1) {
+                    // In bounds by construction.
+                    let _ = grown.set(slam_core::Cell::new(nx, ny), true);
+                }
+            }
+        }
+    }
+    grown
 }
 
 /// Floor `k`'s map from the keyframes at its height (those on the stairs are in none), its

@@ -355,6 +355,7 @@ fn each_floors_grid_matches_its_floor_plan() {
         figures.push((share(near, occupied), share(outside, free)));
         assert!(free > 100_000, "floor {k}: {free} free cells");
     }
+    eprintln!("(occupied near an obstacle, known-free outside) per floor: {figures:?}");
     let (ground_near, ground_outside) = figures[0];
     assert!(ground_near > 0.995 && ground_outside > 0.98, "{figures:?}");
     for &(near, outside) in &figures[1..] {
