@@ -145,9 +145,9 @@ impl FloorMaps {
                 .map_err(NavError::NavigationGrid)?;
                 // On the floor it reaches the flight is a hole in the slab, wider than the
                 // steps (a gap between their sides and the slab's edge, which reads as neither
-                // floor nor step): its edge, a cell round the steps, is the stairwell too.
+                // floor nor step): its edge, two cells round the steps, is the stairwell too.
                 let cells = if floor == upper {
-                    grown_by_a_cell(&cells)
+                    grown_by_a_cell(&grown_by_a_cell(&cells))
                 } else {
                     cells
                 };

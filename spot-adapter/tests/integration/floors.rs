@@ -429,7 +429,8 @@ fn block_rectangle(
 /// the stairs' marking, not of SLAM) and marked on the grids of both floors each joins: against
 /// the building's staircases (the oracle), every cell whose centre lies on a flight at least a
 /// cell in from its edges is stairs on both grids (neither a wall nor floor), no stairs cell
-/// lies more than 0.2 m off a flight, and the floors' planning grids block the flights while
+/// lies more than 0.2 m off a flight on the floor it rises from (0.35 m on the floor it
+/// reaches, where its stairwell with the edge is marked), and the floors' planning grids block the flights while
 /// the links between them still join the floors near each flight's foot and top.
 #[test]
 fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
@@ -482,10 +483,13 @@ fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
                             .staircases()
                             .iter()
                             .enumerate()
-                            .any(|(o, f)| o != s && outside_flight(f, centre) <= 0.2);
+                            .any(|(o, f)| o != s && outside_flight(f, centre) <= 0.35);
+                        // Upstairs the stairwell, 0.1 m wider than the flight, is marked with
+                        // its edge.
+                        let bound = if k == s { 0.2 } else { 0.35 };
                         if stairs && !other {
                             assert!(
-                                off <= 0.2,
+                                off <= bound,
                                 "seed {seed} flight {s} floor {k}: stairs {off:.2} m off the flight at {centre}"
                             );
                         }
