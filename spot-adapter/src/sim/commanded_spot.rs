@@ -191,7 +191,7 @@ impl CommandedSpot {
 
     /// [`CommandedSpot::step`] with the stairs mode on: the robot may walk onto a flight of
     /// stairs rising from or arriving at its floor, facing along it, its body centre at least
-    /// [`FLIGHT_SIDE_MARGIN`] inside the flight's sides; on the flight its body rises with the
+    /// 0.2 m inside the flight's sides; on the flight its body rises with the
     /// steps and pitches with them, and past the flight's top (or foot) it stands on the floor
     /// there.
     pub fn step_on_stairs(&mut self, command: VelocityCommand) -> Sample {
