@@ -115,6 +115,9 @@ fn pytest_suite() {
     let out = run(
         Command::new(&python)
             .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            // Its temporary files under the target directory, not /tmp/pytest-of-<user>.
+            .arg("--basetemp")
+            .arg(tmp.join("pytest-basetemp"))
             .arg(here().join("tests"))
             .current_dir(here()),
         "pytest",
