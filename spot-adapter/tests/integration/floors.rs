@@ -3,7 +3,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point3, Vector2, Vector3};
 use spot_adapter::sim::{
     BoxKind, Building, BuildingConfig, FloorsTour, HitTarget, SLAB_THICKNESS, STAIRS_SPEED,
     SimError,
@@ -265,14 +265,15 @@ fn the_tour_splits_into_its_floors_by_height() {
 
 /// The stairs links a tour's walk gives, on each floor's true planning grid (the floor plan
 /// inflated by the navigator's 0.3 m): one link per flight although the tour climbs and comes
-/// back down each, its foot on the lower floor and its top on the upper one, within 1.2 m of the
-/// flight's true foot and top (the oracle: the building's staircases; the ends are the walk's
-/// last cells a cell clear of the steps' inflation), its length that of the flight and the walk
-/// to it (under 3 m), and a route over the floors from the start to the top floor goes up every
-/// flight.
+/// back down each, its foot on the lower floor and its top on the upper one (the oracle: the
+/// building's staircases). Each end is the walk's last cell a cell clear of the inflation round
+/// the steps (upstairs: round the stairwell): 0.35-0.6 m from them in plan, in front of the
+/// flight's end (0.3 m or more beyond it along the flight), within 1.1 m of its foot or top. The
+/// link's length is the flight's and the walk to its ends: longer than the flight by the ends'
+/// 0.35 m each, shorter than the flight plus 1.5 times the straight lines to the ends. A route
+/// over the floors from the start to the top floor goes up every flight.
 #[test]
 fn the_tours_stairs_become_links_between_the_floors_grids() {
-    use nalgebra::Vector2;
     use spot_adapter::nav::{FloorCell, FloorGraph, RouteLeg, stairs_links};
     for (seed, floors) in [(5, 2), (11, 3)] {
         let (b, positions, split, floor_grids) = tour_on_true_grids(seed, floors);
@@ -290,20 +291,29 @@ fn the_tours_stairs_become_links_between_the_floors_grids() {
             let foot = lower.cell_center(link.foot.cell);
             let top = upper.cell_center(link.top.cell);
             assert!(!lower.is_blocked(link.foot.cell) && !upper.is_blocked(link.top.cell));
-            assert!(
-                (foot - stairs.foot).norm() < 1.2,
-                "seed {seed} floor {k}: foot {foot} against {}",
-                stairs.foot
+            let steps = stairs.step_boxes();
+            let off_steps = steps
+                .iter()
+                .map(|s| rect_distance(foot, s.min.xy().coords, s.max.xy().coords))
+                .fold(f64::INFINITY, f64::min);
+            let (well_min, well_max) = stairs.stairwell();
+            let off_well = rect_distance(top, well_min, well_max);
+            let in_front_of_foot = (foot - stairs.foot).dot(&-stairs.up);
+            let in_front_of_top = (top - stairs.top()).dot(&stairs.up);
+            let (to_foot, to_top) = ((foot - stairs.foot).norm(), (top - stairs.top()).norm());
+            let ends = format!(
+                "seed {seed} floor {k}: foot {foot} ({off_steps:.3} m off the steps, \
+                 {in_front_of_foot:.3} in front, {to_foot:.3} away), top {top} ({off_well:.3} m \
+                 off the stairwell, {in_front_of_top:.3} in front, {to_top:.3} away)"
             );
-            assert!(
-                (top - stairs.top()).norm() < 1.2,
-                "seed {seed} floor {k}: top {top} against {}",
-                stairs.top()
-            );
+            assert!((0.35..=0.6).contains(&off_steps), "{ends}");
+            assert!((0.35..=0.6).contains(&off_well), "{ends}");
+            assert!(in_front_of_foot >= 0.3 && in_front_of_top >= 0.3, "{ends}");
+            assert!(to_foot < 1.1 && to_top < 1.1, "{ends}");
             let flight = stairs.run().hypot(stairs.climb());
             assert!(
-                link.length > flight && link.length < flight + 3.0,
-                "seed {seed} floor {k}: {} m against a {flight} m flight",
+                link.length > flight + 0.7 && link.length < flight + 1.5 * (to_foot + to_top),
+                "{ends}: {} m against a {flight} m flight",
                 link.length
             );
         }
@@ -368,6 +378,13 @@ fn stairs_from_a_walk_that_does_not_fit_are_refused() {
 /// positions, their split into floors, and each floor's true planning grid (the plan: the
 /// ground floor's obstacles, the first flight's steps among them; plus the flight rising from
 /// that floor and the stairwell of the one arriving; inflated by 0.3 m).
+/// Plan-view distance from `p` to the rectangle `min`..`max` (0 inside).
+fn rect_distance(p: Vector2<f64>, min: Vector2<f64>, max: Vector2<f64>) -> f64 {
+    let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
+    let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
+    dx.hypot(dy)
+}
+
 fn tour_on_true_grids(
     seed: u64,
     floors: usize,
@@ -410,11 +427,7 @@ fn tour_on_true_grids(
 }
 
 /// Blocks every cell of `grid` the plan-view rectangle `min`-`max` touches.
-fn block_rectangle(
-    grid: &mut slam_core::BitGrid,
-    min: nalgebra::Vector2<f64>,
-    max: nalgebra::Vector2<f64>,
-) {
+fn block_rectangle(grid: &mut slam_core::BitGrid, min: Vector2<f64>, max: Vector2<f64>) {
     let r = grid.geometry().resolution;
     let (x0, y0) = ((min.x / r).floor() as u32, (min.y / r).floor() as u32);
     let (x1, y1) = ((max.x / r).ceil() as u32, (max.y / r).ceil() as u32);
@@ -435,7 +448,6 @@ fn block_rectangle(
 #[test]
 fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
     use gridmap::CellState;
-    use nalgebra::Vector2;
     use slam_core::{PointCloud, Pose3};
     use spot_adapter::nav::{FloorMaps, NavigationMapConfig};
     use spot_adapter::robot::SpotGeometry;
@@ -518,8 +530,8 @@ fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
 
 /// Plan-view distance of `c` outside `flight`'s rectangle, from its foot to its top and its
 /// width across (metres, negative inside).
-fn outside_flight(flight: &spot_adapter::sim::Staircase, c: nalgebra::Vector2<f64>) -> f64 {
-    let across = nalgebra::Vector2::new(-flight.up.y, flight.up.x);
+fn outside_flight(flight: &spot_adapter::sim::Staircase, c: Vector2<f64>) -> f64 {
+    let across = Vector2::new(-flight.up.y, flight.up.x);
     let d = c - flight.foot;
     let along = d.dot(&flight.up);
     let side = d.dot(&across).abs();
