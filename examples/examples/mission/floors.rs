@@ -132,7 +132,9 @@ pub(crate) fn floors_mission(
         nav_config.planning.inflation,
     )
     .context("building a grid per floor and the stairs between them")?;
-    let clouds = floor_clouds(&keyframes, &floors)?;
+    let clouds = maps
+        .clouds(&keyframes, 0.05)
+        .context("each floor's localisation cloud")?;
     let stairs_cells = print_floors(&maps)?;
     let mut spot = CommandedSpot::new(
         building.clone(),
@@ -320,23 +322,6 @@ fn write_grids(
         )?;
     }
     Ok(())
-}
-
-/// Each floor's localisation cloud: the keyframes at its height, merged, 5 cm voxels.
-fn floor_clouds(
-    keyframes: &[(Pose3, &PointCloud)],
-    floors: &FloorLevels,
-) -> Result<Vec<PointCloud>> {
-    (0..floors.levels().len())
-        .map(|k| {
-            let points: Vec<Point3<f32>> = keyframes
-                .iter()
-                .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
-                .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
-                .collect();
-            Ok(PointCloud::from_points(points).voxel_downsample(0.05)?)
-        })
-        .collect()
 }
 
 /// `count` goals (map frame), each on another floor than the one before (the first off the

@@ -63,16 +63,8 @@ impl FloorGrids {
                 Some((*l, foot, top))
             })
             .collect();
-        let clouds = (0..floors.levels().len())
-            .map(|k| {
-                let points: Vec<Point3<f32>> = scans
-                    .iter()
-                    .filter(|(pose, _)| floors.floor_at(pose.translation.z) == Some(k))
-                    .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
-                    .collect();
-                slam_core::PointCloud::from_points(points).voxel_downsample(0.05)
-            })
-            .collect::<Result<_, _>>()
+        let clouds = maps
+            .clouds(&scans, 0.05)
             .context("each floor's map cloud")?;
         Ok(Self {
             maps,

@@ -230,6 +230,31 @@ impl FloorMaps {
         self.walks.get(i).map(Vec::as_slice)
     }
 
+    /// Each floor's localisation cloud for [`drive_across_floors`](crate::nav::drive_across_floors):
+    /// the `keyframes` (`map_T_lidar` and the scan, as given to [`FloorMaps::build`]) whose
+    /// height is that floor's, merged in the map frame and thinned to one point per `voxel`
+    /// (metres). A floor with no keyframe gets an empty cloud.
+    ///
+    /// # Errors
+    /// [`slam_core::CloudError`] when `voxel` is not positive and finite, or a point lies more
+    /// than 2^63 voxels from the origin.
+    pub fn clouds(
+        &self,
+        keyframes: &[(Pose3, &PointCloud)],
+        voxel: f32,
+    ) -> Result<Vec<PointCloud>, slam_core::CloudError> {
+        (0..self.floors.levels().len())
+            .map(|k| {
+                let points: Vec<_> = keyframes
+                    .iter()
+                    .filter(|(pose, _)| self.floors.floor_at(pose.translation.z) == Some(k))
+                    .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
+                    .collect();
+                PointCloud::from_points(points).voxel_downsample(voxel)
+            })
+            .collect()
+    }
+
     /// The stairs as links between the floors' planning grids
     /// ([`stairs_links`](crate::nav::stairs_links)); none when a floor has no map.
     #[must_use]

@@ -42,18 +42,7 @@ fn mapped(seed: u64, floors: usize) -> (Building, FloorMaps, Vec<PointCloud>) {
         0.3,
     )
     .unwrap();
-    let clouds = (0..floors)
-        .map(|k| {
-            let points: Vec<Point3<f32>> = scans
-                .iter()
-                .filter(|(pose, _)| split.floor_at(pose.translation.z) == Some(k))
-                .flat_map(|(pose, cloud)| cloud.transformed(pose).points().to_vec())
-                .collect();
-            PointCloud::from_points(points)
-                .voxel_downsample(0.05)
-                .unwrap()
-        })
-        .collect();
+    let clouds = maps.clouds(&keyframes, 0.05).unwrap();
     (b, maps, clouds)
 }
 
