@@ -48,7 +48,8 @@ impl Building {
     /// Distance (metres) from `p` to the nearest obstacle of floor `floor` (its walls and
     /// furniture, a flight rising from it, the stairwell of a flight arriving at it) or to the
     /// building's outline, the flights in `except` (indices into
-    /// [`Building::staircases`]) left out; zero inside an obstacle. Floor 0 with no flight
+    /// [`Building::staircases`]; an index past them leaves none out) left out; zero inside an
+    /// obstacle. Floor 0 with no flight
     /// left out is [`Building::clearance`].
     #[must_use]
     pub fn clearance_on(&self, floor: usize, p: Vector2<f64>, except: Option<usize>) -> f64 {
@@ -63,13 +64,12 @@ impl Building {
             let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
             dx.hypot(dy)
         };
-        let skipped = except.map(|i| self.staircases[i]);
+        // The skipped flight's steps, made once: this runs every control step on a flight.
+        let skipped = except
+            .and_then(|i| self.staircases.get(i))
+            .map_or_else(Vec::new, crate::sim::Staircase::step_boxes);
         let own_step = |b: &crate::sim::SolidBox| {
-            skipped.is_some_and(|f| {
-                b.kind == crate::sim::BoxKind::Step
-                    && (b.min.z - f.base_z).abs() < 1e-9
-                    && f.step_boxes().iter().any(|s| s == b)
-            })
+            b.kind == crate::sim::BoxKind::Step && skipped.iter().any(|s| s == b)
         };
         let boxes = self
             .boxes
