@@ -16,9 +16,11 @@ use spot_adapter::nav::{
 };
 use spot_adapter::pipelines::{point_to_plane_localiser, point_to_plane_slam, scan_context_places};
 use spot_adapter::sim::{Building, CommandedSpot, SimRng, SimulatedSpot, SimulationConfig};
-use spot_nav_examples::{map_and_evaluate, out};
+use spot_nav_examples::out;
 
 use crate::legs::Frames;
+use crate::mapping::map_walk;
+use crate::report::MappingSummary;
 
 /// A goal counts as reached within this distance of the true body (metres), on its floor.
 const REACHED_WITHIN: f64 = 0.10;
@@ -52,9 +54,7 @@ struct FloorLeg {
 struct FloorsSummary {
     seed: u64,
     floors: usize,
-    mapping_ate_m: f64,
-    mapping_scans: usize,
-    loops_closed: usize,
+    mapping: MappingSummary,
     /// Cells marked as stairs on each floor's grid.
     stairs_cells: Vec<usize>,
     flights_linked: usize,
@@ -88,26 +88,7 @@ pub(crate) fn floors_mission(
         building.rooms().len()
     )?;
     let mut engine = point_to_plane_slam(slam)?.with_place_recognizer(scan_context_places());
-    let samples = sim.map(Ok::<_, std::convert::Infallible>);
-    let mapping = map_and_evaluate(
-        &mut engine,
-        samples,
-        &body_t_lidar,
-        Some(&truth),
-        "mapping",
-        false,
-    )?;
-    let evaluation = mapping.evaluation.context("the tour has a ground truth")?;
-    let report = engine.report();
-    out!(
-        "mapping     {} scans, {} keyframes, {} loops closed; {:.1} m tour; ATE {:.3} m; {:.1} s",
-        report.scans,
-        report.keyframes,
-        report.loops_closed,
-        evaluation.end_point.path_length,
-        evaluation.ate.rmse,
-        mapping.seconds
-    )?;
+    let mapping = map_walk(&mut engine, sim, "tour")?;
     let positions: Vec<Point3<f64>> = engine
         .scan_trajectory()
         .iter()
@@ -142,11 +123,10 @@ pub(crate) fn floors_mission(
         tour_end.rotation.euler_angles().2,
         config,
     )?;
-    let map_t_body = mapping
-        .estimate
-        .last()
+    let map_t_body = engine
+        .current_lidar_pose()
         .context("the tour gave the engine no scan")?
-        .pose;
+        * body_t_lidar.inverse();
     let goals = floor_goals(&building, &maps, &frames, goals, config.seed)?;
     write_grids(&maps, &clouds, &goals, out_dir)?;
     let legs = walk_goals(
@@ -156,9 +136,7 @@ pub(crate) fn floors_mission(
         &FloorsSummary {
             seed: config.seed,
             floors: floors.levels().len(),
-            mapping_ate_m: evaluation.ate.rmse,
-            mapping_scans: report.scans,
-            loops_closed: report.loops_closed,
+            mapping,
             stairs_cells,
             flights_linked: maps.links().len(),
             goals_reached: legs.iter().filter(|l| l.reached).count(),

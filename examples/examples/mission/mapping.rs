@@ -26,29 +26,7 @@ pub(crate) fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Po
     map_config: &NavigationMapConfig,
 ) -> Result<Mapped> {
     let body_t_lidar = sim.body_t_lidar();
-    let truth = sim.ground_truth();
-    let samples = sim.map(Ok::<_, std::convert::Infallible>);
-    let mapping = map_and_evaluate(
-        &mut slam,
-        samples,
-        &body_t_lidar,
-        Some(&truth),
-        "mapping",
-        false,
-    )?;
-    let e = mapping.evaluation.context("the lap has a ground truth")?;
-    let report = slam.report();
-    out!(
-        "mapping     {} scans, {} keyframes, {} loops closed; {:.1} m lap; ATE {:.3} m, loop end-point error {:.3} m; {:.2} ms mean per scan; {:.1} s",
-        report.scans,
-        report.keyframes,
-        report.loops_closed,
-        e.end_point.path_length,
-        e.ate.rmse,
-        e.loop_end_point_error,
-        report.mean_scan_ms(),
-        mapping.seconds
-    )?;
+    let summary = map_walk(&mut slam, sim, "lap")?;
     let map_t_lidar = slam
         .current_lidar_pose()
         .context("the lap gave the engine no scan")?;
@@ -60,16 +38,45 @@ pub(crate) fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Po
         map: slam.map(0.05)?,
         navigation,
         map_t_body: map_t_lidar * body_t_lidar.inverse(),
-        summary: MappingSummary {
-            scans: report.scans,
-            keyframes: report.keyframes,
-            loops_closed: report.loops_closed,
-            lap_length_m: e.end_point.path_length,
-            ate_m: e.ate.rmse,
-            loop_end_point_error_m: e.loop_end_point_error,
-            segment_drift_percent: e.segments.as_ref().map(|s| 100.0 * s.translation),
-            mean_ms_per_scan: report.mean_scan_ms(),
-            seconds: mapping.seconds,
-        },
+        summary,
+    })
+}
+
+/// Walks `sim` (a `walk`: "lap", "tour") through `slam`, prints its mapping figures in one line
+/// and returns them.
+pub(crate) fn map_walk<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
+    slam: &mut GraphSlam<R, C, O>,
+    sim: SimulatedSpot,
+    walk: &str,
+) -> Result<MappingSummary> {
+    let body_t_lidar = sim.body_t_lidar();
+    let truth = sim.ground_truth();
+    let samples = sim.map(Ok::<_, std::convert::Infallible>);
+    let mapping = map_and_evaluate(slam, samples, &body_t_lidar, Some(&truth), "mapping", false)?;
+    let e = mapping
+        .evaluation
+        .with_context(|| format!("the {walk} has a ground truth"))?;
+    let report = slam.report();
+    out!(
+        "mapping     {} scans, {} keyframes, {} loops closed; {:.1} m {walk}; ATE {:.3} m, loop end-point error {:.3} m; {:.2} ms mean per scan; {:.1} s",
+        report.scans,
+        report.keyframes,
+        report.loops_closed,
+        e.end_point.path_length,
+        e.ate.rmse,
+        e.loop_end_point_error,
+        report.mean_scan_ms(),
+        mapping.seconds
+    )?;
+    Ok(MappingSummary {
+        scans: report.scans,
+        keyframes: report.keyframes,
+        loops_closed: report.loops_closed,
+        lap_length_m: e.end_point.path_length,
+        ate_m: e.ate.rmse,
+        loop_end_point_error_m: e.loop_end_point_error,
+        segment_drift_percent: e.segments.as_ref().map(|s| 100.0 * s.translation),
+        mean_ms_per_scan: report.mean_scan_ms(),
+        seconds: mapping.seconds,
     })
 }
