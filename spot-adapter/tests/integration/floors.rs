@@ -448,9 +448,6 @@ fn block_rectangle(grid: &mut slam_core::BitGrid, min: Vector2<f64>, max: Vector
 #[test]
 fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
     use gridmap::CellState;
-    use slam_core::{PointCloud, Pose3};
-    use spot_adapter::nav::{FloorMaps, NavigationMapConfig};
-    use spot_adapter::robot::SpotGeometry;
     for (seed, floors) in [(5, 2), (11, 3)] {
         let TourWalk {
             building: b,
@@ -458,19 +455,8 @@ fn the_flights_are_stairs_on_the_grids_of_both_floors_they_join() {
             positions,
             split,
         } = tour_walk(seed, floors);
-        let geometry = SpotGeometry::default();
         let scans = scans_along(&b, &lidar_poses, seed, 0.5, Some(10.0));
-        let keyframes: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
-        let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
-        let maps = FloorMaps::build(
-            &keyframes,
-            &positions,
-            &split,
-            lidar_height,
-            &NavigationMapConfig::default(),
-            0.3,
-        )
-        .unwrap();
+        let maps = floor_maps(&scans, &positions, &split);
         assert_eq!(maps.flights().len(), floors - 1, "seed {seed}");
         assert_eq!(maps.links().len(), floors - 1, "seed {seed}");
         for (s, flight) in b.staircases().iter().enumerate() {
@@ -581,6 +567,29 @@ pub(crate) fn tour_walk(seed: u64, floors: usize) -> TourWalk {
 
 /// Scans of `b` from `lidar_poses` (true, `world_T_lidar`), one every `spacing` metres of the
 /// walk (within `near_stairs` metres of a flight's foot when given).
+/// The maps per floor (default settings, 0.3 m inflation) of `scans` (`map_T_lidar`, cloud)
+/// along the walk through `positions`, split into floors as `split`.
+pub(crate) fn floor_maps(
+    scans: &[(slam_core::Pose3, slam_core::PointCloud)],
+    positions: &[Point3<f64>],
+    split: &gridmap::FloorLevels,
+) -> spot_adapter::nav::FloorMaps {
+    use spot_adapter::nav::{FloorMaps, NavigationMapConfig};
+    use spot_adapter::robot::SpotGeometry;
+    let geometry = SpotGeometry::default();
+    let keyframes: Vec<_> = scans.iter().map(|(p, c)| (*p, c)).collect();
+    let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
+    FloorMaps::build(
+        &keyframes,
+        positions,
+        split,
+        lidar_height,
+        &NavigationMapConfig::default(),
+        0.3,
+    )
+    .unwrap()
+}
+
 pub(crate) fn scans_along(
     b: &Building,
     lidar_poses: &[slam_core::Pose3],

@@ -5,16 +5,15 @@
 
 #![allow(clippy::unwrap_used, clippy::panic)]
 
-use crate::floors::{TourWalk, scans_along, tour_walk};
+use crate::floors::{TourWalk, floor_maps, scans_along, tour_walk};
 use nalgebra::{Point3, Vector2};
 use slam_core::Cell;
 use slam_core::{PointCloud, Pose3};
 use spot_adapter::nav::{
-    DriveOutcome, FloorCell, FloorGraph, FloorMaps, FloorPoint, NavigationMapConfig,
-    NavigatorConfig, StairsClimbConfig, drive_across_floors,
+    DriveOutcome, FloorCell, FloorGraph, FloorMaps, FloorPoint, NavigatorConfig, StairsClimbConfig,
+    drive_across_floors,
 };
 use spot_adapter::pipelines::point_to_plane_localiser;
-use spot_adapter::robot::SpotGeometry;
 use spot_adapter::sim::{Building, BuildingConfig, CommandedSpot, SimulationConfig};
 
 /// Building `seed` with `floors` floors, its maps per floor and each floor's localisation
@@ -26,22 +25,12 @@ fn mapped(seed: u64, floors: usize) -> (Building, FloorMaps, Vec<PointCloud>) {
         positions,
         split,
     } = tour_walk(seed, floors);
-    let geometry = SpotGeometry::default();
     let scans: Vec<(Pose3, PointCloud)> = scans_along(&b, &lidar_poses, seed, 1.0, None)
         .into_iter()
         .map(|(pose, cloud)| (pose, cloud.voxel_downsample(0.05).unwrap()))
         .collect();
+    let maps = floor_maps(&scans, &positions, &split);
     let keyframes: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
-    let lidar_height = geometry.body_height + geometry.body_t_lidar.translation.z;
-    let maps = FloorMaps::build(
-        &keyframes,
-        &positions,
-        &split,
-        lidar_height,
-        &NavigationMapConfig::default(),
-        0.3,
-    )
-    .unwrap();
     let clouds = maps.clouds(&keyframes, 0.05).unwrap();
     (b, maps, clouds)
 }
