@@ -67,6 +67,10 @@ struct Args {
     /// `--motion` is for one floor).
     #[arg(long, value_name = "N", default_value_t = 1)]
     floors: usize,
+    /// With `--floors`: every floor a copy of the ground floor's plan (by default each floor
+    /// above has rooms of its own round the same corridor and core).
+    #[arg(long, requires = "floors")]
+    repeat_floor_plan: bool,
     /// Write the recording to this folder.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -165,6 +169,7 @@ fn simulate(args: &Args) -> Result<()> {
     config.motion = args.motion.profile();
     config.motion_distortion = args.skewed;
     config.building.floors = args.floors;
+    config.building.repeat_floor_plan = args.repeat_floor_plan;
     let mut sim = SimulatedSpot::floors_tour(&config)?;
     let size = sim.building().size();
     let truth = sim.ground_truth();
@@ -180,15 +185,17 @@ fn simulate(args: &Args) -> Result<()> {
     )?;
     if sim.building().floors() > 1 {
         let stairs = sim.on_stairs().iter().filter(|&&on| on).count();
-        let flight = sim.building().staircases()[0];
+        let flights: Vec<String> = sim
+            .building()
+            .staircases()
+            .iter()
+            .map(flight_line)
+            .collect();
         out!(
-            "{} floors {:.2} m apart; flights of {} steps ({:.3} m rise, {:.2} m tread, {:.1} m run); {stairs} samples on the stairs",
+            "{} floors {:.2} m apart; flights of {}; {stairs} samples on the stairs",
             sim.building().floors(),
             sim.building().floor_height(1),
-            flight.steps,
-            flight.rise,
-            flight.tread,
-            flight.run(),
+            flights.join("; "),
         )?;
     }
     out!(
@@ -254,4 +261,18 @@ fn simulate(args: &Args) -> Result<()> {
         out!("scans written to {}", f.finish()?.display())?;
     }
     Ok(())
+}
+
+/// A flight's steps, rise, tread, run and landing, for the summary line.
+fn flight_line(f: &spot_adapter::sim::Staircase) -> String {
+    let landing = f.landing.map_or_else(String::new, |l| {
+        format!(", a {:.1} m landing after step {}", l.depth, l.after)
+    });
+    format!(
+        "{} steps ({:.3} m rise, {:.2} m tread, {:.1} m run{landing})",
+        f.steps,
+        f.rise,
+        f.tread,
+        f.run()
+    )
 }

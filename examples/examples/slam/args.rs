@@ -134,6 +134,11 @@ pub(crate) struct Args {
         conflicts_with = "recording"
     )]
     pub(crate) floors: usize,
+    /// With `--floors`: every floor a copy of the ground floor's plan (the same rooms and
+    /// furniture), the hard case for place recognition; by default each floor above has rooms
+    /// of its own round the same corridor and core.
+    #[arg(long, requires = "floors", conflicts_with = "recording")]
+    pub(crate) repeat_floor_plan: bool,
     /// Simulate a blank north corridor: plain walls and shut doors, where LiDAR odometry has
     /// little to hold on to along the corridor.
     #[arg(long, conflicts_with = "recording")]

@@ -90,6 +90,7 @@ fn slam(args: &Args) -> Result<()> {
         sim_config.motion_distortion = args.skewed;
         sim_config.building.blank_corridor = args.blank_corridor;
         sim_config.building.floors = args.floors;
+        sim_config.building.repeat_floor_plan = args.repeat_floor_plan;
         if let Some(range) = args.lidar_range {
             sim_config.lidar.max_range = range;
         }

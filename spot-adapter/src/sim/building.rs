@@ -88,6 +88,8 @@ pub struct Building {
     pub(crate) storey_height: f64,
     /// The flight from floor `k` to floor `k + 1` at index `k`.
     pub(crate) staircases: Vec<Staircase>,
+    /// The rooms of floor `k + 1` at index `k`.
+    pub(crate) upper_rooms: Vec<Vec<Room>>,
     /// Boxes of the generated structure; those after it were added, with the ids in `added`.
     generated: usize,
     added: Vec<BoxId>,
@@ -117,6 +119,7 @@ impl Building {
             floors: 1,
             storey_height: ceiling_height,
             staircases: Vec::new(),
+            upper_rooms: Vec::new(),
             added: Vec::new(),
             next_id: 0,
         }
@@ -212,10 +215,24 @@ impl Building {
         &self.boxes
     }
 
-    /// The rooms, each with its door onto the corridor.
+    /// The ground floor's rooms, each with its door onto the corridor.
     #[must_use]
     pub fn rooms(&self) -> &[Room] {
         &self.rooms
+    }
+
+    /// Floor `floor`'s rooms (its own round the corridor ring, the core's inside it); none for
+    /// a floor the building does not have.
+    #[must_use]
+    pub fn rooms_on(&self, floor: usize) -> &[Room] {
+        match floor {
+            0 => &self.rooms,
+            k if k < self.floors => self
+                .upper_rooms
+                .get(k - 1)
+                .map_or(&self.rooms, Vec::as_slice),
+            _ => &[],
+        }
     }
 
     /// Outer size (x, y) in metres; the building spans `[0, size.x] x [0, size.y]`.

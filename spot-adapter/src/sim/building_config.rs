@@ -48,11 +48,17 @@ pub struct BuildingConfig {
     /// plane-like normals does not (1.1 cm). The rooms behind the shut doors are left out of
     /// [`Building::rooms`](crate::sim::Building::rooms). Default false.
     pub blank_corridor: bool,
-    /// Floors, 1 (the default) to 3. Above one, the ground floor's layout is stacked (every
-    /// floor has the same rooms and corridor, so one floor plan serves them all) with a slab
-    /// between the floors, and a straight staircase joins each floor to the next through a
-    /// stairwell in the slab above it (see [`Staircase`](crate::sim::Staircase)).
+    /// Floors, 1 (the default) to 3. Above one, the floors stand on slabs, each floor with the
+    /// ground floor's corridor ring and core (the rooms inside the ring, where the staircases
+    /// stand) but rooms of its own round the ring and its own furniture; a straight staircase
+    /// (with a landing midway on a tall storey, where its room is deep enough) joins each floor
+    /// to the next through a stairwell in the slab above it (see
+    /// [`Staircase`](crate::sim::Staircase)). The ground floor is the one-floor building of
+    /// the same seed.
     pub floors: usize,
+    /// Every floor a copy of the ground floor's plan (the same rooms and furniture), the hard
+    /// case for mapping: floors told apart only by height and the stairs. Default false.
+    pub repeat_floor_plan: bool,
 }
 
 impl Default for BuildingConfig {
@@ -72,6 +78,7 @@ impl Default for BuildingConfig {
             repeated_rooms: false,
             blank_corridor: false,
             floors: 1,
+            repeat_floor_plan: false,
         }
     }
 }

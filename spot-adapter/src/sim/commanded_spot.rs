@@ -15,6 +15,7 @@ use crate::sim::odometry::OdometryModel;
 use crate::sim::rng::SimRng;
 use crate::sim::simulated_spot::SimulationConfig;
 use crate::sim::solid_box::{BoxId, BoxKind, SolidBox};
+use crate::sim::stairs_gait::stairs_ground;
 
 /// A box that walks to and fro along a segment (a person crossing a corridor), moved each
 /// LiDAR turn.
@@ -303,20 +304,18 @@ impl CommandedSpot {
                     return None;
                 }
                 // The ground follows a line through the step tops, from half a tread before
-                // the foot to half a tread past the top (as the floors tour's walk does).
-                let (s0, s1) = (-0.5 * f.tread, f.run() + 0.5 * f.tread);
-                let t = ((u - s0) / (s1 - s0)).clamp(0.0, 1.0);
-                let ground = f.base_z + f.climb() * t;
-                let slope = if (0.0..1.0).contains(&t) && t > 0.0 {
-                    f.climb() / (s1 - s0)
-                } else {
-                    0.0
-                };
+                // the foot to half a tread past the top (as the floors tour's walk does),
+                // With the jolts and the nod of a body taking the steps.
+                let (ground, nod) = stairs_ground(f, u);
                 let along = Vector2::new(heading.cos(), heading.sin()).dot(&f.up);
                 return Some(Footing {
-                    floor: if t >= 1.0 { upper } else { on_floor },
+                    floor: if u >= f.run() + 0.5 * f.tread {
+                        upper
+                    } else {
+                        on_floor
+                    },
                     ground,
-                    pitch: (slope * along).atan(),
+                    pitch: (f.walk_slope(u) * along).atan() + nod * along,
                 });
             }
         }

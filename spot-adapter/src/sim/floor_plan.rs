@@ -6,6 +6,7 @@ use slam_core::{BitGrid, GridGeometry};
 
 use crate::sim::SimError;
 use crate::sim::building::Building;
+use crate::sim::staircase::Staircase;
 
 /// Boxes whose bottom lies at or below this height (metres) block a walking robot; lintels above
 /// doors (2.1 m) do not. Spot is 0.84 m tall with its LiDAR, so anything lower than this
@@ -98,6 +99,18 @@ impl Building {
     /// [`SimError::Grid`] for a resolution that is not finite and positive or a grid too
     /// large.
     pub fn occupancy_grid(&self, resolution: f64) -> Result<BitGrid, SimError> {
+        self.occupancy_grid_on(0, resolution)
+    }
+
+    /// [`Building::occupancy_grid`] of floor `floor`: the obstacles [`Building::clearance_on`]
+    /// counts there (its walls and furniture, a flight rising from it, the stairwell of a
+    /// flight arriving at it). A floor the building does not have reads as its slab would:
+    /// free but for the outline.
+    ///
+    /// # Errors
+    /// As [`Building::occupancy_grid`].
+    pub fn occupancy_grid_on(&self, floor: usize, resolution: f64) -> Result<BitGrid, SimError> {
+        let z = self.floor_height(floor);
         let geometry = GridGeometry::try_new(Vector2::zeros(), resolution)?;
         let width = (self.size.x / resolution).ceil().max(1.0);
         let height = (self.size.y / resolution).ceil().max(1.0);
@@ -116,9 +129,19 @@ impl Building {
             let b = ((hi / resolution).ceil() as i64 - 1).clamp(0, i64::from(n) - 1) as u32;
             (a.min(n - 1), b)
         };
-        for b in self.boxes.iter().filter(|b| b.min.z < OBSTACLE_HEIGHT) {
-            let (x0, x1) = cells(b.min.x, b.max.x, w);
-            let (y0, y1) = cells(b.min.y, b.max.y, h);
+        let boxes = self
+            .boxes
+            .iter()
+            .filter(|b| b.min.z < z + OBSTACLE_HEIGHT && b.max.z > z + 0.01)
+            .map(|b| (b.min.xy().coords, b.max.xy().coords));
+        let wells = self
+            .staircases
+            .iter()
+            .filter(|f| (f.base_z + f.climb() - z).abs() < 0.5 * OBSTACLE_HEIGHT)
+            .map(Staircase::stairwell);
+        for (min, max) in boxes.chain(wells) {
+            let (x0, x1) = cells(min.x, max.x, w);
+            let (y0, y1) = cells(min.y, max.y, h);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     grid.set(slam_core::Cell::new(x, y), true)?;

@@ -1,10 +1,8 @@
-//! A building of several floors: the generated floor stacked, a slab between the floors with a
-//! stairwell, and a straight staircase from each floor to the next in a core room.
-//!
-//! Every floor has the same layout. That keeps one floor plan true on every floor (the
-//! obstacle queries, the occupancy grid and the routes of the ground floor serve the floors
-//! above), and it is the hard case for mapping: floors that look alike, told apart only by
-//! height and the stairs.
+//! A building of several floors: the floors stacked (the generated ground floor, and above it
+//! either floors of their own round the same corridor ring and core, or copies of the ground
+//! floor), a slab between the floors with a stairwell, and a straight staircase (with a landing
+//! midway where the storey is tall and the room deep) from each floor to the next in a core
+//! room.
 
 use nalgebra::{Point3, Vector2};
 
@@ -25,11 +23,18 @@ const FREE_LANE: f64 = 1.0;
 
 impl Building {
     /// This single-floor building stacked into `floors` floors (itself when `floors` is 1),
-    /// with the furniture and pillars taken out of the rooms the staircases stand in.
+    /// with the furniture and pillars taken out of the rooms the staircases stand in. Floor
+    /// `k` above the ground has the boxes and rooms `upper[k - 1]` (at ground level, lifted
+    /// here); with `upper` empty every floor is a copy of the ground floor.
     ///
     /// # Errors
     /// [`SimError::NoRoomForStairs`] when fewer core rooms than staircases can hold one.
-    pub(crate) fn stack_floors(self, floors: usize, wall_thickness: f64) -> Result<Self, SimError> {
+    pub(crate) fn stack_floors(
+        self,
+        floors: usize,
+        wall_thickness: f64,
+        upper: &[(Vec<SolidBox>, Vec<Room>)],
+    ) -> Result<Self, SimError> {
         if floors <= 1 {
             return Ok(self);
         }
@@ -70,21 +75,22 @@ impl Building {
                     b.min.x >= lo.x && b.max.x <= hi.x && b.min.y >= lo.y && b.max.y <= hi.y
                 })
         };
-        let ground: Vec<SolidBox> = self
-            .boxes
-            .iter()
-            .filter(|b| !in_stair_room(b))
-            .copied()
+        let plans: Vec<(&[SolidBox], &[Room])> = (0..floors)
+            .map(|k| match upper.get(k.wrapping_sub(1)) {
+                Some((boxes, rooms)) if k > 0 => (boxes.as_slice(), rooms.as_slice()),
+                _ => (self.boxes.as_slice(), self.rooms.as_slice()),
+            })
             .collect();
-        let mut boxes = Vec::with_capacity(ground.len() * floors + 64);
-        for k in 0..floors {
+        let mut boxes = Vec::with_capacity(self.boxes.len() * floors + 64);
+        for (k, (plan, _)) in plans.iter().enumerate() {
             let dz = k as f64 * storey;
-            boxes.extend(ground.iter().map(|b| SolidBox {
+            boxes.extend(plan.iter().filter(|b| !in_stair_room(b)).map(|b| SolidBox {
                 min: b.min + nalgebra::Vector3::z() * dz,
                 max: b.max + nalgebra::Vector3::z() * dz,
                 kind: b.kind,
             }));
         }
+        let upper_rooms = plans[1..].iter().map(|(_, r)| r.to_vec()).collect();
         for (k, flight) in staircases.iter().enumerate() {
             boxes.extend(flight.step_boxes());
             let top = (k + 1) as f64 * storey;
@@ -104,6 +110,7 @@ impl Building {
             self.corridor_width,
         );
         building.floors = floors;
+        building.upper_rooms = upper_rooms;
         building.storey_height = storey;
         building.staircases = staircases;
         Ok(building)
@@ -118,15 +125,22 @@ impl Building {
 
 /// The flight in `room` from `base_z`, or `None` when the room is too shallow or too narrow.
 /// It stands against the side wall farther from the door, its foot [`STAIR_APPROACH`] in from
-/// the door's wall, climbing away from the door.
+/// the door's wall, climbing away from the door. A tall storey's flight has a landing midway
+/// when the room is deep enough for it, and is one run otherwise.
 fn place_flight(room: &Room, base_z: f64, storey: f64, wall: f64) -> Option<Staircase> {
     let inward = room.inward;
     let across = Vector2::new(inward.y.abs(), inward.x.abs());
     let extent = room.max - room.min;
+    let fits =
+        |f: &Staircase| extent.dot(&inward.abs()) >= STAIR_APPROACH + f.run() + STAIR_LANDING;
     let probe = Staircase::new(*room, Vector2::zeros(), inward, base_z, storey);
-    let deep = extent.dot(&inward.abs()) >= STAIR_APPROACH + probe.run() + STAIR_LANDING;
+    let probe = if fits(&probe) {
+        probe
+    } else {
+        probe.without_landing()
+    };
     let wide = extent.dot(&across) >= wall + STAIR_WIDTH + STAIRWELL_MARGIN + FREE_LANE;
-    if !(deep && wide) {
+    if !(fits(&probe) && wide) {
         return None;
     }
     let (lo, hi) = (room.min.dot(&across), room.max.dot(&across));
@@ -137,7 +151,7 @@ fn place_flight(room: &Room, base_z: f64, storey: f64, wall: f64) -> Option<Stai
         hi - 0.5 * wall - 0.5 * STAIR_WIDTH
     };
     let foot = across * centre + inward * (room.door.dot(&inward) + STAIR_APPROACH);
-    Some(Staircase::new(*room, foot, inward, base_z, storey))
+    Some(Staircase { foot, ..probe })
 }
 
 /// The slab from `z0` to `z1` over the building's `size`, around the `hole` (min, max): four

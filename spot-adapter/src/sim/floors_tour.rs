@@ -11,6 +11,7 @@ use crate::sim::building::Building;
 use crate::sim::route::Route;
 use crate::sim::setting_checks::require_positive;
 use crate::sim::staircase::Staircase;
+use crate::sim::stairs_gait::stairs_ground;
 
 /// Speed along the slope of a flight (m/s): Spot's stairs mode climbs at about 0.3-0.5 m/s.
 pub const STAIRS_SPEED: f64 = 0.4;
@@ -22,22 +23,41 @@ const TOP_LANDING: f64 = 0.45;
 /// Spot's body, so it tilts as its front legs reach the flight, not at one instant.
 const PITCH_HALF_BASE: f64 = 0.3;
 
-/// A change of height along the tour: the body's ground rises (or falls) linearly from `z0` at
-/// arc length `s0` to `z1` at `s1`.
+/// A change of height along the tour: the body's ground follows `flight`'s
+/// [`Staircase::walk_height`] from arc length `s0` to `s1`, up it or down.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Ramp {
     s0: f64,
     s1: f64,
-    z0: f64,
-    z1: f64,
+    flight: Staircase,
+    up: bool,
+}
+
+impl Ramp {
+    /// How far past the flight's foot along it arc length `s` is (clamped to the ramp's ends).
+    fn along(&self, s: f64) -> f64 {
+        let f = &self.flight;
+        let d = (s - self.s0).clamp(0.0, self.s1 - self.s0);
+        let half = 0.5 * f.tread;
+        if self.up {
+            -half + d
+        } else {
+            f.run() + half - d
+        }
+    }
+
+    /// The ground's height at arc length `s` (clamped to the ramp's ends).
+    fn height(&self, s: f64) -> f64 {
+        self.flight.walk_height(self.along(s))
+    }
 }
 
 /// The tour through every floor of a building, as a plan-view [`Route`] and the height of the
-/// ground under it.
+/// ground under it; walked, the body takes the flights' steps with their jolts and nods
+/// ([`STAIRS_JOLT`](crate::sim::STAIRS_JOLT), [`STAIRS_NOD`](crate::sim::STAIRS_NOD)).
 ///
-/// The ground height follows a straight line through the flight's step tops, half a tread
-/// before the foot to half a tread past the top: never more than half a rise from the true
-/// step under the body.
+/// The ground height follows each flight's [`Staircase::walk_height`], a line through its step
+/// tops (level on a landing): never more than half a rise from the true step under the body.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FloorsTour {
     route: Route,
@@ -119,11 +139,24 @@ impl FloorsTour {
                 return z;
             }
             if s <= r.s1 {
-                return r.z0 + (r.z1 - r.z0) * (s - r.s0) / (r.s1 - r.s0);
+                return r.height(s);
             }
-            z = r.z1;
+            z = r.height(r.s1);
         }
         z
+    }
+
+    /// The body's jolt at arc length `s`: the height (metres) and the nod (radians, nose up)
+    /// a body taking the steps adds to the ground's smooth line; zero off the flights.
+    fn jolt(&self, s: f64) -> (f64, f64) {
+        self.ramps
+            .iter()
+            .find(|r| (r.s0..=r.s1).contains(&s))
+            .map_or((0.0, 0.0), |r| {
+                let u = r.along(s);
+                let (height, nod) = stairs_ground(&r.flight, u);
+                (height - r.flight.walk_height(u), nod)
+            })
     }
 
     /// Whether arc length `s` is on a flight.
@@ -163,12 +196,13 @@ impl FloorsTour {
             last_yaw = Some(yaw);
             let p = self.route.point_at(s);
             // Nose up on the way up: a negative turn about the body's y axis.
+            let (jolt, nod) = self.jolt(s);
             let rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw)
-                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -slope.atan());
+                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -(slope.atan() + nod));
             poses.push(StampedPose {
                 stamp: f64::from(k) / rate,
                 pose: Pose3::from_parts(
-                    Translation3::new(p.x, p.y, self.ground_height(s) + body_height),
+                    Translation3::new(p.x, p.y, self.ground_height(s) + jolt + body_height),
                     rotation,
                 ),
             });
@@ -240,21 +274,16 @@ fn push_flight(
     let half = 0.5 * flight.tread;
     let to_foot = (flight.foot - from).norm();
     let to_top = (flight.top() - from).norm();
-    let (lower, upper) = (flight.base_z, flight.base_z + flight.climb());
-    let ramp = if up {
-        Ramp {
-            s0: to_foot - half,
-            s1: to_top + half,
-            z0: lower,
-            z1: upper,
-        }
+    let (s0, s1) = if up {
+        (to_foot - half, to_top + half)
     } else {
-        Ramp {
-            s0: to_top - half,
-            s1: to_foot + half,
-            z0: upper,
-            z1: lower,
-        }
+        (to_top - half, to_foot + half)
+    };
+    let ramp = Ramp {
+        s0,
+        s1,
+        flight: *flight,
+        up,
     };
     ramps.push((k, ramp));
 }

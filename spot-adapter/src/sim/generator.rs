@@ -150,73 +150,70 @@ impl Building {
         let ly = draw(&mut rng, config.loop_length_y);
         let ceiling = draw(&mut rng, config.ceiling_height);
         let (w, h) = (lx + cw + 2.0 * band, ly + cw + 2.0 * band);
-        let t = config.wall_thickness;
         let mut d = Draft {
             cfg: config,
             boxes: Vec::new(),
             ceiling,
         };
-        let mut rooms = Vec::new();
-        let door_w = |rng: &mut SimRng| draw(rng, config.door_width);
-
-        // Outer walls.
-        d.wall(true, 0.0, 0.0, w, &[]);
-        d.wall(true, h, 0.0, w, &[]);
-        d.wall(false, 0.0, 0.0, h, &[]);
-        d.wall(false, w, 0.0, h, &[]);
-
         // The corridor's outer walls with the doors of the outer-band rooms.
         let (cx0, cx1, cy0, cy1) = (band, w - band, band, h - band);
         let core = [cx0 + cw, cx1 - cw, cy0 + cw, cy1 - cw];
         let repeat = config
             .repeated_rooms
             .then(|| Repetition::draw(&mut rng, config, core[0], core[1]));
-        // Furnished rooms copied into others: (template room, copy room, x shift).
-        let mut copies: Vec<(usize, usize, f64)> = Vec::new();
-        for south in [true, false] {
-            let plan = Band {
-                south,
-                size: (w, h),
-                corridor: (cx0, cx1, cy0, cy1),
-                repeat: repeat.filter(|_| south),
-            };
-            plan.build(&mut d, &mut rng, &mut rooms, &mut copies);
-        }
-        for west in [true, false] {
-            let mut ys = vec![cy0];
-            ys.extend(cuts(&mut rng, cy0, cy1, config.room_width));
-            ys.push(cy1);
-            let (x_wall, x_out) = if west { (cx0, 0.0) } else { (cx1, w) };
-            let mut doors = Vec::new();
-            for pair in ys.windows(2) {
-                let (a, b) = (pair[0], pair[1]);
-                let width = door_w(&mut rng);
-                let c = door_on(&mut rng, t, a, b, width);
-                doors.push((c, width));
-                rooms.push(Room {
-                    min: Vector2::new(x_out.min(x_wall), a),
-                    max: Vector2::new(x_out.max(x_wall), b),
-                    door: Vector2::new(x_wall, c),
-                    inward: Vector2::new(if west { -1.0 } else { 1.0 }, 0.0),
-                });
-                if b < cy1 {
-                    d.wall(true, b, x_out.min(x_wall), x_out.max(x_wall), &[]);
-                }
-            }
-            d.wall(false, x_wall, cy0, cy1, &doors);
-        }
+        let ring = Ring {
+            size: (w, h),
+            corridor: (cx0, cx1, cy0, cy1),
+            repeat,
+        };
+        let (mut rooms, mut copies) = ring.outer_rooms(&mut d, &mut rng);
 
         // The core inside the loop: two rows of rooms, doors onto the corridor's inner walls.
+        // The same on every floor (the staircases stand in it).
+        let (core_boxes, core_rooms_at) = (d.boxes.len(), rooms.len());
         let (south_doors, north_doors) =
             core_rooms(&mut d, &mut rng, core, &mut rooms, repeat, &mut copies);
         pilasters(&mut d, &mut rng, core, &south_doors, &north_doors, repeat);
+        let core_part = CorePart {
+            boxes: d.boxes[core_boxes..].to_vec(),
+            rooms: rooms[core_rooms_at..].to_vec(),
+            copies: copies
+                .iter()
+                .filter(|c| c.0 >= core_rooms_at)
+                .map(|&(t, c, dx)| (t - core_rooms_at, c - core_rooms_at, dx))
+                .collect(),
+        };
 
         furnish_rooms(&mut d, &mut rng, &rooms, &copies);
-        if config.blank_corridor {
-            // The rooms behind the shut doors: those whose door is on the north corridor's
-            // walls (the west and east rooms' doors face along x).
-            rooms.retain(|r| r.inward.x != 0.0 || r.door.y < core[3] - 1e-9);
-        }
+        let open_rooms = |mut rooms: Vec<Room>| {
+            if config.blank_corridor {
+                // The rooms behind the shut doors: those whose door is on the north corridor's
+                // walls (the west and east rooms' doors face along x).
+                rooms.retain(|r| r.inward.x != 0.0 || r.door.y < core[3] - 1e-9);
+            }
+            rooms
+        };
+        let rooms = open_rooms(rooms);
+        // Each floor above its own rooms round the corridor and its own furniture, drawn from
+        // a stream of its own (the ground floor stays the one-floor building of the seed).
+        let upper: Vec<(Vec<SolidBox>, Vec<Room>)> = if config.repeat_floor_plan {
+            Vec::new()
+        } else {
+            (1..config.floors)
+                .map(|k| {
+                    let mut rng = SimRng::new(seed, 0xb111_d146 ^ (k as u64) << 32);
+                    let mut f = Draft {
+                        cfg: config,
+                        boxes: Vec::new(),
+                        ceiling,
+                    };
+                    let (mut rooms, mut copies) = ring.outer_rooms(&mut f, &mut rng);
+                    core_part.add_to(&mut f, &mut rooms, &mut copies);
+                    furnish_rooms(&mut f, &mut rng, &rooms, &copies);
+                    (f.boxes, open_rooms(rooms))
+                })
+                .collect()
+        };
 
         let building = Self::from_generated(
             d.boxes,
@@ -231,7 +228,97 @@ impl Building {
             ],
             cw,
         );
-        building.stack_floors(config.floors, config.wall_thickness)
+        building.stack_floors(config.floors, config.wall_thickness, &upper)
+    }
+}
+
+/// The corridor ring of a floor: the building's outline, the corridor's outer walls and the
+/// repeated stretch, which every floor shares.
+struct Ring {
+    /// Building width and depth.
+    size: (f64, f64),
+    /// The corridor loop's outer walls: x0, x1, y0, y1.
+    corridor: (f64, f64, f64, f64),
+    repeat: Option<Repetition>,
+}
+
+impl Ring {
+    /// The outer walls and the rooms between them and the corridor (the south and north
+    /// bands, the west and east sides), their walls and doors drawn from `rng`: the rooms and
+    /// the furnished rooms to copy (template, copy, x shift).
+    #[allow(clippy::type_complexity)]
+    fn outer_rooms(
+        &self,
+        d: &mut Draft<'_>,
+        rng: &mut SimRng,
+    ) -> (Vec<Room>, Vec<(usize, usize, f64)>) {
+        let config = d.cfg;
+        let (w, h) = self.size;
+        let (cx0, cx1, cy0, cy1) = self.corridor;
+        let t = config.wall_thickness;
+        d.wall(true, 0.0, 0.0, w, &[]);
+        d.wall(true, h, 0.0, w, &[]);
+        d.wall(false, 0.0, 0.0, h, &[]);
+        d.wall(false, w, 0.0, h, &[]);
+        let mut rooms = Vec::new();
+        let mut copies: Vec<(usize, usize, f64)> = Vec::new();
+        for south in [true, false] {
+            let plan = Band {
+                south,
+                size: self.size,
+                corridor: self.corridor,
+                repeat: self.repeat.filter(|_| south),
+            };
+            plan.build(d, rng, &mut rooms, &mut copies);
+        }
+        for west in [true, false] {
+            let mut ys = vec![cy0];
+            ys.extend(cuts(rng, cy0, cy1, config.room_width));
+            ys.push(cy1);
+            let (x_wall, x_out) = if west { (cx0, 0.0) } else { (cx1, w) };
+            let mut doors = Vec::new();
+            for pair in ys.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let width = rng.range(config.door_width.0, config.door_width.1);
+                let c = door_on(rng, t, a, b, width);
+                doors.push((c, width));
+                rooms.push(Room {
+                    min: Vector2::new(x_out.min(x_wall), a),
+                    max: Vector2::new(x_out.max(x_wall), b),
+                    door: Vector2::new(x_wall, c),
+                    inward: Vector2::new(if west { -1.0 } else { 1.0 }, 0.0),
+                });
+                if b < cy1 {
+                    d.wall(true, b, x_out.min(x_wall), x_out.max(x_wall), &[]);
+                }
+            }
+            d.wall(false, x_wall, cy0, cy1, &doors);
+        }
+        (rooms, copies)
+    }
+}
+
+/// The core of the ground floor (its walls, pilasters and rooms, unfurnished), which every
+/// floor repeats.
+struct CorePart {
+    boxes: Vec<SolidBox>,
+    rooms: Vec<Room>,
+    /// Furnished rooms to copy, as indices into `rooms`.
+    copies: Vec<(usize, usize, f64)>,
+}
+
+impl CorePart {
+    /// The core added to a floor's draft, rooms and copies.
+    fn add_to(
+        &self,
+        d: &mut Draft<'_>,
+        rooms: &mut Vec<Room>,
+        copies: &mut Vec<(usize, usize, f64)>,
+    ) {
+        let at = rooms.len();
+        d.boxes.extend(self.boxes.iter().copied());
+        rooms.extend(self.rooms.iter().copied());
+        copies.extend(self.copies.iter().map(|&(t, c, dx)| (t + at, c + at, dx)));
     }
 }
 

@@ -41,6 +41,7 @@ mod simulated_spot;
 mod solid_box;
 mod speed_profile;
 mod staircase;
+mod stairs_gait;
 mod timed_walk;
 
 pub use building::{Building, Room};
@@ -65,4 +66,5 @@ pub use route::Route;
 pub use route_planning::{RouteConfig, shortest_length};
 pub use simulated_spot::{STAIRS_SLIP, SimulatedSpot, SimulationConfig};
 pub use solid_box::{BoxId, BoxKind, SolidBox};
-pub use staircase::Staircase;
+pub use staircase::{Landing, MAX_RISES_WITHOUT_LANDING, Staircase};
+pub use stairs_gait::{STAIRS_JOLT, STAIRS_NOD};

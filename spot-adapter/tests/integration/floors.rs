@@ -64,26 +64,142 @@ fn floors_outside_one_to_three_are_refused_by_name() {
     }
 }
 
+/// Seed 5's flight has a landing midway (a storey of 17 rises), seed 11's is one run (16).
+/// Each floor above the ground has rooms of its own round the same corridor ring and core
+/// (where the staircases stand), and its grid (`occupancy_grid_on`) agrees with rays cast down
+/// onto it (the oracle: a point whose ray stops above the floor or falls through it is in a
+/// blocked cell; a cell whose 3 x 3 rays 0.1 m apart all land on the floor is free). With
+/// `repeat_floor_plan` every floor has the ground floor's rooms.
+#[test]
+fn each_floor_has_rooms_of_its_own_round_the_same_core() {
+    use spot_adapter::sim::SimRng;
+    for (seed, floors) in [(5, 2), (11, 3)] {
+        let config = BuildingConfig {
+            floors,
+            ..BuildingConfig::default()
+        };
+        let b = Building::generate(seed, &config).unwrap();
+        let ring = b.corridor_loop();
+        let in_core = |r: &spot_adapter::sim::Room| {
+            r.min.x > ring[0].x && r.max.x < ring[2].x && r.min.y > ring[0].y && r.max.y < ring[2].y
+        };
+        let ground = b.grid_on(0);
+        for k in 1..floors {
+            let (here, below) = (b.rooms_on(k), b.rooms_on(0));
+            let core = |rooms: &[spot_adapter::sim::Room]| -> Vec<_> {
+                rooms.iter().filter(|r| in_core(r)).copied().collect()
+            };
+            assert_eq!(core(here), core(below), "seed {seed} floor {k}");
+            let outer: Vec<_> = here.iter().filter(|r| !in_core(r)).collect();
+            assert!(
+                outer.iter().any(|r| !below.contains(r)),
+                "seed {seed} floor {k}: the same rooms as the ground floor"
+            );
+            for f in b.staircases() {
+                assert!(here.contains(&f.room), "seed {seed} floor {k}");
+            }
+            for r in here {
+                assert!(b.clearance_on(k, r.entry_point(), None) > 0.4, "{r:?}");
+            }
+            let grid = b.grid_on(k);
+            let differ = (0..grid.height())
+                .flat_map(|y| (0..grid.width()).map(move |x| slam_core::Cell::new(x, y)))
+                .filter(|&c| grid.is_blocked(c) != ground.is_blocked(c))
+                .count();
+            let share = differ as f64 / f64::from(grid.width() * grid.height());
+            assert!(share > 0.02, "seed {seed} floor {k}: {share}");
+        }
+        assert!(b.rooms_on(floors).is_empty());
+        // The grid of each floor against rays down onto it.
+        let mut rng = SimRng::new(seed, 7);
+        for k in 0..floors {
+            let z = b.floor_height(k);
+            let grid = b.occupancy_grid_on(k, 0.1).unwrap();
+            let lands = |p: Vector2<f64>| {
+                let origin = Point3::new(p.x, p.y, z + 0.99);
+                let hit = b.cast_ray(&origin, &-Vector3::z(), 10.0).unwrap();
+                origin.z - hit.range
+            };
+            let (mut blocked, mut free) = (0, 0);
+            for _ in 0..20_000 {
+                let p = Vector2::new(
+                    rng.range(0.3, b.size().x - 0.3),
+                    rng.range(0.3, b.size().y - 0.3),
+                );
+                let cell = grid.cell_at(p).unwrap();
+                if (lands(p) - z).abs() > 0.01 {
+                    assert!(grid.is_blocked(cell), "seed {seed} floor {k}: {p:?}");
+                    blocked += 1;
+                } else if (-1..=1).all(|i| {
+                    (-1..=1).all(|j| {
+                        let q = p + Vector2::new(f64::from(i), f64::from(j)) * 0.1;
+                        (lands(q) - z).abs() <= 0.01
+                    })
+                }) {
+                    assert!(!grid.is_blocked(cell), "seed {seed} floor {k}: {p:?}");
+                    free += 1;
+                }
+            }
+            assert!(blocked > 1000 && free > 5000, "{blocked} {free}");
+        }
+        // Every floor a copy of the ground floor's rooms, when asked.
+        let repeated = Building::generate(
+            seed,
+            &BuildingConfig {
+                repeat_floor_plan: true,
+                ..config
+            },
+        )
+        .unwrap();
+        for k in 1..floors {
+            assert_eq!(repeated.rooms_on(k), repeated.rooms_on(0));
+        }
+        assert_eq!(repeated.rooms_on(0), b.rooms_on(0));
+    }
+}
+
 #[test]
 fn rays_see_each_step_the_slab_and_through_the_stairwell() {
-    let b = two_floors(5);
+    for (seed, landing) in [(5, true), (11, false)] {
+        rays_see_the_flight_of(seed, landing);
+    }
+}
+
+fn rays_see_the_flight_of(seed: u64, landing: bool) {
+    use spot_adapter::sim::MAX_RISES_WITHOUT_LANDING;
+    let b = two_floors(seed);
     let storey = b.floor_height(1);
     assert!((storey - b.ceiling_height() - SLAB_THICKNESS).abs() < 1e-12);
     let flight = b.staircases()[0];
-    // The oracle: step k's top at k rises, the rises dividing the storey evenly.
-    let rise = storey / (flight.steps + 1) as f64;
+    // The oracle: step k's top at k rises, the rises dividing the storey evenly; treads 0.28 m
+    // deep, but for a landing halfway up a storey of more than 16 rises (1.2 m deep).
+    let rises = flight.steps + 1;
+    let rise = storey / rises as f64;
     assert!((0.15..=0.21).contains(&rise), "rise {rise}");
+    assert_eq!(flight.landing.is_some(), landing, "seed {seed}");
+    assert_eq!(landing, rises > MAX_RISES_WITHOUT_LANDING, "seed {seed}");
+    let landing_step = landing.then_some(rises / 2);
+    let depth = |k: usize| if Some(k) == landing_step { 1.2 } else { 0.28 };
     let down = -Vector3::z();
+    let mut front = 0.0;
     for k in 1..=flight.steps {
-        let p = flight.foot + flight.up * ((k as f64 - 0.5) * flight.tread);
-        let origin = Point3::new(p.x, p.y, k as f64 * rise + 0.3);
-        let hit = b.cast_ray(&origin, &down, 10.0).unwrap();
-        assert_eq!(kind(&b, hit.target), Some(BoxKind::Step), "step {k}");
-        assert!(
-            (origin.z - hit.range - k as f64 * rise).abs() < 1e-9,
-            "step {k}"
-        );
+        let p = flight.foot + flight.up * (front + 0.5 * depth(k));
+        for at in [p, flight.foot + flight.up * (front + 0.05)] {
+            let origin = Point3::new(at.x, at.y, k as f64 * rise + 0.3);
+            let hit = b.cast_ray(&origin, &down, 10.0).unwrap();
+            assert_eq!(
+                kind(&b, hit.target),
+                Some(BoxKind::Step),
+                "seed {seed} step {k}"
+            );
+            assert!(
+                (origin.z - hit.range - k as f64 * rise).abs() < 1e-9,
+                "seed {seed} step {k}"
+            );
+        }
+        front += depth(k);
     }
+    assert!((flight.run() - front).abs() < 1e-9, "seed {seed}");
     // Up from the middle of the flight: through the stairwell to the upper floor's ceiling.
     let mid = flight.foot + flight.up * (0.5 * flight.run());
     let origin = Point3::new(mid.x, mid.y, 0.5 * storey + 0.5);
@@ -130,10 +246,16 @@ fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
             );
             top = top.max(t.z - body);
             if stairs[k] && stairs.get(k + 1) == Some(&true) {
-                // Along the slope at the stairs speed, pitched with it.
+                // Along the slope at the stairs speed: in plan view between its cosine on the
+                // steepest part (a rise over a tread) and all of it on a landing; the height
+                // takes the steps' jolts, so the plan view is what is steady.
                 let next = poses[k + 1].pose.translation.vector;
-                let speed = (next - t).norm() * 5.0;
-                assert!((speed - STAIRS_SPEED).abs() < 0.1, "speed {speed}");
+                let speed = (next - t).xy().norm() * 5.0;
+                let steepest = STAIRS_SPEED * rise.atan2(0.28).cos();
+                assert!(
+                    speed > steepest - 0.02 && speed < STAIRS_SPEED + 0.02,
+                    "plan-view speed {speed}"
+                );
             }
         }
         assert!((top - b.floor_height(floors - 1)).abs() < 1e-9, "top {top}");
@@ -143,14 +265,15 @@ fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
         let climbs = stairs.windows(2).filter(|w| !w[0] && w[1]).count();
         assert_eq!(climbs, 2 * (floors - 1));
         assert!(tour.route().length() > 100.0 * floors as f64);
-        // Mid-flight the body pitches with the flight, nose up (a negative pitch) going up.
+        // A quarter of the way up (on the steps below any landing) the body pitches with the
+        // flight, nose up (a negative pitch) going up, nodding by 1.5 degrees at most.
         let flight = b.staircases()[0];
         let slope = (flight.rise / flight.tread).atan();
         let mid = poses
             .iter()
             .zip(&stairs)
             .find(|(p, on)| {
-                **on && (p.pose.translation.z - body - 0.5 * flight.climb()).abs() < 0.3
+                **on && (p.pose.translation.z - body - 0.25 * flight.climb()).abs() < 0.1
             })
             .unwrap()
             .0;
@@ -160,26 +283,41 @@ fn the_tour_climbs_every_floor_on_the_steps_and_comes_back_down() {
 }
 
 /// Graph-SLAM (point-to-plane, the robot's odometry, Scan Context as the `slam` example runs
-/// it) over seed 2's tour of two floors, against the truth: ATE and end height within 5 cm, and
+/// it) over seed 10's tour of two floors (370 m; a flight with a landing, taken with the steps'
+/// jolts; each floor with its own rooms round the same core), against the truth, at the issue's
+/// bar: relative drift at most 0.3 %, end error 3 cm, ATE and end height within 5 cm, and
 /// every pose on the upper floor within 5 cm of its true height (the estimate moved so that its
-/// first pose is the truth's; 4.4 cm at most). Checked to fail without the odometry edges'
-/// tilt information (`GraphSlamConfig::gravity_tilt_sigma` at 1000 rad: more than 5 cm low at
-/// the upper floor's far end, the optimiser having tilted the floor). About 25 s in release:
-/// `cargo test --release -p spot-nav-adapter --test integration -- --ignored two_floors`.
-///
-/// The upper floor's layout repeats the ground floor's, so place recognition matches the two;
-/// the height gate (`GraphSlamConfig::loop_max_height_drift_rate`) must refuse those loops
-/// (checked to fail with the gate off: ATE 1.5 m, 5.6 m low at the end).
+/// first pose is the truth's). Measured: ATE 1.0 cm, end 0.15 cm, 0.05 %. About 25 s in
+/// release.
 #[test]
-#[ignore = "about 25 s: maps a 408 m tour over two floors"]
 fn two_floors_are_mapped_through_the_stairs_with_place_recognition() {
+    two_floors_mapped(10, false);
+}
+
+/// The same over seed 2's floors of one repeated plan, the hard case: place recognition
+/// matches the two floors' rooms, and the height gate
+/// (`GraphSlamConfig::loop_max_height_drift_rate`) must refuse those loops (checked to fail
+/// with the gate off: ATE 1.5 m, 5.2 m low at the end). Also checked to fail without the
+/// odometry edges' tilt information (`GraphSlamConfig::gravity_tilt_sigma` at 1000 rad: more
+/// than 5 cm low at the upper floor's far end, the optimiser having tilted the floor). About
+/// 25 s in release: `cargo test --release -p spot-nav-adapter --test integration --
+/// --ignored two_floors_of_one_plan`.
+#[test]
+#[ignore = "about 25 s: maps a 408 m tour over two floors of one plan"]
+fn two_floors_of_one_plan_are_mapped_through_the_stairs_with_place_recognition() {
+    two_floors_mapped(2, true);
+}
+
+/// Maps seed `seed`'s tour of two floors (of one plan with `repeat_floor_plan`) and checks it.
+fn two_floors_mapped(seed: u64, repeat_floor_plan: bool) {
     use slam_core::LoopRejection;
     use spot_adapter::eval::TrajectoryEvaluation;
     use spot_adapter::pipelines::{point_to_plane_slam, scan_context_places, slam_config};
     use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
-    let mut config = SimulationConfig::with_seed(2);
+    let mut config = SimulationConfig::with_seed(seed);
     config.building.floors = 2;
+    config.building.repeat_floor_plan = repeat_floor_plan;
     let sim = SimulatedSpot::floors_tour(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();
@@ -193,8 +331,23 @@ fn two_floors_are_mapped_through_the_stairs_with_place_recognition() {
     let (e, _) =
         TrajectoryEvaluation::of_lidar_trajectory(slam.scan_trajectory(), &body_t_lidar, &truth)
             .unwrap();
-    assert!(e.end_point.path_length > 400.0);
+    assert!(e.end_point.path_length > 350.0);
+    eprintln!(
+        "two floors: {:.1} m, ATE {:.4} m, end {:.4} m, segments {:.4} %, height {:.4} m",
+        e.end_point.path_length,
+        e.ate.rmse,
+        e.loop_end_point_error,
+        100.0 * e.segments.as_ref().unwrap().translation,
+        e.height_drift
+    );
     assert!(e.ate.rmse <= 0.05, "ATE {} m", e.ate.rmse);
+    assert!(
+        e.loop_end_point_error <= 0.03,
+        "end error {} m",
+        e.loop_end_point_error
+    );
+    let drift = e.segments.as_ref().unwrap().translation;
+    assert!(drift <= 0.003, "relative drift {} %", 100.0 * drift);
     assert!(
         e.height_drift.abs() <= 0.05,
         "height drift {} m",
@@ -202,7 +355,9 @@ fn two_floors_are_mapped_through_the_stairs_with_place_recognition() {
     );
     let report = slam.report();
     assert!(report.place_candidates > 0);
-    assert!(report.loop_rejections.get(LoopRejection::BeyondHeightDrift) > 0);
+    if repeat_floor_plan {
+        assert!(report.loop_rejections.get(LoopRejection::BeyondHeightDrift) > 0);
+    }
     // The upper floor's heights, pose by pose (the simulator's samples carry its truth's stamps).
     let estimate = slam.scan_trajectory();
     let at = |stamp: f64| truth.iter().find(|t| (t.stamp - stamp).abs() < 1e-6);
@@ -379,6 +534,17 @@ fn stairs_from_a_walk_that_does_not_fit_are_refused() {
 /// ground floor's obstacles, the first flight's steps among them; plus the flight rising from
 /// that floor and the stairwell of the one arriving; inflated by 0.3 m).
 /// Plan-view distance from `p` to the rectangle `min`..`max` (0 inside).
+trait GridOn {
+    /// Floor `k`'s true grid at 0.1 m.
+    fn grid_on(&self, k: usize) -> slam_core::BitGrid;
+}
+
+impl GridOn for Building {
+    fn grid_on(&self, k: usize) -> slam_core::BitGrid {
+        self.occupancy_grid_on(k, 0.1).unwrap()
+    }
+}
+
 fn rect_distance(p: Vector2<f64>, min: Vector2<f64>, max: Vector2<f64>) -> f64 {
     let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
     let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
@@ -408,34 +574,11 @@ fn tour_on_true_grids(
     let split = FloorLevels::split(&positions, &FloorLevelsConfig::default()).unwrap();
     let grids = (0..floors)
         .map(|k| {
-            let mut plan = b.occupancy_grid(0.1).unwrap();
-            for (s, stairs) in b.staircases().iter().enumerate() {
-                if s == k {
-                    for step in stairs.step_boxes() {
-                        block_rectangle(&mut plan, step.min.xy().coords, step.max.xy().coords);
-                    }
-                }
-                if s + 1 == k {
-                    let (min, max) = stairs.stairwell();
-                    block_rectangle(&mut plan, min, max);
-                }
-            }
+            let plan = b.occupancy_grid_on(k, 0.1).unwrap();
             inflate(&plan, 0.3).unwrap()
         })
         .collect();
     (b, positions, split, grids)
-}
-
-/// Blocks every cell of `grid` the plan-view rectangle `min`-`max` touches.
-fn block_rectangle(grid: &mut slam_core::BitGrid, min: Vector2<f64>, max: Vector2<f64>) {
-    let r = grid.geometry().resolution;
-    let (x0, y0) = ((min.x / r).floor() as u32, (min.y / r).floor() as u32);
-    let (x1, y1) = ((max.x / r).ceil() as u32, (max.y / r).ceil() as u32);
-    for y in y0..y1.min(grid.height()) {
-        for x in x0..x1.min(grid.width()) {
-            grid.set(slam_core::Cell::new(x, y), true).unwrap();
-        }
-    }
 }
 
 /// The flights of a tour, found from scans along it (at the true poses, so that the test is of

@@ -14,7 +14,9 @@ use spot_adapter::nav::{
     drive_across_floors,
 };
 use spot_adapter::pipelines::point_to_plane_localiser;
-use spot_adapter::sim::{Building, BuildingConfig, CommandedSpot, SimulationConfig};
+use spot_adapter::sim::{
+    Building, BuildingConfig, CommandedSpot, STAIRS_JOLT, STAIRS_NOD, SimulationConfig,
+};
 
 /// Building `seed` with `floors` floors, its maps per floor and each floor's localisation
 /// cloud, from a scan every metre of the floors tour.
@@ -192,9 +194,11 @@ fn a_goal_that_is_on_no_floor_is_refused_before_moving() {
     assert!((spot.body_pose().translation.vector - pose.translation.vector).norm() < 1e-9);
 }
 
-/// The simulated Spot on a flight (the oracle: the staircase's own steps): with the stairs
-/// mode off it cannot walk onto the flight; with it on it climbs, its body rising with the
-/// steps and pitched nose up, and stands on the upper floor past the top.
+/// The simulated Spot on a flight (the oracle: the staircase's own steps; seed 5's has a
+/// landing midway): with the stairs mode off it cannot walk onto the flight; with it on it
+/// climbs, its body rising with the steps (a jolt at each step's edge, within half a rise of the
+/// step under it) and pitched nose up as steeply as a rise over a tread, nodding with each
+/// step, and stands on the upper floor past the top.
 #[test]
 fn the_simulated_spot_climbs_a_flight_only_in_the_stairs_mode() {
     use spot_adapter::robot::VelocityCommand;
@@ -223,7 +227,8 @@ fn the_simulated_spot_climbs_a_flight_only_in_the_stairs_mode() {
     );
     assert!(spot.collisions() > 0);
     let refused = spot.collisions();
-    let mut highest_pitch = 0.0_f64;
+    assert!(flight.landing.is_some());
+    let (mut highest_pitch, mut jolt) = (0.0_f64, 0.0_f64);
     while along(&spot) < flight.run() + 0.6 {
         spot.step_on_stairs(ahead);
         let body = spot.body_pose();
@@ -237,17 +242,23 @@ fn the_simulated_spot_climbs_a_flight_only_in_the_stairs_mode() {
                 "{u:.2} m up: ground {ground:.3} against the step's {:.3}",
                 flight.surface_at(u)
             );
+            // Off the smooth line through the treads' middles (as far as half a rise).
+            jolt = jolt.max((ground - flight.walk_height(u)).abs());
             let (_, pitch, _) = body.rotation.euler_angles();
             highest_pitch = highest_pitch.max(-pitch);
         }
     }
+    assert!(
+        jolt > 0.1 * flight.rise && jolt <= STAIRS_JOLT * 0.5 * flight.rise + 1e-9,
+        "jolt {jolt}"
+    );
     assert_eq!(spot.collisions(), refused);
     assert_eq!(spot.floor(), 1);
     assert!((spot.body_pose().translation.z - spot.building().floor_height(1) - 0.5).abs() < 1e-9);
-    let slope = (flight.climb() / (flight.run() + flight.tread)).atan();
+    let slope = (flight.rise / flight.tread).atan();
     assert!(
-        (highest_pitch - slope).abs() < 1e-6,
-        "pitch {highest_pitch} against {slope}"
+        highest_pitch > slope + 0.5 * STAIRS_NOD && highest_pitch < slope + STAIRS_NOD + 1e-9,
+        "pitch {highest_pitch} against {slope} and a {STAIRS_NOD} rad nod"
     );
 }
 
@@ -300,10 +311,12 @@ fn a_stairs_climb_refuses_a_walk_too_short_or_not_finite_and_bad_settings() {
 }
 
 /// Each floor's grid against that floor's true plan (the oracle: the building's boxes on that
-/// floor, `Building::clearance_on`): occupied cells lie within 0.15 m of a true obstacle and
-/// known-free cells outside every one, on the upper floors as on the ground floor (whose grid
-/// is made as a single floor's is). Before each storey's floor was held to its level, 4 % of
-/// an upper floor's occupied cells were its own floor, beside the stairwell.
+/// floor, `Building::clearance_on`; each floor has its own rooms and furniture): on every
+/// floor, as on the ground floor (whose grid is made as a single floor's is), 99.5 % of the
+/// occupied cells lie within 0.15 m of a true obstacle and 98 % of the known-free cells outside
+/// every one (those inside are under desks and crates the beams pass over). Before each
+/// storey's floor was held to its level, 4 % of an upper floor's occupied cells were its own
+/// floor, beside the stairwell.
 #[test]
 fn each_floors_grid_matches_its_floor_plan() {
     use gridmap::CellState;
@@ -334,10 +347,7 @@ fn each_floors_grid_matches_its_floor_plan() {
         assert!(free > 100_000, "floor {k}: {free} free cells");
     }
     eprintln!("(occupied near an obstacle, known-free outside) per floor: {figures:?}");
-    let (ground_near, ground_outside) = figures[0];
-    assert!(ground_near > 0.995 && ground_outside > 0.98, "{figures:?}");
-    for &(near, outside) in &figures[1..] {
-        assert!(near > ground_near - 0.005, "{figures:?}");
-        assert!(outside > ground_outside - 0.005, "{figures:?}");
+    for &(near, outside) in &figures {
+        assert!(near > 0.995 && outside > 0.98, "{figures:?}");
     }
 }
