@@ -16,12 +16,17 @@
 //! `EXPLORATION_BENCH_BUILDING=large` explores the 114 m x 59 m building instead (about 10
 //! minutes; `small` the 17 m x 17 m one), `EXPLORATION_BENCH_SEED=N` another building, and
 //! `EXPLORATION_BENCH_MAX_SCANS=N` sets the scan budget (12,000; 40,000 for `large`).
+//! The engine keeps the newest 200 keyframes' map clouds in memory and older ones in a file
+//! under the target folder (`GraphSlam::with_keyframe_store`);
+//! `EXPLORATION_BENCH_KEYFRAMES_IN_MEMORY=N` keeps N, 0 every one.
 
 use nalgebra::Vector2;
 use slam_core::io::StampedPose;
 use spot_adapter::eval::TrajectoryEvaluation;
 use spot_adapter::nav::{ExplorationReport, ExplorerConfig, NavigatorConfig, explore};
-use spot_adapter::pipelines::{point_to_plane_slam, point_to_plane_tracker, slam_config};
+use spot_adapter::pipelines::{
+    PointToPlaneSlam, point_to_plane_slam, point_to_plane_tracker, slam_config,
+};
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, SimulationConfig, floor_coverage,
 };
@@ -118,6 +123,29 @@ fn print_frontiers(report: &ExplorationReport) {
     );
 }
 
+/// The engine as the mission sets it up, keeping the newest keyframes' map clouds in memory and
+/// older ones in a file (`EXPLORATION_BENCH_KEYFRAMES_IN_MEMORY`, 200; 0: every one held).
+fn engine() -> Result<PointToPlaneSlam, String> {
+    let slam = point_to_plane_slam(slam_config()).map_err(|e| e.to_string())?;
+    let in_memory: usize = env_or("EXPLORATION_BENCH_KEYFRAMES_IN_MEMORY", 200)?;
+    if in_memory == 0 {
+        return Ok(slam);
+    }
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    slam.with_keyframe_store(dir, in_memory)
+        .map_err(|e| format!("the keyframe store in {}: {e}", dir.display()))
+}
+
+/// How many keyframe map clouds the engine holds in memory at the end.
+fn print_store(slam: &PointToPlaneSlam) {
+    println!(
+        "Keyframe map clouds in memory at the end: {} of {} ({} refused by the store's file).",
+        slam.keyframe_scans_in_memory(),
+        slam.keyframe_count(),
+        slam.report().keyframe_store_failures
+    );
+}
+
 fn run() -> Result<(), String> {
     let (name, seed, max_scans, config) = settings()?;
     let building = Building::generate(seed, &config.building).map_err(|e| e.to_string())?;
@@ -126,7 +154,7 @@ fn run() -> Result<(), String> {
     // The engine's map frame is the odometry frame, which starts at the body's start pose.
     let world_t_map = spot.body_pose();
     let map_t_world = world_t_map.inverse();
-    let mut slam = point_to_plane_slam(slam_config()).map_err(|e| e.to_string())?;
+    let mut slam = engine()?;
     let navigator = NavigatorConfig::default();
     let explorer = ExplorerConfig::default();
     let resident_at_start = resident_mb();
@@ -217,6 +245,7 @@ fn run() -> Result<(), String> {
         mean(&report.decision_ms),
         report.decision_ms.iter().copied().fold(0.0, f64::max),
     );
+    print_store(&slam);
     Ok(())
 }
 

@@ -399,7 +399,8 @@ fn own_backends(args: &Args) -> Result<()> {
     // starts at the first body pose; the LiDAR sits its mounting above the body.
     let world_t_map = truth.first().context("empty lap")?.pose;
     let map_t_lidar = slam.current_lidar_pose().context("no scan was mapped")?;
-    let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
+    let loaded = slam.keyframe_scans().collect::<Result<Vec<_>, _>>()?;
+    let scans: Vec<(Pose3, &PointCloud)> = loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let navigation =
         NavigationMap::from_scans(&scans, lidar_height, &settings.navigator.map_config())?;

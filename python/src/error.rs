@@ -93,6 +93,7 @@ to_py! {
     slam_core::OptimizeError => OptimizationError,
     slam_core::PlanError => PlanningError,
     slam_core::CloudError => CloudError,
+    slam_core::KeyframeCloudError => CloudError,
     slam_core::GridError => GridMapError,
     slam_core::InvalidSetting => InvalidInputError,
     posegraph::GraphFileError => GraphFileError,

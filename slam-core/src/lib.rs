@@ -60,8 +60,9 @@ pub use grid::{BitGrid, Cell, GridGeometry, MAX_GRID_CELLS};
 pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
-    EdgeInformation, GraphSlam, GraphSlamConfig, LoopOutcome, LoopRejection, LoopRejections,
-    ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew, level_on_gravity,
+    EdgeInformation, GraphSlam, GraphSlamConfig, KeyframeCloudError, LoopOutcome, LoopRejection,
+    LoopRejections, ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew,
+    level_on_gravity,
 };
 pub use traits::optimizer::{
     IncrementalOptimizer, IncrementalReport, OptimizationReport, Optimizer, StopReason,

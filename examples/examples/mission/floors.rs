@@ -102,7 +102,9 @@ pub(crate) fn floors_mission(
             building.floors()
         );
     }
-    let keyframes: Vec<(Pose3, &PointCloud)> = engine.keyframe_scans().collect();
+    let loaded = engine.keyframe_scans().collect::<Result<Vec<_>, _>>()?;
+    let keyframes: Vec<(Pose3, &PointCloud)> =
+        loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
     let lidar_height = config.spot.body_height + config.spot.body_t_lidar.translation.z;
     let maps = FloorMaps::build(
         &keyframes,

@@ -30,7 +30,8 @@ pub(crate) fn map_building<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Po
     let map_t_lidar = slam
         .current_lidar_pose()
         .context("the lap gave the engine no scan")?;
-    let scans: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
+    let loaded = slam.keyframe_scans().collect::<Result<Vec<_>, _>>()?;
+    let scans: Vec<(Pose3, &PointCloud)> = loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
     let sim_config = SimulationConfig::default();
     let lidar_height = sim_config.spot.body_height + sim_config.spot.body_t_lidar.translation.z;
     let navigation = NavigationMap::from_scans(&scans, lidar_height, map_config)?;

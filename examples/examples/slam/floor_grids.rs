@@ -34,7 +34,9 @@ impl FloorGrids {
         poses: &[StampedPose],
         inflation: f64,
     ) -> Result<Self> {
-        let scans: Vec<_> = slam.keyframe_scans().collect();
+        let loaded = slam.keyframe_scans().collect::<Result<Vec<_>, _>>()?;
+        let scans: Vec<(slam_core::Pose3, &slam_core::PointCloud)> =
+            loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
         let positions: Vec<Point3<f64>> = poses
             .iter()
             .map(|p| Point3::from(p.pose.translation.vector))

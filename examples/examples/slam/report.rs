@@ -181,8 +181,9 @@ fn print_floors<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     floors: &FloorLevels,
 ) -> Result<Vec<FloorSummary>> {
     let keyframe_floors: Vec<Option<usize>> = slam
-        .keyframe_scans()
-        .map(|(pose, _)| floors.floor_at(pose.translation.z))
+        .keyframe_trajectory()
+        .iter()
+        .map(|k| floors.floor_at(k.pose.translation.z))
         .collect();
     let summaries: Vec<FloorSummary> = floors
         .levels()
@@ -385,7 +386,9 @@ pub(crate) fn write_outputs<R: MapRegistrator, C: MapRegistrator, O: Optimizer<P
     write_pcd(dir.join("map.pcd"), &map, PcdEncoding::Binary)?;
     write_tum(dir.join("trajectory.tum"), &mapping.estimate)?;
     write_g2o(dir.join("graph.g2o"), &G2oGraph::Se3(slam.graph().clone()))?;
-    let scans: Vec<_> = slam.keyframe_scans().collect();
+    let loaded = slam.keyframe_scans().collect::<Result<Vec<_>, _>>()?;
+    let scans: Vec<(Pose3, &slam_core::PointCloud)> =
+        loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
     if let Some(grids) = floor_grids {
         return grids.write(mapping, dir);
     }

@@ -189,8 +189,8 @@ pub(crate) fn map_live(
     }
     let scans: Vec<(Pose3, PointCloud)> = slam
         .keyframe_scans()
-        .map(|(pose, cloud)| (start_t_odom * pose, cloud.clone()))
-        .collect();
+        .map(|scan| scan.map(|(pose, cloud)| (start_t_odom * pose, cloud.into_owned())))
+        .collect::<Result<_, _>>()?;
     let refs: Vec<(Pose3, &PointCloud)> = scans.iter().map(|(p, c)| (*p, c)).collect();
     let navigation =
         NavigationMap::from_scans(&refs, lidar_height, &NavigationMapConfig::default())?;

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use nalgebra::{Matrix6, UnitQuaternion};
 
+use super::cloud_store::{KeyframeCloudError, KeyframeClouds};
 use super::config::GraphSlamConfig;
 use super::gravity::level_on_gravity;
 use super::information::{edge_information, with_tilt};
@@ -79,6 +80,8 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     pub(super) tracker: Tracker,
     pub(super) graph: PoseGraph<Pose3>,
     pub(super) keyframes: Vec<Keyframe<R::Source, C::Source>>,
+    /// The keyframes' map clouds, in memory or in the store's file.
+    pub(super) clouds: KeyframeClouds,
     pub(super) local_map: Option<LocalMap<R::Target>>,
     /// The keyframes the local map is made of.
     pub(super) window: LocalWindow,
@@ -159,6 +162,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             optimizer,
             graph: PoseGraph::new(),
             keyframes: Vec::new(),
+            clouds: KeyframeClouds::default(),
             local_map: None,
             window: LocalWindow::default(),
             anchor: None,
@@ -187,6 +191,33 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     pub fn with_place_recognizer(mut self, places: Box<dyn PlaceRecognizer + Send>) -> Self {
         self.places = Some(places);
         self
+    }
+
+    /// The engine keeping only the newest `resident` keyframes' map clouds in memory and the
+    /// older ones in a file it makes in `dir` (and removes when dropped), so that a long walk's
+    /// memory grows by the keyframes' poses and registration points only (about 100 KB a
+    /// keyframe with the point-to-plane pipeline, against 240 KB with every cloud held).
+    /// [`GraphSlam::keyframe_scans`] and [`GraphSlam::map`] read the older clouds back; the
+    /// tracking and the loop checks never need them. Clouds already kept move to the store.
+    /// A cloud the file refuses stays in memory and is counted
+    /// ([`SlamReport::keyframe_store_failures`]).
+    ///
+    /// # Errors
+    /// [`KeyframeCloudError::Store`] when the file cannot be made in `dir`, or a cloud already
+    /// kept cannot be moved to it.
+    pub fn with_keyframe_store(
+        mut self,
+        dir: &std::path::Path,
+        resident: usize,
+    ) -> Result<Self, KeyframeCloudError> {
+        let mut store = KeyframeClouds::in_folder(dir, resident)?;
+        for i in 0..self.clouds.len() {
+            if let Some(cloud) = self.clouds.get(i) {
+                store.push(cloud?.into_owned())?;
+            }
+        }
+        self.clouds = store;
+        Ok(self)
     }
 
     /// The settings.
@@ -556,7 +587,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             odom_t_lidar,
             source: self.odometry.keyframe_source(source),
             coarse: self.loop_coarse.keyframe_source(coarse),
-            cloud,
             matched,
             links: parent
                 .map(|keyframe| Link {
@@ -566,6 +596,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .into_iter()
                 .collect(),
         });
+        if self.clouds.push(cloud).is_err() {
+            // Kept in memory instead; counted, the walk goes on.
+            self.report.keyframe_store_failures += 1;
+        }
         if let Some(from) = parent {
             self.keyframes[from].links.push(Link {
                 keyframe: index,

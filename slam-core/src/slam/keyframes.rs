@@ -1,11 +1,13 @@
 //! What the engine keeps of each scan: keyframes (graph nodes with their clouds) and every
 //! accepted scan's pose riding on one; the trajectories and the map read from them.
 
+use std::borrow::Cow;
+
 use nalgebra::Vector6;
 
+use super::cloud_store::KeyframeCloudError;
 use super::engine::GraphSlam;
 use crate::cloud::PointCloud;
-use crate::error::CloudError;
 use crate::geometry::Pose3;
 use crate::io::StampedPose;
 use crate::traits::optimizer::Optimizer;
@@ -20,8 +22,6 @@ pub(super) struct Keyframe<S, C> {
     pub(super) source: S,
     /// Prepared for the coarse loop registrator.
     pub(super) coarse: C,
-    /// Voxel-filtered scan (LiDAR frame) for the map.
-    pub(super) cloud: PointCloud,
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     pub(super) walked: f64,
@@ -131,26 +131,46 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
 
     /// Every keyframe's scan (voxel-filtered, in the LiDAR frame; positions and intensities,
     /// no ring or time channel) with its optimised `map_T_lidar`: the rays an occupancy grid's
-    /// free space comes from.
-    pub fn keyframe_scans(&self) -> impl Iterator<Item = (Pose3, &PointCloud)> + '_ {
-        self.keyframes
-            .iter()
-            .enumerate()
-            .map(|(i, k)| (self.keyframe_pose(i), &k.cloud))
+    /// free space comes from. A scan held in memory is borrowed; one the engine keeps in its
+    /// file ([`GraphSlam::with_keyframe_store`]) is read back.
+    ///
+    /// # Errors
+    /// [`KeyframeCloudError::Store`] for a scan the store's file no longer gives back.
+    pub fn keyframe_scans(
+        &self,
+    ) -> impl Iterator<Item = Result<(Pose3, Cow<'_, PointCloud>), KeyframeCloudError>> + '_ {
+        (0..self.keyframes.len()).filter_map(|i| self.keyframe_scan(i))
+    }
+
+    /// Keyframe `i`'s scan with its optimised `map_T_lidar`, as [`GraphSlam::keyframe_scans`]
+    /// gives it; `None` past the last keyframe.
+    pub fn keyframe_scan(
+        &self,
+        i: usize,
+    ) -> Option<Result<(Pose3, Cow<'_, PointCloud>), KeyframeCloudError>> {
+        let cloud = self.clouds.get(i)?;
+        Some(cloud.map(|c| (self.keyframe_pose(i), c)))
+    }
+
+    /// How many keyframe scans are held in memory (all but those written to the store's file).
+    #[must_use]
+    pub fn keyframe_scans_in_memory(&self) -> usize {
+        self.clouds.held()
     }
 
     /// The map: every keyframe cloud at its optimised pose, voxel-filtered at `voxel_size`.
     ///
     /// # Errors
-    /// [`CloudError::InvalidVoxelSize`] for a bad voxel size.
-    pub fn map(&self, voxel_size: f32) -> Result<PointCloud, CloudError> {
+    /// [`KeyframeCloudError::Cloud`] for a bad voxel size; as
+    /// [`GraphSlam::keyframe_scans`].
+    pub fn map(&self, voxel_size: f32) -> Result<PointCloud, KeyframeCloudError> {
         let mut all = PointCloud::new();
-        for (i, k) in self.keyframes.iter().enumerate() {
-            let mut c = k.cloud.transformed(&self.keyframe_pose(i));
+        for scan in self.keyframe_scans() {
+            let (pose, cloud) = scan?;
             // Channels may differ between sensors' scans; the map keeps positions only.
-            c = PointCloud::from_points(c.into_parts().0);
+            let c = PointCloud::from_points(cloud.transformed(&pose).into_parts().0);
             all.extend_from(&c)?;
         }
-        all.voxel_downsample(voxel_size)
+        Ok(all.voxel_downsample(voxel_size)?)
     }
 }

@@ -16,10 +16,11 @@
 //!
 //! One file a stage: `prediction` (where the scan should be), `scan_preparation` (thinning and
 //! deskewing), `scan_tracking` (registration against the local map, the sweep's own motion),
-//! `local_map`, `revisit` (riding on old keyframes), `keyframes` (what is kept, the trajectories and the map), `loop_closure` (the
+//! `local_map`, `revisit` (riding on old keyframes), `keyframes` (what is kept, the trajectories and the map), `cloud_store` (the keyframes' map clouds, in memory or in a file), `loop_closure` (the
 //! candidate queue and the checks, each rejection counted by its [`LoopRejection`]),
 //! `information` (edge information); `engine` holds the state and runs the stages in order.
 
+mod cloud_store;
 mod config;
 mod deskew;
 mod engine;
@@ -35,6 +36,7 @@ mod revisit;
 mod scan_preparation;
 mod scan_tracking;
 
+pub use cloud_store::KeyframeCloudError;
 pub use config::{EdgeInformation, GraphSlamConfig, TurnPrediction};
 pub use deskew::deskew;
 pub use engine::{GraphSlam, ScanInput};

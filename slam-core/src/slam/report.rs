@@ -235,6 +235,9 @@ pub struct SlamReport {
     /// Local maps the odometry's backend could not build from the keyframes (the scan then fell
     /// back to its prediction, counted in [`SlamReport::tracking`] as having no target).
     pub local_map_failures: usize,
+    /// Keyframe clouds the keyframe store's file refused (kept in memory instead; see
+    /// [`GraphSlam::with_keyframe_store`](crate::GraphSlam::with_keyframe_store)).
+    pub keyframe_store_failures: usize,
     /// Loop edges the optimiser weighted out in its last run (an optimiser that decides
     /// outliers, see [`Optimizer::edge_weights`](crate::Optimizer::edge_weights); 0 with one
     /// that keeps every edge): accepted by the geometric check, yet inconsistent with the rest

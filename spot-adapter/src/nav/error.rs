@@ -111,9 +111,10 @@ pub enum ExplorationError<E: std::error::Error + 'static> {
     /// Invalid settings, or the navigator or its map failed.
     #[error("navigation failed")]
     Navigation(#[source] NavError),
-    /// The engine's map cloud could not be made for the navigator to localise against.
+    /// The engine's map cloud could not be made for the navigator to localise against (or a
+    /// keyframe's scan could not be read back from the engine's keyframe store).
     #[error("the map cloud cannot be made")]
-    Map(#[source] slam_core::CloudError),
+    Map(#[source] slam_core::KeyframeCloudError),
     /// The engine kept none of the first `cycles` scans (every one skipped): there is no map
     /// to explore from.
     #[error("the engine kept none of the first {cycles} scans: no map to explore from")]

@@ -1,12 +1,15 @@
 //! `GrowingMap`: the explorer's navigation map and localisation cloud, grown by the keyframes
 //! added since the last decision instead of rendered afresh from all of them at every decision.
 
+use std::borrow::Cow;
 use std::collections::HashSet;
 
 use gridmap::{FloorBandAccumulator, FloorMap, floor_hints_below};
 use nalgebra::{Point3, Vector2};
 use rustc_hash::FxHashMap;
-use slam_core::{CloudError, GraphSlam, MapRegistrator, Optimizer, PointCloud, Pose3};
+use slam_core::{
+    CloudError, GraphSlam, KeyframeCloudError, MapRegistrator, Optimizer, PointCloud, Pose3,
+};
 
 use crate::nav::NavError;
 use crate::nav::config::NavigationMapConfig;
@@ -93,19 +96,19 @@ impl GrowingMap {
         O: Optimizer<Pose3>,
         E: std::error::Error + Send + Sync + 'static,
     {
-        let keyframes: Vec<(Pose3, &PointCloud)> = slam.keyframe_scans().collect();
-        self.update_from(&keyframes)
+        let poses: Vec<Pose3> = slam.keyframe_trajectory().iter().map(|k| k.pose).collect();
+        self.update_from(&EngineKeyframes { slam, poses })
     }
 
     /// [`Self::update`] with the walk's keyframes (`map_T_lidar` and points, in order).
     fn update_from<E: std::error::Error + Send + Sync + 'static>(
         &mut self,
-        keyframes: &[(Pose3, &PointCloud)],
+        keyframes: &(impl Keyframes + ?Sized),
     ) -> Result<NavigationMap, ExplorationError<E>> {
         let cell = self.config.grid.resolution;
         let limit = MOVED_CELLS * cell;
         let moved = self.rendered.iter().any(|&(k, at)| {
-            keyframes.get(k).is_none_or(|(now, _)| {
+            keyframes.pose(k).is_none_or(|now| {
                 let d = at.inverse() * now;
                 d.translation.vector.norm() + d.rotation.angle() * self.range > limit
             })
@@ -117,13 +120,15 @@ impl GrowingMap {
             self.full_render(keyframes)?;
         } else {
             let fresh = self.pick(keyframes);
-            let scans: Vec<(Pose3, &PointCloud)> = fresh.iter().map(|&k| keyframes[k]).collect();
+            let loaded = load(keyframes, &fresh)?;
+            let scans: Vec<(Pose3, &PointCloud)> =
+                loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
             if let Some(band) = self.band.as_mut() {
                 band.add_scans(&scans).map_err(grid_error)?;
             }
-            self.cloud.add(&scans).map_err(ExplorationError::Map)?;
+            self.cloud.add(&scans).map_err(map_error)?;
             self.rendered
-                .extend(fresh.iter().map(|&k| (k, keyframes[k].0)));
+                .extend(fresh.iter().zip(&scans).map(|(&k, (pose, _))| (k, *pose)));
         }
         let band = self
             .band
@@ -143,7 +148,7 @@ impl GrowingMap {
     /// Everything rendered afresh from `keyframes` at their current poses.
     fn full_render<E: std::error::Error + Send + Sync + 'static>(
         &mut self,
-        keyframes: &[(Pose3, &PointCloud)],
+        keyframes: &(impl Keyframes + ?Sized),
     ) -> Result<(), ExplorationError<E>> {
         let grid_error = |e| ExplorationError::Navigation(NavError::NavigationGrid(e));
         self.config
@@ -153,7 +158,9 @@ impl GrowingMap {
         self.squares.clear();
         self.seen = 0;
         let picked = self.pick(keyframes);
-        let scans: Vec<(Pose3, &PointCloud)> = picked.iter().map(|&k| keyframes[k]).collect();
+        let loaded = load(keyframes, &picked)?;
+        let scans: Vec<(Pose3, &PointCloud)> =
+            loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
         let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
         let hints = floor_hints_below(&poses, self.lidar_height);
         let floor = FloorMap::estimate_from_scans(&scans, &hints, &self.config.floor)
@@ -163,9 +170,9 @@ impl GrowingMap {
                 .map_err(grid_error)?;
         band.add_scans(&scans).map_err(grid_error)?;
         self.cloud.clear();
-        self.cloud.add(&scans).map_err(ExplorationError::Map)?;
+        self.cloud.add(&scans).map_err(map_error)?;
         self.band = Some(band);
-        self.rendered = picked.iter().map(|&k| (k, keyframes[k].0)).collect();
+        self.rendered = picked.iter().zip(&poses).map(|(&k, &p)| (k, p)).collect();
         self.rendered_at_full = self.rendered.len();
         self.full_renders += 1;
         Ok(())
@@ -173,9 +180,10 @@ impl GrowingMap {
 
     /// The keyframes from the first not looked at yet that are the first in their square (by
     /// LiDAR position), and the newest when it is not one of them or rendered already.
-    fn pick(&mut self, keyframes: &[(Pose3, &PointCloud)]) -> Vec<usize> {
+    fn pick(&mut self, keyframes: &(impl Keyframes + ?Sized)) -> Vec<usize> {
         let mut picked = Vec::new();
-        for (k, (pose, _)) in keyframes.iter().enumerate().skip(self.seen) {
+        let count = keyframes.count();
+        for (k, pose) in (self.seen..count).filter_map(|k| Some((k, keyframes.pose(k)?))) {
             let at = pose.translation.vector / self.spacing;
             if self
                 .squares
@@ -184,8 +192,8 @@ impl GrowingMap {
                 picked.push(k);
             }
         }
-        self.seen = keyframes.len();
-        if let Some(newest) = keyframes.len().checked_sub(1)
+        self.seen = count;
+        if let Some(newest) = count.checked_sub(1)
             && picked.last() != Some(&newest)
             && self.rendered.last().map(|&(k, _)| k) != Some(newest)
         {
@@ -193,6 +201,79 @@ impl GrowingMap {
         }
         picked
     }
+}
+
+/// The walk's keyframes as the map is grown from them: each one's pose, and its scan read only
+/// when it is rendered (an engine keeps older scans in a file,
+/// [`GraphSlam::with_keyframe_store`]).
+pub(crate) trait Keyframes {
+    /// How many there are.
+    fn count(&self) -> usize;
+    /// Keyframe `k`'s `map_T_lidar`.
+    fn pose(&self, k: usize) -> Option<Pose3>;
+    /// Keyframe `k`'s scan (LiDAR frame).
+    fn scan(&self, k: usize) -> Result<Cow<'_, PointCloud>, KeyframeCloudError>;
+}
+
+impl Keyframes for [(Pose3, &PointCloud)] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn pose(&self, k: usize) -> Option<Pose3> {
+        self.get(k).map(|(pose, _)| *pose)
+    }
+
+    fn scan(&self, k: usize) -> Result<Cow<'_, PointCloud>, KeyframeCloudError> {
+        Ok(self
+            .get(k)
+            .map_or_else(|| Cow::Owned(PointCloud::new()), |(_, c)| Cow::Borrowed(*c)))
+    }
+}
+
+/// An engine's keyframes, their poses read once.
+struct EngineKeyframes<'a, R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> {
+    slam: &'a GraphSlam<R, C, O>,
+    poses: Vec<Pose3>,
+}
+
+impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> Keyframes
+    for EngineKeyframes<'_, R, C, O>
+{
+    fn count(&self) -> usize {
+        self.poses.len()
+    }
+
+    fn pose(&self, k: usize) -> Option<Pose3> {
+        self.poses.get(k).copied()
+    }
+
+    fn scan(&self, k: usize) -> Result<Cow<'_, PointCloud>, KeyframeCloudError> {
+        self.slam
+            .keyframe_scan(k)
+            .map_or_else(|| Ok(Cow::Owned(PointCloud::new())), |s| s.map(|(_, c)| c))
+    }
+}
+
+/// The poses and scans of keyframes `picked`.
+fn load<'k, E: std::error::Error + Send + Sync + 'static>(
+    keyframes: &'k (impl Keyframes + ?Sized),
+    picked: &[usize],
+) -> Result<Vec<(Pose3, Cow<'k, PointCloud>)>, ExplorationError<E>> {
+    picked
+        .iter()
+        .map(|&k| {
+            let pose = keyframes.pose(k).unwrap_or_else(Pose3::identity);
+            Ok((pose, keyframes.scan(k).map_err(ExplorationError::Map)?))
+        })
+        .collect()
+}
+
+/// A cloud error as the exploration names it.
+fn map_error<E: std::error::Error + Send + Sync + 'static>(
+    e: slam_core::CloudError,
+) -> ExplorationError<E> {
+    ExplorationError::Map(KeyframeCloudError::Cloud(e))
 }
 
 /// Points of placed scans thinned to one centroid per cubic voxel, added scan by scan: the

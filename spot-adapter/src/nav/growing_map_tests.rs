@@ -68,7 +68,7 @@ fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
         .collect();
     let mut m = map();
     let first = m
-        .update_from::<std::io::Error>(&refs(&scans[..24]))
+        .update_from::<std::io::Error>(&refs(&scans[..24])[..])
         .unwrap();
     assert_eq!(m.full_renders(), 1);
     // Squares 0-5 (keyframes 0, 4, ..., 20) and the newest (23).
@@ -77,7 +77,7 @@ fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
         [0, 4, 8, 12, 16, 20, 23]
     );
     let second = m
-        .update_from::<std::io::Error>(&refs(&scans[..28]))
+        .update_from::<std::io::Error>(&refs(&scans[..28])[..])
         .unwrap();
     let cloud = m.cloud_within(Vector2::zeros(), f64::INFINITY);
     assert_eq!(
@@ -124,12 +124,12 @@ fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
     // A keyframe moved by 2 cm (a fifth of a cell): kept as rendered.
     let mut moved = scans.clone();
     moved[4].0 = Pose3::from_parts(Translation3::new(1.02, 0.0, 0.6), moved[4].0.rotation);
-    m.update_from::<std::io::Error>(&refs(&moved[..29]))
+    m.update_from::<std::io::Error>(&refs(&moved[..29])[..])
         .unwrap();
     assert_eq!(m.full_renders(), 1);
     // Turned by 1 degree: a point 4 m out moves 7 cm, more than half a cell.
     moved[4].0.rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 1f64.to_radians());
-    m.update_from::<std::io::Error>(&refs(&moved[..30]))
+    m.update_from::<std::io::Error>(&refs(&moved[..30])[..])
         .unwrap();
     assert_eq!(m.full_renders(), 2);
     assert_eq!(
@@ -141,7 +141,8 @@ fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
     let mut k = 30;
     while m.full_renders() == 2 && k < moved.len() {
         k += 1;
-        m.update_from::<std::io::Error>(&refs(&moved[..k])).unwrap();
+        m.update_from::<std::io::Error>(&refs(&moved[..k])[..])
+            .unwrap();
     }
     assert_eq!(m.full_renders(), 3);
     assert!(m.rendered.len() <= before + before.div_ceil(2) + 1);
@@ -153,7 +154,7 @@ fn a_map_without_obstacles_is_refused_by_name() {
     let floor_only = PointCloud::from_points(vec![Point3::new(1.0, 0.0, -0.6); 50]);
     let mut m = map();
     let err = m
-        .update_from::<std::io::Error>(&[(Pose3::translation(0.0, 0.0, 0.6), &floor_only)])
+        .update_from::<std::io::Error>(&[(Pose3::translation(0.0, 0.0, 0.6), &floor_only)][..])
         .unwrap_err();
     assert!(
         matches!(

@@ -104,16 +104,19 @@ pub fn explore_building(
     choice: FrontierChoice,
     max_cycles: usize,
 ) -> Explored {
-    explore_shutting(building, choice, max_cycles, None).0
+    explore_shutting(building, choice, max_cycles, None, None).0
 }
 
 /// [`explore_building`], closing `shut`'s door on the way ([`ShutsADoor`]); coverage is
-/// measured on the building as it is at the end. Also returns the scan the door shut on.
+/// measured on the building as it is at the end. Also returns the scan the door shut on. With
+/// `keyframes_in_memory`, the engine keeps older keyframes' map clouds in a file
+/// (`GraphSlam::with_keyframe_store`), so the growing map reads them back.
 fn explore_shutting(
     building: &Building,
     choice: FrontierChoice,
     max_cycles: usize,
     shut: Option<Room>,
+    keyframes_in_memory: Option<usize>,
 ) -> (Explored, Option<usize>) {
     let mut sim = SimulationConfig::default();
     // A quarter of the VLP-16's columns (0.8 degrees): rooms of a few metres are seen as well,
@@ -129,6 +132,10 @@ fn explore_shutting(
     // The engine's map frame is the odometry frame, which starts at the body's start pose.
     let world_t_map = spot.spot.body_pose();
     let mut slam = point_to_plane_slam(slam_config()).unwrap();
+    if let Some(n) = keyframes_in_memory {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+        slam = slam.with_keyframe_store(dir, n).unwrap();
+    }
     let config = ExplorerConfig {
         choice,
         ..ExplorerConfig::default()
@@ -154,6 +161,11 @@ fn explore_shutting(
     )
     .unwrap();
     let seconds = started.elapsed().as_secs_f64();
+    if let Some(n) = keyframes_in_memory {
+        assert!(slam.keyframe_count() > n);
+        assert_eq!(slam.keyframe_scans_in_memory(), n);
+        assert_eq!(slam.report().keyframe_store_failures, 0);
+    }
     let coverage = coverage(spot.spot.building(), start, &world_t_map, &report);
     let explored = Explored {
         report,
@@ -306,7 +318,9 @@ fn a_closed_door_leaves_its_room_out() {
 /// from the start is shut as the robot first comes near it. What the robot saw of the room
 /// through the door stays on its map with its frontiers, and the explorer says so: they are
 /// given up on the way or left unreachable at the end, never walked into. The exploration still
-/// stops by itself with the floor that stays reachable mapped, and no collision.
+/// stops by itself with the floor that stays reachable mapped, and no collision. The engine
+/// keeps only its newest 30 keyframes' map clouds in memory, the rest in a file, which the
+/// growing map reads back when it renders.
 #[test]
 fn a_frontier_shut_off_by_a_dropped_box_is_given_up_and_reported() {
     let building = small_building(13);
@@ -317,8 +331,13 @@ fn a_frontier_shut_off_by_a_dropped_box_is_given_up_and_reported() {
         .max_by(|a, b| (a.door - start).norm().total_cmp(&(b.door - start).norm()))
         .copied()
         .unwrap();
-    let (explored, shut_at) =
-        explore_shutting(&building, FrontierChoice::default(), 3000, Some(room));
+    let (explored, shut_at) = explore_shutting(
+        &building,
+        FrontierChoice::default(),
+        3000,
+        Some(room),
+        Some(30),
+    );
     print("box dropped in a door", &explored);
     let shut_at = shut_at.expect("the robot came near the door");
     let world_t_map = explored.world_t_map;

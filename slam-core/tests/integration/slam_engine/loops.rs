@@ -237,3 +237,60 @@ fn every_rejected_loop_is_counted_by_its_reason() {
     );
     assert!(report.loop_rejections.get(LoopRejection::CoarseMismatch) >= 1);
 }
+
+/// The loop walked with the keyframes' map clouds kept in a file past the newest 4: the same
+/// trajectory and map, bit for bit, as with every cloud in memory (the oracle: the engine
+/// without the store), only 4 clouds held, every keyframe's scan read back equal to the one held
+/// in memory, and the file gone with the engine. Moving an engine's clouds to a store midway
+/// gives the same.
+#[test]
+fn keyframe_clouds_kept_in_a_file_change_nothing_but_memory() {
+    let world = hall();
+    let truth = loop_poses();
+    let odom = drifting_odometry(&truth);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("keyframe-store");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut held = brute_engine(loop_config()).unwrap();
+    let mut stored = brute_engine(loop_config())
+        .unwrap()
+        .with_keyframe_store(&dir, 4)
+        .unwrap();
+    let mut moved = brute_engine(loop_config()).unwrap();
+    for (k, (gt, od)) in truth.iter().zip(&odom).enumerate() {
+        for slam in [&mut held, &mut stored] {
+            feed(slam, &world, k, gt, *od);
+        }
+        feed(&mut moved, &world, k, gt, *od);
+        if k == truth.len() / 2 {
+            moved = moved.with_keyframe_store(&dir, 4).unwrap();
+        }
+    }
+    let keyframes = held.keyframe_count();
+    assert!(keyframes > 20, "{keyframes} keyframes");
+    assert!(held.report().loops_closed > 0);
+    assert_eq!(held.keyframe_scans_in_memory(), keyframes);
+    for slam in [&stored, &moved] {
+        assert_eq!(slam.keyframe_scans_in_memory(), 4);
+        assert_eq!(slam.report().keyframe_store_failures, 0);
+        assert_eq!(slam.scan_trajectory(), held.scan_trajectory());
+        assert_eq!(slam.map(0.1).unwrap(), held.map(0.1).unwrap());
+        let scans: Vec<_> = slam.keyframe_scans().map(Result::unwrap).collect();
+        let expected: Vec<_> = held.keyframe_scans().map(Result::unwrap).collect();
+        assert_eq!(scans.len(), keyframes);
+        for ((p, c), (q, d)) in scans.iter().zip(&expected) {
+            assert_eq!(p, q);
+            assert_eq!(c.as_ref(), d.as_ref());
+        }
+    }
+    let files = || std::fs::read_dir(&dir).unwrap().count();
+    assert_eq!(files(), 2);
+    drop(stored);
+    drop(moved);
+    assert_eq!(files(), 0);
+    // A folder that does not exist is refused by its path.
+    let missing = dir.join("missing");
+    assert!(matches!(
+        brute_engine(loop_config()).unwrap().with_keyframe_store(&missing, 4),
+        Err(slam_core::KeyframeCloudError::Store { path, .. }) if path.starts_with(&missing)
+    ));
+}
