@@ -199,6 +199,14 @@ impl MapRegistrator for CountingIcp {
     fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
         self.icp.ready_map_beside(map, beside);
     }
+
+    fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
+        self.icp.stored_source(source)
+    }
+
+    fn restored_source(&self, bytes: &[u8]) -> Option<Self::Source> {
+        self.icp.restored_source(bytes)
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

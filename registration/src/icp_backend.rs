@@ -71,6 +71,15 @@ macro_rules! icp_backend {
                 source
             }
 
+            /// The points' coordinates as little-endian f64, exactly.
+            fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
+                Some($crate::icp_target::points_to_bytes(source))
+            }
+
+            fn restored_source(&self, bytes: &[u8]) -> Option<Self::Source> {
+                $crate::icp_target::points_from_bytes(bytes)
+            }
+
             /// [`IcpConfig::source_voxel`](crate::IcpConfig::source_voxel) when above zero: the
             /// source is the scan's voxel centroids.
             fn source_voxel(&self) -> Option<f32> {

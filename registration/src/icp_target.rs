@@ -57,3 +57,26 @@ pub(crate) fn empty_map<S: IcpStep>(config: &IcpConfig) -> Option<PreparedTarget
 pub(crate) fn source_voxel(config: &IcpConfig) -> Option<f32> {
     (config.source_voxel > 0.0).then_some(config.source_voxel)
 }
+
+/// Points as their coordinates in little-endian f64, x, y, z in turn.
+pub(crate) fn points_to_bytes(points: &[Point3<f64>]) -> Vec<u8> {
+    points
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .flat_map(f64::to_le_bytes)
+        .collect()
+}
+
+/// The points [`points_to_bytes`] wrote; `None` for bytes that are not whole points.
+pub(crate) fn points_from_bytes(bytes: &[u8]) -> Option<Vec<Point3<f64>>> {
+    if !bytes.len().is_multiple_of(24) {
+        return None;
+    }
+    let value = |b: &[u8]| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]);
+    Some(
+        bytes
+            .chunks_exact(24)
+            .map(|c| Point3::new(value(&c[..8]), value(&c[8..16]), value(&c[16..])))
+            .collect(),
+    )
+}

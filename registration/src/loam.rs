@@ -395,6 +395,15 @@ impl MapRegistrator for LoamRegistrator {
     /// Thins the map points to the local-map voxels in the sensor frame (the picks to align stay
     /// whole): a 40-keyframe map then merges a few thousand points per keyframe, not every
     /// reliable point of every scan.
+    /// `None`: LOAM's features stay in memory.
+    fn stored_source(&self, _source: &Self::Source) -> Option<Vec<u8>> {
+        None
+    }
+
+    fn restored_source(&self, _bytes: &[u8]) -> Option<Self::Source> {
+        None
+    }
+
     fn keyframe_source(&self, mut source: Self::Source) -> Self::Source {
         let c = &self.config;
         source.edge_map = voxel_thin(source.edge_map, c.local_map_edge_voxel);

@@ -8,4 +8,5 @@ mod degeneracy;
 
 mod loam;
 mod real_scans;
+mod stored_sources;
 mod voxel_hash_map;

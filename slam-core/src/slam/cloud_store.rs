@@ -62,7 +62,8 @@ impl Drop for StoreFile {
     }
 }
 
-/// The keyframes' map clouds, in keyframe order.
+/// The keyframes' map clouds, in keyframe order, and the file their registration points may go
+/// to as well ([`Stash`]).
 #[derive(Default)]
 pub(super) struct KeyframeClouds {
     slots: Vec<Slot>,
@@ -71,6 +72,31 @@ pub(super) struct KeyframeClouds {
     resident: usize,
     /// The first slot still held that may be written out (clouds go out oldest first).
     next_out: usize,
+    /// The first keyframe whose registration points may still be held in memory.
+    pub(super) sources_out: usize,
+}
+
+/// A keyframe's prepared points: in memory, or where the store's file holds them.
+pub(super) enum Stash<T> {
+    Held(T),
+    Stored { offset: u64, len: usize },
+}
+
+/// A stashed value, borrowed when held, read back when stored.
+pub(super) enum Loaded<'a, T> {
+    Borrowed(&'a T),
+    Owned(T),
+}
+
+impl<T> std::ops::Deref for Loaded<'_, T> {
+    type Target = T;
+
+    fn deref(&self) -> &T {
+        match self {
+            Loaded::Borrowed(t) => t,
+            Loaded::Owned(t) => t,
+        }
+    }
 }
 
 /// Distinguishes the files of several engines in one process.
@@ -101,7 +127,75 @@ impl KeyframeClouds {
             file: Some(StoreFile { file, path, end: 0 }),
             resident,
             next_out: 0,
+            sources_out: 0,
         })
+    }
+
+    /// How many keyframes keep their clouds and points in memory, when the store has a file.
+    pub(super) fn resident(&self) -> Option<usize> {
+        self.file.as_ref().map(|_| self.resident)
+    }
+
+    /// Writes `bytes` to the end of the file; where they start. An error without a file.
+    pub(super) fn write_bytes(&mut self, bytes: &[u8]) -> Result<u64, KeyframeCloudError> {
+        let Some(file) = self.file.as_mut() else {
+            return Err(KeyframeCloudError::Store {
+                path: PathBuf::new(),
+                action: "written (no file)",
+                source: std::io::Error::from(std::io::ErrorKind::NotFound),
+            });
+        };
+        let offset = file.end;
+        file.file
+            .seek(SeekFrom::Start(offset))
+            .and_then(|_| file.file.write_all(bytes))
+            .map_err(|source| KeyframeCloudError::Store {
+                path: file.path.clone(),
+                action: "written",
+                source,
+            })?;
+        file.end += bytes.len() as u64;
+        Ok(offset)
+    }
+
+    /// The `len` bytes written at `offset`.
+    pub(super) fn read_bytes(
+        &self,
+        offset: u64,
+        len: usize,
+    ) -> Result<Vec<u8>, KeyframeCloudError> {
+        let Some(file) = self.file.as_ref() else {
+            return Err(KeyframeCloudError::Store {
+                path: PathBuf::new(),
+                action: "read (no file)",
+                source: std::io::Error::from(std::io::ErrorKind::NotFound),
+            });
+        };
+        let mut bytes = vec![0_u8; len];
+        // Reads through a shared handle: `&File` is `Read + Seek`, the store stays `&self`.
+        let mut handle = &file.file;
+        handle
+            .seek(SeekFrom::Start(offset))
+            .and_then(|_| handle.read_exact(&mut bytes))
+            .map_err(|source| KeyframeCloudError::Store {
+                path: file.path.clone(),
+                action: "read",
+                source,
+            })?;
+        Ok(bytes)
+    }
+
+    /// The error for stored bytes a registrator does not take back.
+    pub(super) fn not_restored(&self) -> KeyframeCloudError {
+        KeyframeCloudError::Store {
+            path: self
+                .file
+                .as_ref()
+                .map(|f| f.path.clone())
+                .unwrap_or_default(),
+            action: "read as the registrator's points",
+            source: std::io::Error::from(std::io::ErrorKind::InvalidData),
+        }
     }
 
     /// Number of clouds.
@@ -122,30 +216,22 @@ impl KeyframeClouds {
     /// error is returned for the engine to count.
     pub(super) fn push(&mut self, cloud: PointCloud) -> Result<(), KeyframeCloudError> {
         self.slots.push(Slot::Held(cloud));
-        let Some(file) = self.file.as_mut() else {
+        if self.file.is_none() {
             return Ok(());
-        };
+        }
         while self.slots.len() - self.next_out > self.resident {
             let i = self.next_out;
             let Slot::Held(cloud) = &self.slots[i] else {
                 self.next_out += 1;
                 continue;
             };
-            let offset = file.end;
+            let (len, intensity) = (cloud.len(), cloud.intensity().is_some());
             let bytes = encode(cloud);
-            file.file
-                .seek(SeekFrom::Start(offset))
-                .and_then(|_| file.file.write_all(&bytes))
-                .map_err(|source| KeyframeCloudError::Store {
-                    path: file.path.clone(),
-                    action: "written",
-                    source,
-                })?;
-            file.end += bytes.len() as u64;
+            let offset = self.write_bytes(&bytes)?;
             self.slots[i] = Slot::Stored {
                 offset,
-                len: cloud.len(),
-                intensity: cloud.intensity().is_some(),
+                len,
+                intensity,
             };
             self.next_out += 1;
         }
@@ -171,22 +257,7 @@ impl KeyframeClouds {
         len: usize,
         intensity: bool,
     ) -> Result<PointCloud, KeyframeCloudError> {
-        // Only a store with a file has stored slots.
-        let Some(file) = self.file.as_ref() else {
-            return Ok(PointCloud::new());
-        };
-        let failed = |source| KeyframeCloudError::Store {
-            path: file.path.clone(),
-            action: "read",
-            source,
-        };
-        let mut bytes = vec![0_u8; len * if intensity { 16 } else { 12 }];
-        // Reads through a shared handle: `&File` is `Read + Seek`, the store stays `&self`.
-        let mut handle = &file.file;
-        handle
-            .seek(SeekFrom::Start(offset))
-            .and_then(|_| handle.read_exact(&mut bytes))
-            .map_err(failed)?;
+        let bytes = self.read_bytes(offset, len * if intensity { 16 } else { 12 })?;
         Ok(decode(&bytes, len, intensity)?)
     }
 }

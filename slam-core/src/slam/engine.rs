@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use nalgebra::{Matrix6, UnitQuaternion};
 
-use super::cloud_store::{KeyframeCloudError, KeyframeClouds};
+use super::cloud_store::{KeyframeCloudError, KeyframeClouds, Stash};
 use super::config::GraphSlamConfig;
 use super::gravity::level_on_gravity;
 use super::information::{edge_information, with_tilt};
@@ -217,6 +217,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             }
         }
         self.clouds = store;
+        self.stash_old_points();
         Ok(self)
     }
 
@@ -585,8 +586,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             walked,
             stamp: scan.stamp,
             odom_t_lidar,
-            source: self.odometry.keyframe_source(source),
-            coarse: self.loop_coarse.keyframe_source(coarse),
+            source: Stash::Held(self.odometry.keyframe_source(source)),
+            coarse: Stash::Held(self.loop_coarse.keyframe_source(coarse)),
             matched,
             links: parent
                 .map(|keyframe| Link {
@@ -600,6 +601,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             // Kept in memory instead; counted, the walk goes on.
             self.report.keyframe_store_failures += 1;
         }
+        self.stash_old_points();
         if let Some(from) = parent {
             self.keyframes[from].links.push(Link {
                 keyframe: index,

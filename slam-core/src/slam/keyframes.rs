@@ -5,7 +5,7 @@ use std::borrow::Cow;
 
 use nalgebra::Vector6;
 
-use super::cloud_store::KeyframeCloudError;
+use super::cloud_store::{KeyframeCloudError, KeyframeClouds, Loaded, Stash};
 use super::engine::GraphSlam;
 use crate::cloud::PointCloud;
 use crate::geometry::Pose3;
@@ -18,10 +18,11 @@ pub(super) struct Keyframe<S, C> {
     pub(super) stamp: f64,
     /// The odometry at the keyframe, `None` for a LiDAR-only scan.
     pub(super) odom_t_lidar: Option<Pose3>,
-    /// Prepared for the odometry/refinement registrator.
-    pub(super) source: S,
-    /// Prepared for the coarse loop registrator.
-    pub(super) coarse: C,
+    /// Prepared for the odometry/refinement registrator (read with
+    /// [`GraphSlam::source_of`]).
+    pub(super) source: Stash<S>,
+    /// Prepared for the coarse loop registrator (read with [`GraphSlam::coarse_of`]).
+    pub(super) coarse: Stash<C>,
     /// Distance walked from the first keyframe to this one along the estimate when it was
     /// made (metres): the drift a loop may correct grows with it.
     pub(super) walked: f64,
@@ -33,6 +34,44 @@ pub(super) struct Keyframe<S, C> {
     /// keyframe, or on a revisit the old keyframe the walk rode on) and each accepted loop's
     /// other end, with the loop edge's index in the graph.
     pub(super) links: Vec<Link>,
+}
+
+/// The points in `stash`: borrowed when held, read back from `store`'s file and restored by
+/// `registrator` when written out.
+pub(super) fn source_of<'a, M: MapRegistrator>(
+    stash: &'a Stash<M::Source>,
+    store: &KeyframeClouds,
+    registrator: &M,
+) -> Result<Loaded<'a, M::Source>, KeyframeCloudError> {
+    match stash {
+        Stash::Held(s) => Ok(Loaded::Borrowed(s)),
+        &Stash::Stored { offset, len } => {
+            let bytes = store.read_bytes(offset, len)?;
+            registrator
+                .restored_source(&bytes)
+                .map(Loaded::Owned)
+                .ok_or_else(|| store.not_restored())
+        }
+    }
+}
+
+/// Writes the points held in `stash` to `store`'s file when `registrator` can write them; on a
+/// failed write they stay held.
+fn stash<M: MapRegistrator>(
+    stash: &mut Stash<M::Source>,
+    registrator: &M,
+    store: &mut KeyframeClouds,
+) -> Result<(), KeyframeCloudError> {
+    if let Stash::Held(points) = stash
+        && let Some(bytes) = registrator.stored_source(points)
+    {
+        let offset = store.write_bytes(&bytes)?;
+        *stash = Stash::Stored {
+            offset,
+            len: bytes.len(),
+        };
+    }
+    Ok(())
 }
 
 /// An edge of the graph seen from one of its keyframes.
@@ -89,6 +128,47 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     #[must_use]
     pub fn keyframe_count(&self) -> usize {
         self.keyframes.len()
+    }
+
+    /// Keyframe `i`'s points prepared for the odometry and refinement registrator, read back
+    /// from the store's file when they were written out.
+    pub(super) fn source_of(&self, i: usize) -> Result<Loaded<'_, R::Source>, KeyframeCloudError> {
+        source_of(&self.keyframes[i].source, &self.clouds, &self.odometry)
+    }
+
+    /// Keyframe `i`'s points prepared for the coarse loop registrator, as
+    /// [`GraphSlam::source_of`].
+    pub(super) fn coarse_of(&self, i: usize) -> Result<Loaded<'_, C::Source>, KeyframeCloudError> {
+        source_of(&self.keyframes[i].coarse, &self.clouds, &self.loop_coarse)
+    }
+
+    /// With a store's file, writes out the prepared points of the keyframes older than the
+    /// newest it keeps in memory (those the registrators can write); a write that fails leaves
+    /// them in memory and is counted.
+    pub(super) fn stash_old_points(&mut self) {
+        let Some(resident) = self.clouds.resident() else {
+            return;
+        };
+        while self.clouds.sources_out + resident < self.keyframes.len() {
+            let i = self.clouds.sources_out;
+            self.clouds.sources_out += 1;
+            let failures = usize::from(
+                stash(
+                    &mut self.keyframes[i].source,
+                    &self.odometry,
+                    &mut self.clouds,
+                )
+                .is_err(),
+            ) + usize::from(
+                stash(
+                    &mut self.keyframes[i].coarse,
+                    &self.loop_coarse,
+                    &mut self.clouds,
+                )
+                .is_err(),
+            );
+            self.report.keyframe_store_failures += failures;
+        }
     }
 
     /// Keyframe `i`'s optimised LiDAR pose (`map_T_lidar`).

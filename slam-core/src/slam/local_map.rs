@@ -3,6 +3,7 @@
 //! keyframes the robot was at (the newest keyframes on a first walk; on a revisit, the old ones
 //! it rides on), slid keyframe by keyframe, rebuilt when a loop closure moved them.
 
+use super::keyframes::source_of;
 use std::collections::VecDeque;
 
 use super::engine::GraphSlam;
@@ -71,22 +72,35 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         let keyed = u32::try_from(self.keyframes.len()).is_ok();
         if let (Some(mut target), true) = (self.odometry.empty_map(), keyed) {
+            let mut unread = 0;
             for i in self.window.keys() {
                 let pose = self.keyframe_pose(i);
-                self.odometry
-                    .add_to_map(&mut target, i as u32, &self.keyframes[i].source, &pose);
+                // A keyframe the store cannot give back is left out of the map, and counted.
+                match self.source_of(i) {
+                    Ok(source) => self
+                        .odometry
+                        .add_to_map(&mut target, i as u32, &source, &pose),
+                    Err(_) => unread += 1,
+                }
             }
+            self.report.keyframe_store_failures += unread;
             self.local_map = Some(LocalMap {
                 target,
                 in_place: true,
             });
         } else {
-            let parts: Vec<(&R::Source, Pose3)> = self
+            let loaded: Vec<_> = self
                 .window
                 .keys()
-                .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
+                .filter_map(|i| Some((self.source_of(i).ok()?, self.keyframe_pose(i))))
                 .collect();
-            match self.odometry.target_from_sources(&parts) {
+            let unread = self.window.keys().count() - loaded.len();
+            let parts: Vec<(&R::Source, Pose3)> = loaded.iter().map(|(s, p)| (&**s, *p)).collect();
+            let built = self.odometry.target_from_sources(&parts);
+            drop(parts);
+            drop(loaded);
+            self.report.keyframe_store_failures += unread;
+            match built {
                 Ok(target) => {
                     self.local_map = Some(LocalMap {
                         target,
@@ -116,8 +130,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 }),
                 Ok(key),
             ) => {
-                self.odometry
-                    .add_to_map(target, key, &self.keyframes[index].source, &pose);
+                match source_of(&self.keyframes[index].source, &self.clouds, &self.odometry) {
+                    Ok(source) => self.odometry.add_to_map(target, key, &source, &pose),
+                    Err(_) => self.report.keyframe_store_failures += 1,
+                }
                 if let Some(old) = left {
                     self.odometry.remove_from_map(target, old as u32);
                 }

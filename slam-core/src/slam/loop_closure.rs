@@ -3,6 +3,7 @@
 //! registration against the old keyframe's neighbourhood, the drift the walk allows), closed
 //! with a new edge and one optimisation.
 
+use super::cloud_store::KeyframeCloudError;
 use std::collections::VecDeque;
 use std::time::Instant;
 
@@ -162,12 +163,25 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // Keep the neighbourhood disjoint from the new keyframe's own recent window.
         let hi = (cand + self.config.loop_neighbours)
             .min(new.saturating_sub(self.config.local_map_keyframes));
-        let coarse_parts: Vec<(&C::Source, Pose3)> = (lo..=hi.max(cand))
-            .map(|i| (&self.keyframes[i].coarse, self.keyframe_pose(i)))
-            .collect();
-        let refine_parts: Vec<(&R::Source, Pose3)> = (lo..=hi.max(cand))
-            .map(|i| (&self.keyframes[i].source, self.keyframe_pose(i)))
-            .collect();
+        // Old keyframes' points may come back from the keyframe store's file.
+        let coarse_loaded = (lo..=hi.max(cand))
+            .map(|i| Ok((self.coarse_of(i)?, self.keyframe_pose(i))))
+            .collect::<Result<Vec<_>, KeyframeCloudError>>()
+            .map_err(|_| LoopRejection::CoarseTarget)?;
+        let refine_loaded = (lo..=hi.max(cand))
+            .map(|i| Ok((self.source_of(i)?, self.keyframe_pose(i))))
+            .collect::<Result<Vec<_>, KeyframeCloudError>>()
+            .map_err(|_| LoopRejection::RefineTarget)?;
+        let new_coarse = self
+            .coarse_of(new)
+            .map_err(|_| LoopRejection::CoarseTarget)?;
+        let new_source = self
+            .source_of(new)
+            .map_err(|_| LoopRejection::RefineTarget)?;
+        let coarse_parts: Vec<(&C::Source, Pose3)> =
+            coarse_loaded.iter().map(|(s, p)| (&**s, *p)).collect();
+        let refine_parts: Vec<(&R::Source, Pose3)> =
+            refine_loaded.iter().map(|(s, p)| (&**s, *p)).collect();
         let initial = candidate.guess.unwrap_or_else(|| self.keyframe_pose(new));
         let coarse_target = self
             .loop_coarse
@@ -175,7 +189,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .map_err(|_| LoopRejection::CoarseTarget)?;
         let coarse = self
             .loop_coarse
-            .align(&self.keyframes[new].coarse, &coarse_target, &initial)
+            .align(&new_coarse, &coarse_target, &initial)
             .map_err(|_| LoopRejection::CoarseAlignment)?;
         if !coarse.converged || !pose3_is_finite(&coarse.pose) {
             return Err(LoopRejection::CoarseNotConverged);
@@ -190,7 +204,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .map_err(|_| LoopRejection::RefineTarget)?;
         let refined = self
             .loop_refine
-            .align(&self.keyframes[new].source, &refine_target, &coarse.pose)
+            .align(&new_source, &refine_target, &coarse.pose)
             .map_err(|_| LoopRejection::RefineAlignment)?;
         if !refined.converged || !pose3_is_finite(&refined.pose) {
             return Err(LoopRejection::RefineNotConverged);

@@ -230,6 +230,16 @@ pub trait MapRegistrator: Registrator {
     /// returns may change. A backend with nothing to prepare runs `beside` alone; a wrapper
     /// forwards it (required, as the others are, so that a wrapper cannot lose it unnoticed).
     fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send));
+
+    /// A keyframe's source (as [`MapRegistrator::keyframe_source`] left it) as bytes, for an
+    /// engine that keeps older keyframes in a file
+    /// ([`GraphSlam::with_keyframe_store`](crate::GraphSlam::with_keyframe_store)); `None`
+    /// keeps it in memory. [`MapRegistrator::restored_source`] must give back a source that
+    /// aligns and maps exactly as this one.
+    fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>>;
+
+    /// The source [`MapRegistrator::stored_source`] wrote; `None` when `bytes` are not one.
+    fn restored_source(&self, bytes: &[u8]) -> Option<Self::Source>;
 }
 
 /// A registrator that builds maps only whole: implementing this one method gives it
@@ -280,6 +290,18 @@ pub trait WholeMapRegistrator: Registrator {
         &self,
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError>;
+
+    /// As [`MapRegistrator::stored_source`]; by default `None`, the source kept in memory.
+    fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
+        let _ = source;
+        None
+    }
+
+    /// As [`MapRegistrator::restored_source`]; by default `None`.
+    fn restored_source(&self, bytes: &[u8]) -> Option<Self::Source> {
+        let _ = bytes;
+        None
+    }
 }
 
 impl<R: WholeMapRegistrator> MapRegistrator for R {
@@ -316,5 +338,13 @@ impl<R: WholeMapRegistrator> MapRegistrator for R {
     /// A map built whole is ready when built: `beside` alone.
     fn ready_map_beside(&self, _map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
         beside();
+    }
+
+    fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
+        WholeMapRegistrator::stored_source(self, source)
+    }
+
+    fn restored_source(&self, bytes: &[u8]) -> Option<Self::Source> {
+        WholeMapRegistrator::restored_source(self, bytes)
     }
 }

@@ -14,6 +14,9 @@ pub(super) struct BruteIcp {
 
 pub(super) struct Prepared(pub(super) Vec<Point3<f64>>);
 
+/// How many sources the engines of this test binary read back from a keyframe store.
+pub(super) static RESTORED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 fn points(cloud: &PointCloud, voxel: f32) -> Vec<Point3<f64>> {
     cloud
         .voxel_downsample(voxel)
@@ -137,6 +140,35 @@ impl WholeMapRegistrator for BruteIcp {
             cloud.extend_from(&PointCloud::from_points(pts)).unwrap();
         }
         Ok(Prepared(points(&cloud, 0.2)))
+    }
+
+    /// Exact little-endian f64 coordinates, so that the engine may keep old keyframes' points in
+    /// its keyframe store.
+    fn stored_source(&self, source: &Prepared) -> Option<Vec<u8>> {
+        Some(
+            source
+                .0
+                .iter()
+                .flat_map(|p| [p.x, p.y, p.z])
+                .flat_map(f64::to_le_bytes)
+                .collect(),
+        )
+    }
+
+    fn restored_source(&self, bytes: &[u8]) -> Option<Prepared> {
+        RESTORED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let values: Vec<f64> = bytes
+            .chunks_exact(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        bytes.len().is_multiple_of(24).then(|| {
+            Prepared(
+                values
+                    .chunks_exact(3)
+                    .map(|v| Point3::new(v[0], v[1], v[2]))
+                    .collect(),
+            )
+        })
     }
 }
 

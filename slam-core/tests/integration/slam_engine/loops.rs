@@ -238,11 +238,12 @@ fn every_rejected_loop_is_counted_by_its_reason() {
     assert!(report.loop_rejections.get(LoopRejection::CoarseMismatch) >= 1);
 }
 
-/// The loop walked with the keyframes' map clouds kept in a file past the newest 4: the same
-/// trajectory and map, bit for bit, as with every cloud in memory (the oracle: the engine
-/// without the store), only 4 clouds held, every keyframe's scan read back equal to the one held
-/// in memory, and the file gone with the engine. Moving an engine's clouds to a store midway
-/// gives the same.
+/// The loop walked with the keyframes' map clouds and registration points kept in a file past
+/// the newest 4 (the loop checks and the local map read the old keyframes' points back): the
+/// same trajectory, loops and map, bit for bit, as with everything in memory (the oracle: the
+/// engine without the store), only 4 clouds held, every keyframe's scan read back equal to the
+/// one held in memory, and the file gone with the engine. Moving an engine's keyframes to a
+/// store midway gives the same.
 #[test]
 fn keyframe_clouds_kept_in_a_file_change_nothing_but_memory() {
     let world = hall();
@@ -267,11 +268,14 @@ fn keyframe_clouds_kept_in_a_file_change_nothing_but_memory() {
     }
     let keyframes = held.keyframe_count();
     assert!(keyframes > 20, "{keyframes} keyframes");
+    // The loop checks read old keyframes' points back from the file.
+    assert!(super::backends::RESTORED.load(std::sync::atomic::Ordering::Relaxed) > 0);
     assert!(held.report().loops_closed > 0);
     assert_eq!(held.keyframe_scans_in_memory(), keyframes);
     for slam in [&stored, &moved] {
         assert_eq!(slam.keyframe_scans_in_memory(), 4);
         assert_eq!(slam.report().keyframe_store_failures, 0);
+        assert_eq!(slam.report().loops_closed, held.report().loops_closed);
         assert_eq!(slam.scan_trajectory(), held.scan_trajectory());
         assert_eq!(slam.map(0.1).unwrap(), held.map(0.1).unwrap());
         let scans: Vec<_> = slam.keyframe_scans().map(Result::unwrap).collect();

@@ -102,6 +102,12 @@ impl MapRegistrator for InPlaceIcp {
     fn ready_map_beside(&self, _map: &mut InPlaceMap, beside: &mut (dyn FnMut() + Send)) {
         beside();
     }
+    fn stored_source(&self, _source: &Prepared) -> Option<Vec<u8>> {
+        None
+    }
+    fn restored_source(&self, _bytes: &[u8]) -> Option<Prepared> {
+        None
+    }
 }
 
 /// A local map slid in place (one keyframe in, the oldest out) must hold exactly the window a
