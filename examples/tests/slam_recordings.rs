@@ -363,3 +363,57 @@ fn a_ground_truth_file_replaces_the_recordings_own_and_says_so() {
     let _ = std::fs::remove_file(&truth);
     let _ = std::fs::remove_file(&summary);
 }
+
+/// `--keyframes-in-memory 2` keeps the older keyframes of an 8-scan walk in a file: the same
+/// trajectory and map, byte for byte, as with every keyframe in memory, and the file gone
+/// afterwards.
+#[test]
+fn keyframes_kept_in_a_file_give_the_same_map() {
+    let (scans, poses) = moving_folder("stored");
+    let (tum, kitti) = truth_files(&scans, &poses);
+    let stores = || {
+        std::fs::read_dir(std::env::temp_dir()).map_or(0, |d| {
+            d.filter_map(Result::ok)
+                .filter(|e| {
+                    e.file_name()
+                        .to_string_lossy()
+                        .starts_with("spot-nav-keyframes-")
+                })
+                .count()
+        })
+    };
+    let before = stores();
+    let mut outputs = Vec::new();
+    for store in [None, Some("2")] {
+        let out = temp_dir(if store.is_some() {
+            "stored-out"
+        } else {
+            "held-out"
+        });
+        let mut command = Command::new(example("slam"));
+        command
+            .arg(&scans)
+            .arg("--ground-truth")
+            .arg(&tum)
+            .arg("--out")
+            .arg(&out);
+        if let Some(n) = store {
+            command.arg("--keyframes-in-memory").arg(n);
+        }
+        let run = command.output().expect("slam runs");
+        let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+        assert!(
+            run.status.success(),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let read = |name: &str| std::fs::read(out.join(name)).expect(name);
+        outputs.push((read("trajectory.tum"), read("map.ply"), read("graph.g2o")));
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    assert!(outputs[0] == outputs[1], "the stored run's outputs differ");
+    assert_eq!(stores(), before, "the store's file was left behind");
+    let _ = std::fs::remove_dir_all(&scans);
+    let _ = std::fs::remove_file(&tum);
+    let _ = std::fs::remove_file(&kitti);
+}

@@ -182,6 +182,11 @@ pub(crate) struct Args {
     /// loops are found however far the estimate drifted).
     #[arg(long)]
     pub(crate) no_place_recognition: bool,
+    /// Keep only the newest N keyframes' scans and registration points in memory and the older
+    /// ones in a file in the system's temporary folder (removed at the end), for long
+    /// recordings; by default every keyframe stays in memory.
+    #[arg(long, value_name = "N")]
+    pub(crate) keyframes_in_memory: Option<usize>,
     /// Write the map, trajectory, pose graph, grid and summary.json to this folder.
     #[arg(long, value_name = "DIR")]
     pub(crate) out: Option<PathBuf>,

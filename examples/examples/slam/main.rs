@@ -259,6 +259,9 @@ where
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
+            if let Some(n) = args.keyframes_in_memory {
+                slam = slam.with_keyframe_store(&std::env::temp_dir(), n)?;
+            }
             let run = map_samples(&mut slam, &mut *samples, label, context.lidar_only)?;
             let points = dropped(samples);
             finish(&slam, &run, &body_t_lidar, points, args, context)
@@ -267,6 +270,9 @@ where
             let mut slam = loam_slam(config)?;
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
+            }
+            if let Some(n) = args.keyframes_in_memory {
+                slam = slam.with_keyframe_store(&std::env::temp_dir(), n)?;
             }
             let run = map_samples(&mut slam, &mut *samples, label, context.lidar_only)?;
             let points = dropped(samples);
