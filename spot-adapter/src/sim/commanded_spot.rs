@@ -306,7 +306,7 @@ impl CommandedSpot {
                 // The ground follows a line through the step tops, from half a tread before
                 // the foot to half a tread past the top (as the floors tour's walk does),
                 // With the jolts and the nod of a body taking the steps.
-                let (ground, nod) = stairs_ground(f, u);
+                let ground = stairs_ground(f, u);
                 let along = Vector2::new(heading.cos(), heading.sin()).dot(&f.up);
                 return Some(Footing {
                     floor: if u >= f.run() + 0.5 * f.tread {
@@ -314,8 +314,8 @@ impl CommandedSpot {
                     } else {
                         on_floor
                     },
-                    ground,
-                    pitch: (f.walk_slope(u) * along).atan() + nod * along,
+                    ground: ground.height,
+                    pitch: (ground.slope * along).atan() + ground.nod * along,
                 });
             }
         }

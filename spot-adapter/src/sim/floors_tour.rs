@@ -154,8 +154,8 @@ impl FloorsTour {
             .find(|r| (r.s0..=r.s1).contains(&s))
             .map_or((0.0, 0.0), |r| {
                 let u = r.along(s);
-                let (height, nod) = stairs_ground(&r.flight, u);
-                (height - r.flight.walk_height(u), nod)
+                let ground = stairs_ground(&r.flight, u);
+                (ground.height - ground.line, ground.nod)
             })
     }
 

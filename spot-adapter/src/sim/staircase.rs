@@ -188,28 +188,35 @@ impl Staircase {
     /// rise from [`Staircase::surface_at`].
     #[must_use]
     pub fn walk_height(&self, u: f64) -> f64 {
-        let knots = self.walk_knots();
-        let (first, last) = (knots[0], knots[knots.len() - 1]);
-        if u <= first.0 {
-            return first.1;
-        }
-        if u >= last.0 {
-            return last.1;
-        }
-        knots.windows(2).find(|w| u <= w[1].0).map_or(last.1, |w| {
-            w[0].1 + (w[1].1 - w[0].1) * (u - w[0].0) / (w[1].0 - w[0].0)
-        })
+        self.walk_at(u).0
     }
 
     /// The slope of [`Staircase::walk_height`] at `u` (rise over run; 0 off the flight and on
     /// a landing's level part).
     #[must_use]
     pub fn walk_slope(&self, u: f64) -> f64 {
+        self.walk_at(u).1
+    }
+
+    /// [`Staircase::walk_height`] and [`Staircase::walk_slope`] at `u`, from one pass over the
+    /// line's knots.
+    #[must_use]
+    pub fn walk_at(&self, u: f64) -> (f64, f64) {
         let knots = self.walk_knots();
+        let (first, last) = (knots[0], knots[knots.len() - 1]);
+        if u < first.0 {
+            return (first.1, 0.0);
+        }
+        if u >= last.0 {
+            return (last.1, 0.0);
+        }
         knots
             .windows(2)
             .find(|w| u >= w[0].0 && u < w[1].0)
-            .map_or(0.0, |w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0))
+            .map_or((last.1, 0.0), |w| {
+                let slope = (w[1].1 - w[0].1) / (w[1].0 - w[0].0);
+                (w[0].1 + slope * (u - w[0].0), slope)
+            })
     }
 
     /// The knots (distance past the foot, height) of [`Staircase::walk_height`], in order.

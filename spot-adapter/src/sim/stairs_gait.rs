@@ -12,16 +12,33 @@ pub const STAIRS_JOLT: f64 = 0.3;
 /// nose up as the front legs reach the next step, down as the hind legs follow.
 pub const STAIRS_NOD: f64 = 0.026;
 
-/// The body's ground on `flight`, `u` metres past its foot along it: its height (metres) with
-/// the step jolts, and the pitch the nod adds (radians, positive nose up going up the flight;
-/// zero off the flight's slopes and on a landing's level part).
-pub(crate) fn stairs_ground(flight: &Staircase, u: f64) -> (f64, f64) {
-    let line = flight.walk_height(u);
+/// The body's ground on `flight`, `u` metres past its foot along it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StairsGround {
+    /// The smooth walking line's height ([`Staircase::walk_height`], metres).
+    pub(crate) line: f64,
+    /// Its slope ([`Staircase::walk_slope`], rise over run).
+    pub(crate) slope: f64,
+    /// The body's ground with the step jolts (metres).
+    pub(crate) height: f64,
+    /// The pitch the nod adds (radians, positive nose up going up the flight; zero off the
+    /// flight's slopes and on a landing's level part).
+    pub(crate) nod: f64,
+}
+
+/// [`StairsGround`] on `flight` at `u` metres past its foot.
+pub(crate) fn stairs_ground(flight: &Staircase, u: f64) -> StairsGround {
+    let (line, slope) = flight.walk_at(u);
     let height = line + STAIRS_JOLT * (flight.surface_at(u) - line);
-    let nod = if flight.walk_slope(u) == 0.0 {
+    let nod = if slope == 0.0 {
         0.0
     } else {
         STAIRS_NOD * (std::f64::consts::TAU * u / flight.tread).sin()
     };
-    (height, nod)
+    StairsGround {
+        line,
+        slope,
+        height,
+        nod,
+    }
 }
