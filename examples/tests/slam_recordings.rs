@@ -167,6 +167,28 @@ fn slam_succeeds(recording: &Path, truth: &Path, option: &str, path: &Path) -> S
     stdout
 }
 
+/// `slam SCANS --ground-truth TRUTH --out OUT EXTRA...` succeeds; OUT (a fresh temporary
+/// folder named `name`).
+fn slam_writes(scans: &Path, truth: &Path, extra: &[&str], name: &str) -> PathBuf {
+    let out = temp_dir(name);
+    let run = Command::new(example("slam"))
+        .arg(scans)
+        .arg("--ground-truth")
+        .arg(truth)
+        .arg("--out")
+        .arg(&out)
+        .args(extra)
+        .output()
+        .expect("slam runs");
+    assert!(
+        run.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    out
+}
+
 /// The summary.json at `path`.
 fn summary_json(path: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(path).expect("summary.json written");
@@ -385,27 +407,19 @@ fn keyframes_kept_in_a_file_give_the_same_map() {
     let before = stores();
     let mut outputs = Vec::new();
     for store in [None, Some("2")] {
-        let out = temp_dir(if store.is_some() {
-            "stored-out"
-        } else {
-            "held-out"
-        });
-        let mut command = Command::new(example("slam"));
-        command
-            .arg(&scans)
-            .arg("--ground-truth")
-            .arg(&tum)
-            .arg("--out")
-            .arg(&out);
-        if let Some(n) = store {
-            command.arg("--keyframes-in-memory").arg(n);
-        }
-        let run = command.output().expect("slam runs");
-        let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
-        assert!(
-            run.status.success(),
-            "{stdout}\n{}",
-            String::from_utf8_lossy(&run.stderr)
+        let extra: &[&str] = match store {
+            Some(n) => &["--keyframes-in-memory", n],
+            None => &[],
+        };
+        let out = slam_writes(
+            &scans,
+            &tum,
+            extra,
+            if store.is_some() {
+                "stored-out"
+            } else {
+                "held-out"
+            },
         );
         let read = |name: &str| std::fs::read(out.join(name)).expect(name);
         outputs.push((read("trajectory.tum"), read("map.ply"), read("graph.g2o")));
@@ -413,6 +427,61 @@ fn keyframes_kept_in_a_file_give_the_same_map() {
     }
     assert!(outputs[0] == outputs[1], "the stored run's outputs differ");
     assert_eq!(stores(), before, "the store's file was left behind");
+    let _ = std::fs::remove_dir_all(&scans);
+    let _ = std::fs::remove_file(&tum);
+    let _ = std::fs::remove_file(&kitti);
+}
+
+/// `--tracker-map-voxel 0.1` keeps the tracker's local map at 0.1 m instead of 0.2 m: the
+/// summary says so and the walk's trajectory differs from the default's; a voxel the tracker
+/// refuses is named by its setting, and the option is refused with LOAM, each before anything
+/// is written.
+#[test]
+fn the_trackers_map_voxel_is_set_or_refused_by_name() {
+    let (scans, poses) = moving_folder("map-voxel");
+    let (tum, kitti) = truth_files(&scans, &poses);
+    let mut runs = Vec::new();
+    for voxel in [None, Some("0.1")] {
+        let extra: &[&str] = match voxel {
+            Some(v) => &["--tracker-map-voxel", v],
+            None => &[],
+        };
+        let out = slam_writes(
+            &scans,
+            &tum,
+            extra,
+            if voxel.is_some() {
+                "fine-out"
+            } else {
+                "coarse-out"
+            },
+        );
+        let json = summary_json(&out.join("summary.json"));
+        let trajectory = std::fs::read(out.join("trajectory.tum")).expect("trajectory.tum");
+        runs.push((json["tracker_map_voxel"].as_f64(), trajectory));
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    let near = |v: Option<f64>, want: f64| v.is_some_and(|v| (v - want).abs() < 1e-6);
+    assert!(near(runs[0].0, 0.2), "{:?}", runs[0].0);
+    assert!(near(runs[1].0, 0.1), "{:?}", runs[1].0);
+    assert!(runs[0].1 != runs[1].1, "the finer map changed nothing");
+    let out = temp_dir("refused-out");
+    slam_fails_leaving_nothing(
+        &[scans.as_os_str(), "--tracker-map-voxel=-1".as_ref()],
+        &out,
+        &["--tracker-map-voxel -1", "IcpConfig::target_voxel"],
+    );
+    slam_fails_leaving_nothing(
+        &[
+            scans.as_os_str(),
+            "--registration".as_ref(),
+            "loam".as_ref(),
+            "--tracker-map-voxel".as_ref(),
+            "0.1".as_ref(),
+        ],
+        &out,
+        &["--tracker-map-voxel", "point-to-plane"],
+    );
     let _ = std::fs::remove_dir_all(&scans);
     let _ = std::fs::remove_file(&tum);
     let _ = std::fs::remove_file(&kitti);

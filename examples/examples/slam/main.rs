@@ -23,7 +23,7 @@ use anyhow::Result;
 use clap::Parser;
 use slam_core::io::StampedPose;
 use slam_core::{EdgeInformation, GraphSlamConfig, Pose3};
-use spot_adapter::pipelines::{loam_slam, point_to_plane_slam, scan_context_places};
+use spot_adapter::pipelines::{loam_slam, point_to_plane_slam_with, scan_context_places};
 use spot_adapter::record::{DroppedPoints, ReadAhead, SampleSource, open_recording};
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
@@ -81,6 +81,8 @@ fn slam(args: &Args) -> Result<()> {
     if let Some(format) = args.settings.print_config {
         return print_settings(&Settings { slam: config }, format);
     }
+    // A bad tracker setting fails before the recording is read or the building made.
+    args.tracker()?;
     if let Some(path) = &args.recording {
         replay(args, config, path)
     } else {
@@ -255,7 +257,7 @@ where
     };
     match args.registration {
         Registration::PointToPlane => {
-            let mut slam = point_to_plane_slam(config)?;
+            let mut slam = point_to_plane_slam_with(config, args.tracker()?)?;
             if !args.no_place_recognition {
                 slam = slam.with_place_recognizer(scan_context_places());
             }
