@@ -7,7 +7,7 @@ use slam_core::{PointCloud, Pose3};
 use crate::band::{Height, ObstacleBandConfig, band_at, classify};
 use crate::builder::OccupancyGridBuilder;
 use crate::config::OccupancyGridConfig;
-use crate::error::GridMapError;
+use crate::error::{GridMapError, check_finite_points};
 use crate::floor::FloorMap;
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::{below_top, clip_to_bounds, floor_i64, traverse};
@@ -163,13 +163,25 @@ impl FloorBandAccumulator {
     /// [`GridMapError::NonFinitePoints`] for a scan with a non-finite point,
     /// [`GridMapError::TooManyCells`] when the grid would grow beyond `max_cells`.
     pub fn add_scans(&mut self, scans: &[(Pose3, &PointCloud)]) -> Result<(), GridMapError> {
+        let points: Vec<(Pose3, &[Point3<f32>])> =
+            scans.iter().map(|(pose, c)| (*pose, c.points())).collect();
+        self.add_scan_points(&points)
+    }
+
+    /// [`Self::add_scans`] for scans given as their points alone (a caller that keeps many
+    /// scans' points in a few large buffers rather than a cloud each).
+    ///
+    /// # Errors
+    /// As [`Self::add_scans`].
+    pub fn add_scan_points(
+        &mut self,
+        scans: &[(Pose3, &[Point3<f32>])],
+    ) -> Result<(), GridMapError> {
         // 1. The extent with this batch, checked before anything changes.
         let mut bounds = self.bounds;
         let mut any_hit = self.any_hit;
         for (pose, cloud) in scans {
-            if !cloud.is_empty() {
-                OccupancyGridBuilder::check_cloud(cloud)?;
-            }
+            check_finite_points(cloud)?;
             let mut grow = |p: Vector2<f64>| {
                 bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.inf(&p), hi.sup(&p))));
             };
@@ -310,10 +322,9 @@ impl FloorBandAccumulator {
 /// The points of `cloud` in the world frame.
 pub(crate) fn world_points<'a>(
     pose: &'a Pose3,
-    cloud: &'a PointCloud,
+    cloud: &'a [Point3<f32>],
 ) -> impl Iterator<Item = Point3<f64>> + 'a {
     cloud
-        .points()
         .iter()
         .map(move |p| pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
 }

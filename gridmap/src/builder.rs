@@ -54,7 +54,7 @@ impl OccupancyGridBuilder {
         if cloud.is_empty() {
             return Err(GridMapError::EmptyCloud);
         }
-        check_finite_points(cloud)
+        check_finite_points(cloud.points())
     }
 
     fn slice_bounds(&self, lidar_height: f64) -> Result<(f64, f64), GridMapError> {

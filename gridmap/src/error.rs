@@ -142,9 +142,8 @@ pub(crate) fn check_not_negative(settings: &[(&'static str, f64)]) -> Result<(),
 }
 
 /// [`GridMapError::NonFinitePoints`] when any point of `cloud` has a coordinate that is not finite.
-pub(crate) fn check_finite_points(cloud: &slam_core::PointCloud) -> Result<(), GridMapError> {
+pub(crate) fn check_finite_points(cloud: &[nalgebra::Point3<f32>]) -> Result<(), GridMapError> {
     let bad = cloud
-        .points()
         .iter()
         .filter(|p| !p.iter().all(|v| v.is_finite()))
         .count();

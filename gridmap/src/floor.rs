@@ -156,14 +156,28 @@ impl FloorMap {
         hints: &[Point3<f64>],
         config: &FloorConfig,
     ) -> Result<Self, GridMapError> {
+        let points: Vec<(Pose3, &[Point3<f32>])> =
+            scans.iter().map(|(pose, c)| (*pose, c.points())).collect();
+        Self::estimate_from_scan_points(&points, hints, config)
+    }
+
+    /// [`FloorMap::estimate_from_scans`] for scans given as their points alone (a caller that
+    /// keeps many scans' points in a few large buffers rather than a cloud each).
+    ///
+    /// # Errors
+    /// As [`FloorMap::estimate_from_scans`].
+    pub fn estimate_from_scan_points(
+        scans: &[(Pose3, &[Point3<f32>])],
+        hints: &[Point3<f64>],
+        config: &FloorConfig,
+    ) -> Result<Self, GridMapError> {
         if scans.iter().all(|(_, c)| c.is_empty()) {
             return Err(GridMapError::EmptyCloud);
         }
         let bad: usize = scans
             .iter()
             .map(|(_, c)| {
-                c.points()
-                    .iter()
+                c.iter()
                     .filter(|p| !p.iter().all(|v| v.is_finite()))
                     .count()
             })
@@ -174,7 +188,6 @@ impl FloorMap {
         // Transformed on every pass rather than stored: a map's scans hold millions of points.
         let points = scans.iter().flat_map(|(pose, cloud)| {
             cloud
-                .points()
                 .iter()
                 .map(move |p| pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
         });

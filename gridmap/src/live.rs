@@ -443,7 +443,7 @@ impl LiveLayer {
             }
             .into());
         }
-        check_finite_points(scan)?;
+        check_finite_points(scan.points())?;
         let g = *self.combined.geometry();
         let res = g.resolution;
         let n = self.n;
