@@ -5,7 +5,7 @@ use std::borrow::Cow;
 use std::collections::HashSet;
 
 use gridmap::{FloorBandAccumulator, FloorMap, floor_hints_below};
-use nalgebra::{Point3, Vector2};
+use nalgebra::{Isometry3, Point3, Vector2};
 use rustc_hash::FxHashMap;
 use slam_core::{
     CloudError, GraphSlam, KeyframeCloudError, MapRegistrator, Optimizer, PointCloud, Pose3,
@@ -15,6 +15,7 @@ use crate::nav::NavError;
 use crate::nav::config::NavigationMapConfig;
 use crate::nav::error::ExplorationError;
 use crate::nav::navigation_map::NavigationMap;
+use crate::nav::scan_blocks::ScanBlocks;
 
 /// A rendered keyframe that moved farther than this share of a grid cell (or turned so far that
 /// a point [`GrowingMap`]'s `range` away moved so far) since it was rendered calls for a full
@@ -121,10 +122,9 @@ impl GrowingMap {
         } else {
             let fresh = self.pick(keyframes);
             let loaded = load(keyframes, &fresh)?;
-            let scans: Vec<(Pose3, &PointCloud)> =
-                loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
+            let scans = loaded.scans();
             if let Some(band) = self.band.as_mut() {
-                band.add_scans(&scans).map_err(grid_error)?;
+                band.add_scan_points(&scans).map_err(grid_error)?;
             }
             self.cloud.add(&scans).map_err(map_error)?;
             self.rendered
@@ -159,16 +159,15 @@ impl GrowingMap {
         self.seen = 0;
         let picked = self.pick(keyframes);
         let loaded = load(keyframes, &picked)?;
-        let scans: Vec<(Pose3, &PointCloud)> =
-            loaded.iter().map(|(p, c)| (*p, c.as_ref())).collect();
+        let scans = loaded.scans();
         let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
         let hints = floor_hints_below(&poses, self.lidar_height);
-        let floor = FloorMap::estimate_from_scans(&scans, &hints, &self.config.floor)
+        let floor = FloorMap::estimate_from_scan_points(&scans, &hints, &self.config.floor)
             .map_err(grid_error)?;
         let mut band =
             FloorBandAccumulator::new(self.config.grid.clone(), floor, self.config.band.clone())
                 .map_err(grid_error)?;
-        band.add_scans(&scans).map_err(grid_error)?;
+        band.add_scan_points(&scans).map_err(grid_error)?;
         self.cloud.clear();
         self.cloud.add(&scans).map_err(map_error)?;
         self.band = Some(band);
@@ -255,18 +254,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> Keyframes
     }
 }
 
-/// The poses and scans of keyframes `picked`.
-fn load<'k, E: std::error::Error + Send + Sync + 'static>(
-    keyframes: &'k (impl Keyframes + ?Sized),
+/// The poses and points of keyframes `picked`, read one at a time into [`ScanBlocks`]: a full
+/// render holds every rendered keyframe's points at once.
+fn load<E: std::error::Error + Send + Sync + 'static>(
+    keyframes: &(impl Keyframes + ?Sized),
     picked: &[usize],
-) -> Result<Vec<(Pose3, Cow<'k, PointCloud>)>, ExplorationError<E>> {
-    picked
-        .iter()
-        .map(|&k| {
-            let pose = keyframes.pose(k).unwrap_or_else(Pose3::identity);
-            Ok((pose, keyframes.scan(k).map_err(ExplorationError::Map)?))
-        })
-        .collect()
+) -> Result<ScanBlocks, ExplorationError<E>> {
+    let mut blocks = ScanBlocks::default();
+    for &k in picked {
+        let pose = keyframes.pose(k).unwrap_or_else(Pose3::identity);
+        let scan = keyframes.scan(k).map_err(ExplorationError::Map)?;
+        blocks.push(pose, scan.points());
+    }
+    Ok(blocks)
 }
 
 /// A cloud error as the exploration names it.
@@ -298,18 +298,19 @@ impl VoxelCentroids {
         self.sums.clear();
     }
 
-    /// Adds each scan's points moved by its pose (non-finite ones skipped).
+    /// Adds each scan's points moved by its pose (non-finite ones skipped), as
+    /// [`PointCloud::transformed`] moves them.
     ///
     /// # Errors
     /// [`CloudError::InvalidVoxelSize`] unless the voxel is finite and positive.
-    pub(crate) fn add(&mut self, scans: &[(Pose3, &PointCloud)]) -> Result<(), CloudError> {
+    pub(crate) fn add(&mut self, scans: &[(Pose3, &[Point3<f32>])]) -> Result<(), CloudError> {
         if !(self.voxel.is_finite() && self.voxel > 0.0) {
             return Err(CloudError::InvalidVoxelSize { size: self.voxel });
         }
         let inv = 1.0 / f64::from(self.voxel);
-        for (pose, cloud) in scans {
-            let moved = cloud.transformed(pose);
-            for p in moved.points() {
+        for (pose, points) in scans {
+            let t: Isometry3<f32> = nalgebra::convert(*pose);
+            for p in points.iter().map(|p| t * p) {
                 if !p.iter().all(|v| v.is_finite()) {
                     continue;
                 }

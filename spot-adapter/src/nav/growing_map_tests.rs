@@ -41,8 +41,8 @@ fn refs(scans: &[(Pose3, PointCloud)]) -> Vec<(Pose3, &PointCloud)> {
 fn centroids_grown_scan_by_scan_are_the_merged_scans_thinned() {
     let scans: Vec<_> = (0..5).map(|k| corridor_scan(0.7 * f64::from(k))).collect();
     let mut grown = VoxelCentroids::new(0.1);
-    for s in refs(&scans) {
-        grown.add(&[s]).unwrap();
+    for (pose, cloud) in &scans {
+        grown.add(&[(*pose, cloud.points())]).unwrap();
     }
     let mut merged = PointCloud::new();
     for (pose, cloud) in &scans {
@@ -54,7 +54,11 @@ fn centroids_grown_scan_by_scan_are_the_merged_scans_thinned() {
     for (g, w) in got.points().iter().zip(want.points()) {
         assert!((g - w).norm() < 1e-5, "{g} vs {w}");
     }
-    assert!(VoxelCentroids::new(f32::NAN).add(&refs(&scans)).is_err());
+    assert!(
+        VoxelCentroids::new(f32::NAN)
+            .add(&[(scans[0].0, scans[0].1.points())])
+            .is_err()
+    );
 }
 
 /// Keyframes walked along the corridor: one a square of 1 m and the newest are rendered, only
@@ -180,7 +184,7 @@ fn the_cloud_within_reach_is_the_whole_cloud_filtered() {
         .collect();
     let mut centroids = VoxelCentroids::new(0.2);
     centroids
-        .add(&[(Pose3::identity(), &PointCloud::from_points(points))])
+        .add(&[(Pose3::identity(), points.as_slice())])
         .unwrap();
     let whole = centroids.cloud();
     for (at, reach) in [

@@ -76,6 +76,7 @@ mod navigation_map;
 mod navigator;
 mod path;
 mod planner;
+mod scan_blocks;
 mod stairs_climb;
 mod stairs_links;
 mod step;
