@@ -278,9 +278,16 @@ fn map_error<E: std::error::Error + Send + Sync + 'static>(
 
 /// Points of placed scans thinned to one centroid per cubic voxel, added scan by scan: the
 /// cloud [`PointCloud::voxel_downsample`] gives for the scans merged in the order added.
+///
+/// The large building's whole map holds about 2 million voxels: their keys are packed into a
+/// `u64` and their slots into a `u32` (16-byte index entries, not 32), with the rare voxel that
+/// does not fit in a map of its own, so no two voxels ever share an entry.
 pub(crate) struct VoxelCentroids {
     voxel: f32,
-    index: FxHashMap<[i64; 3], usize>,
+    /// Slots in `sums` by packed key ([`packed`]).
+    index: FxHashMap<u64, u32>,
+    /// Slots of the voxels whose key does not pack or whose slot passed `u32::MAX`.
+    far: FxHashMap<[i64; 3], usize>,
     sums: Vec<([f64; 3], u32)>,
 }
 
@@ -289,13 +296,37 @@ impl VoxelCentroids {
         Self {
             voxel,
             index: FxHashMap::default(),
+            far: FxHashMap::default(),
             sums: Vec::new(),
         }
     }
 
     pub(crate) fn clear(&mut self) {
         self.index.clear();
+        self.far.clear();
         self.sums.clear();
+    }
+
+    /// The slot of voxel `key`, a new one at the end of `sums` when it has none yet.
+    fn slot(&mut self, key: [i64; 3]) -> usize {
+        let packed = packed(key);
+        if let Some(&slot) = packed.and_then(|p| self.index.get(&p)) {
+            return slot as usize;
+        }
+        if let Some(&slot) = self.far.get(&key) {
+            return slot;
+        }
+        let next = self.sums.len();
+        self.sums.push(([0.0; 3], 0));
+        match (packed, u32::try_from(next)) {
+            (Some(p), Ok(slot)) => {
+                self.index.insert(p, slot);
+            }
+            _ => {
+                self.far.insert(key, next);
+            }
+        }
+        next
     }
 
     /// Adds each scan's points moved by its pose (non-finite ones skipped), as
@@ -315,12 +346,7 @@ impl VoxelCentroids {
                     continue;
                 }
                 let v = [f64::from(p.x), f64::from(p.y), f64::from(p.z)];
-                let key = v.map(|c| (c * inv).floor() as i64);
-                let next = self.sums.len();
-                let slot = *self.index.entry(key).or_insert(next);
-                if slot == next {
-                    self.sums.push(([0.0; 3], 0));
-                }
+                let slot = self.slot(v.map(|c| (c * inv).floor() as i64));
                 let (sum, count) = &mut self.sums[slot];
                 for (s, c) in sum.iter_mut().zip(v) {
                     *s += c;
@@ -365,6 +391,16 @@ impl VoxelCentroids {
     pub(crate) fn cloud(&self) -> PointCloud {
         PointCloud::from_points(self.sums.iter().map(|(s, n)| centroid(s, *n)).collect())
     }
+}
+
+/// Voxel coordinates within 2^20 of the origin (105 km at 0.1 m) packed 21 bits an axis;
+/// `None` farther out.
+fn packed(key: [i64; 3]) -> Option<u64> {
+    const HALF: i64 = 1 << 20;
+    key.iter().try_fold(0u64, |packed, &c| {
+        let offset = u64::try_from(c.checked_add(HALF)?).ok()?;
+        (offset < 1 << 21).then_some(packed << 21 | offset)
+    })
 }
 
 /// The centroid of `n` points summing to `sum`, as the map cloud stores it.

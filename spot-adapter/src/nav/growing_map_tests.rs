@@ -61,6 +61,70 @@ fn centroids_grown_scan_by_scan_are_the_merged_scans_thinned() {
     );
 }
 
+/// Voxels whose keys do not pack (beyond 2^20 voxels on an axis, in either direction) keep
+/// their own centroids beside the packed ones: the cloud is still the merged scans thinned by
+/// [`PointCloud::voxel_downsample`] (the oracle, with its own keys), non-finite points skipped.
+#[test]
+fn centroids_far_out_and_near_are_the_merged_scans_thinned() {
+    // 2^20 voxels of 0.1 m are 104,858 m: points at ±105 km and beyond take the other map.
+    let offsets = [0.0f32, 104_000.0, -104_800.0, 105_000.0, -106_000.0, 3.0e6];
+    let scans: Vec<(Pose3, PointCloud)> = (0..4)
+        .map(|k| {
+            let mut points = Vec::new();
+            for (j, &far) in offsets.iter().enumerate() {
+                for i in 0..50 {
+                    let f = (i + 7 * k) as f32;
+                    let p = Point3::new(far + (f * 0.37).sin(), (f * 0.11).cos() * 0.5, 0.02 * f);
+                    // The same place seen along each axis.
+                    points.push([p, p.yzx(), p.zxy()][j % 3]);
+                }
+            }
+            points.push(Point3::new(f32::NAN, 0.0, 0.0));
+            points.push(Point3::new(0.0, f32::INFINITY, 0.0));
+            let pose = Pose3::translation(0.05 * f64::from(k), -0.03 * f64::from(k), 0.0);
+            (pose, PointCloud::from_points(points))
+        })
+        .collect();
+    let mut grown = VoxelCentroids::new(0.1);
+    for (pose, cloud) in &scans {
+        grown.add(&[(*pose, cloud.points())]).unwrap();
+    }
+    assert!(!grown.far.is_empty() && !grown.index.is_empty());
+    let mut merged = PointCloud::new();
+    for (pose, cloud) in &scans {
+        merged.extend_from(&cloud.transformed(pose)).unwrap();
+    }
+    let want = merged.voxel_downsample(0.1).unwrap();
+    let got = grown.cloud();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.points().iter().zip(want.points()) {
+        let scale = w.coords.amax().max(1.0);
+        assert!((g - w).amax() <= 1e-6 * scale, "{g} vs {w}");
+    }
+}
+
+/// Keys pack 21 bits an axis within 2^20 voxels of the origin, and no farther.
+#[test]
+fn voxel_keys_pack_within_two_to_the_twenty() {
+    let edge = 1i64 << 20;
+    assert_eq!(
+        packed([0, 0, 0]),
+        Some((edge as u64) << 42 | (edge as u64) << 21 | edge as u64)
+    );
+    assert!(packed([-edge, edge - 1, 0]).is_some());
+    for bad in [
+        [edge, 0, 0],
+        [0, -edge - 1, 0],
+        [0, 0, i64::MAX],
+        [i64::MIN, 0, 0],
+    ] {
+        assert_eq!(packed(bad), None, "{bad:?}");
+    }
+    let a = packed([-edge, 5, edge - 1]);
+    assert_ne!(a, packed([-edge, 6, edge - 1]));
+    assert_ne!(a, packed([edge - 1, 5, -edge]));
+}
+
 /// Keyframes walked along the corridor: one a square of 1 m and the newest are rendered, only
 /// the new ones at each update; the grid is the one all of them give at once; a keyframe moved
 /// by more than half a cell, or a map grown by half, is rendered afresh.
