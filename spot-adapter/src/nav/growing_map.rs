@@ -280,8 +280,8 @@ fn map_error<E: std::error::Error + Send + Sync + 'static>(
 /// cloud [`PointCloud::voxel_downsample`] gives for the scans merged in the order added.
 ///
 /// The large building's whole map holds about 2 million voxels: their keys are packed into a
-/// `u64` and their slots into a `u32` (16-byte index entries, not 32), with the rare voxel that
-/// does not fit in a map of its own, so no two voxels ever share an entry.
+/// `u64` and their slots into a `u32` (16-byte index entries, not 32); the rare voxel whose key
+/// or slot does not fit is kept in a map of its own, so no two voxels ever share an entry.
 pub(crate) struct VoxelCentroids {
     voxel: f32,
     /// Slots in `sums` by packed key ([`packed`]).
