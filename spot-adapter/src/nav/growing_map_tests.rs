@@ -36,19 +36,25 @@ fn refs(scans: &[(Pose3, PointCloud)]) -> Vec<(Pose3, &PointCloud)> {
     scans.iter().map(|(p, c)| (*p, c)).collect()
 }
 
+/// `scans` added one at a time to 0.1 m centroids, and the oracle: the scans merged and thinned
+/// at once by [`PointCloud::voxel_downsample`].
+fn grown_and_thinned(scans: &[(Pose3, PointCloud)]) -> (VoxelCentroids, PointCloud) {
+    let mut grown = VoxelCentroids::new(0.1);
+    for (pose, cloud) in scans {
+        grown.add(&[(*pose, cloud.points())]).unwrap();
+    }
+    let mut merged = PointCloud::new();
+    for (pose, cloud) in scans {
+        merged.extend_from(&cloud.transformed(pose)).unwrap();
+    }
+    (grown, merged.voxel_downsample(0.1).unwrap())
+}
+
 /// The map cloud grown scan by scan is the scans merged and thinned at once.
 #[test]
 fn centroids_grown_scan_by_scan_are_the_merged_scans_thinned() {
     let scans: Vec<_> = (0..5).map(|k| corridor_scan(0.7 * f64::from(k))).collect();
-    let mut grown = VoxelCentroids::new(0.1);
-    for (pose, cloud) in &scans {
-        grown.add(&[(*pose, cloud.points())]).unwrap();
-    }
-    let mut merged = PointCloud::new();
-    for (pose, cloud) in &scans {
-        merged.extend_from(&cloud.transformed(pose)).unwrap();
-    }
-    let want = merged.voxel_downsample(0.1).unwrap();
+    let (grown, want) = grown_and_thinned(&scans);
     let got = grown.cloud();
     assert_eq!(got.len(), want.len());
     for (g, w) in got.points().iter().zip(want.points()) {
@@ -85,16 +91,8 @@ fn centroids_far_out_and_near_are_the_merged_scans_thinned() {
             (pose, PointCloud::from_points(points))
         })
         .collect();
-    let mut grown = VoxelCentroids::new(0.1);
-    for (pose, cloud) in &scans {
-        grown.add(&[(*pose, cloud.points())]).unwrap();
-    }
+    let (grown, want) = grown_and_thinned(&scans);
     assert!(!grown.far.is_empty() && !grown.index.is_empty());
-    let mut merged = PointCloud::new();
-    for (pose, cloud) in &scans {
-        merged.extend_from(&cloud.transformed(pose)).unwrap();
-    }
-    let want = merged.voxel_downsample(0.1).unwrap();
     let got = grown.cloud();
     assert_eq!(got.len(), want.len());
     for (g, w) in got.points().iter().zip(want.points()) {
