@@ -71,7 +71,12 @@ fn yawed(degrees: f64) -> Pose3 {
 /// matched there, 35 % elsewhere), each predicted `off` degrees away, every one tracked; and the
 /// basin.
 fn warmed_up(width: f64, off: f64, scans: usize) -> (Tracker, Basin) {
-    let mut tracker = Tracker::new(TrackerConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+    warmed_up_with(TrackerConfig::default(), width, off, scans)
+}
+
+/// [`warmed_up`] with `config`.
+fn warmed_up_with(config: TrackerConfig, width: f64, off: f64, scans: usize) -> (Tracker, Basin) {
+    let mut tracker = Tracker::new(config).unwrap_or_else(|e| panic!("{e}"));
     let scan = Basin {
         answer: yawed(0.0),
         width: width.to_radians(),
@@ -169,16 +174,29 @@ fn a_scan_a_wide_reach_slides_along_a_corridor_is_found_at_the_initial_reach() {
     let corridor = SlidingCorridor {
         answer: Pose3::from_parts(Translation3::new(0.3, 0.0, 0.0), UnitQuaternion::identity()),
     };
+    // The fine stage run again from the predicted position finds it at once ...
+    let outcome = tracker.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
+    assert!(outcome.tracked() && !outcome.recovered, "{outcome:?}");
+    assert!(
+        (outcome.pose.translation.x - 0.3).abs() < 1e-12,
+        "{outcome:?}"
+    );
+    // ... and without that recheck, the retry at the initial reach.
+    let no_recheck = TrackerConfig {
+        recheck_distance: 0.0,
+        ..TrackerConfig::default()
+    };
+    let (mut tracker, _) = warmed_up_with(no_recheck, 20.0, 15.0, 10);
     let outcome = tracker.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
     assert!(outcome.tracked() && outcome.recovered, "{outcome:?}");
     assert!(
         (outcome.pose.translation.x - 0.3).abs() < 1e-12,
         "{outcome:?}"
     );
-    // Without the retries the scan falls back for the refused correction.
+    // Without either the scan falls back for the refused correction.
     let mut strict = Tracker::new(TrackerConfig {
         retry: false,
-        ..TrackerConfig::default()
+        ..no_recheck
     })
     .unwrap_or_else(|e| panic!("{e}"));
     for _ in 0..10 {
@@ -317,6 +335,106 @@ fn every_bad_setting_is_refused_by_name() {
             Tracker::new(config).err().map(|e| e.setting),
             Some(setting),
             "{config:?}"
+        );
+    }
+}
+
+/// A corridor where the wide stages carry any guess 0.2 m short of the truth along it (a basin
+/// that fits a little worse: `short_fit`), and the fine stage converges to the truth from
+/// within 0.1 m of it and stays put farther away.
+struct ShortBasin {
+    truth: Pose3,
+    /// Matched share and RMS error of the short pose.
+    short_fit: (f64, f64),
+}
+
+impl ShortBasin {
+    fn short(&self) -> Pose3 {
+        Pose3::translation(-0.2, 0.0, 0.0) * self.truth
+    }
+}
+
+/// An alignment ending at `pose` with this matched share and RMS error.
+fn fitted(pose: Pose3, (inlier_ratio, rmse): (f64, f64)) -> Alignment {
+    Alignment {
+        rmse,
+        ..alignment(pose, inlier_ratio)
+    }
+}
+
+impl Registrator for ShortBasin {
+    type Source = ();
+    type Target = ();
+    fn prepare_source(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn prepare_target(&self, _: &PointCloud) -> Result<(), RegistrationError> {
+        Ok(())
+    }
+    fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
+        let off = (guess.translation.vector - self.truth.translation.vector).norm();
+        Ok(if off <= 0.1 {
+            fitted(self.truth, (0.9, 0.017))
+        } else {
+            fitted(self.short(), self.short_fit)
+        })
+    }
+    fn align_within(
+        &self,
+        (): &(),
+        (): &(),
+        _: &Pose3,
+        _: &Reach,
+    ) -> Result<Alignment, RegistrationError> {
+        Ok(fitted(self.short(), self.short_fit))
+    }
+}
+
+#[test]
+fn a_registration_carried_short_along_a_corridor_is_rechecked_from_the_predicted_position() {
+    let truth = Pose3::from_parts(
+        Translation3::new(3.0, 1.0, 0.0),
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.3),
+    );
+    // The prediction 3 cm and 10 degrees off: the wide stages fix the heading but end short.
+    let prediction = Pose3::translation(0.03, 0.0, 0.0) * turned(&truth, -10f64.to_radians());
+    let track = |config: TrackerConfig, short_fit: (f64, f64)| {
+        let mut tracker = Tracker::new(config).unwrap_or_else(|e| panic!("{e}"));
+        let corridor = ShortBasin { truth, short_fit };
+        let outcome = tracker.track(&corridor, &(), Some(&()), &[prediction], 10.0);
+        assert!(outcome.tracked(), "{outcome:?}");
+        outcome.pose
+    };
+    let gap = |a: Pose3, b: Pose3| (a.translation.vector - b.translation.vector).norm();
+    let short = Pose3::translation(-0.2, 0.0, 0.0) * truth;
+    // Worse on both counts there: the recheck from the predicted position finds the truth.
+    let d = TrackerConfig::default();
+    assert!(gap(track(d, (0.85, 0.02)), truth) < 1e-12);
+    // Off: the staged result stands.
+    let off = TrackerConfig {
+        recheck_distance: 0.0,
+        ..d
+    };
+    assert!(gap(track(off, (0.85, 0.02)), short) < 1e-12);
+    // Only when the other fits at least as well on both counts: matching more of the scan with
+    // a larger error is no proof.
+    assert!(gap(track(d, (0.85, 0.015)), short) < 1e-12);
+    assert!(gap(track(d, (0.95, 0.02)), short) < 1e-12);
+    // Ending within the distance of the prediction, nothing is rechecked.
+    let far = TrackerConfig {
+        recheck_distance: 0.5,
+        ..d
+    };
+    assert!(gap(track(far, (0.85, 0.02)), short) < 1e-12);
+    // A distance that is negative or not finite is refused by name.
+    for bad in [-0.1, f64::INFINITY, f64::NAN] {
+        let config = TrackerConfig {
+            recheck_distance: bad,
+            ..d
+        };
+        assert_eq!(
+            Tracker::new(config).err().map(|e| e.setting),
+            Some("TrackerConfig::recheck_distance")
         );
     }
 }

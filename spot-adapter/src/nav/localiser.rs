@@ -115,6 +115,9 @@ impl LocaliserConfig {
             max_translation_correction: 1e3,
             max_rotation_correction: std::f64::consts::PI,
             retry: false,
+            // Against a fixed map from the robot's odometry the correction is centimetres; the
+            // localiser checks a large one itself.
+            recheck_distance: 0.0,
             ..TrackerConfig::default()
         }
     }
