@@ -3,6 +3,8 @@
 
 use nalgebra::{Matrix6, Vector6};
 
+use crate::traits::registrator::SweepAlignment;
+
 use super::engine::{GraphSlam, ScanInput};
 use super::scan_preparation::Prepared;
 use crate::geometry::{Pose3, pose3_is_finite};
@@ -44,17 +46,53 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if refine_sweep
             && self.config.sweep_motion
             && tracked.information.is_some()
-            && let Some((at, information, correction, inlier_ratio)) =
-                self.sweep_motion(&tracked.prepared, &tracked.pose)
+            && let Some(sweep) = self.sweep_motion(&tracked.prepared, &tracked.pose)
         {
+            let sweep = self.recheck_sweep(&tracked.prepared, guesses, sweep);
+            let a = sweep.alignment;
             // The second scan has no velocity yet: its sweep's own motion is all there is.
             let v = velocity.unwrap_or_else(Vector6::zeros);
-            tracked.prepared = self.redeskew(scan, tracked.prepared, v + correction);
-            tracked.pose = at;
-            tracked.information = Some(information);
-            tracked.inlier_ratio = inlier_ratio;
+            tracked.prepared = self.redeskew(scan, tracked.prepared, v + sweep.velocity_correction);
+            tracked.pose = a.pose;
+            tracked.information = Some(a.information);
+            tracked.inlier_ratio = a.inlier_ratio;
         }
         tracked
+    }
+
+    /// `found`, or the sweep registered from the predicted position (`guesses[0]`) with
+    /// `found`'s rotation when `found` ended more than
+    /// [`TrackerConfig::recheck_distance`](crate::tracking::TrackerConfig::recheck_distance) from
+    /// that position and the other matched at least as much of the sweep with no larger RMS error:
+    /// the tracker's own recheck compares registrations of a scan deskewed with the last scan's
+    /// velocity, which after a jolt fits well nowhere until the sweep's motion is found.
+    fn recheck_sweep(
+        &self,
+        prepared: &Prepared<R::Source>,
+        guesses: &[Pose3],
+        found: SweepAlignment,
+    ) -> SweepAlignment {
+        let distance = self.config.tracker.recheck_distance;
+        let (Some(prediction), Some(map)) = (guesses.first(), self.local_map.as_ref()) else {
+            return found;
+        };
+        let a = &found.alignment;
+        let moved = (a.pose.translation.vector - prediction.translation.vector).norm();
+        if distance == 0.0 || moved <= distance {
+            return found;
+        }
+        let start = Pose3::from_parts(prediction.translation, a.pose.rotation);
+        let sweep = prepared.coarse.as_ref().unwrap_or(&prepared.cloud);
+        match self.odometry.align_sweep(sweep, &map.target, &start) {
+            Some(Ok(other))
+                if pose3_is_finite(&other.alignment.pose)
+                    && other.alignment.inlier_ratio >= a.inlier_ratio
+                    && other.alignment.rmse <= a.rmse =>
+            {
+                other
+            }
+            _ => found,
+        }
     }
 
     /// The pose of a scan, its registration's information and matched share: registered against the local
@@ -94,16 +132,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
 
     /// The scan registered again from `pose` (its registration) together with its sweep's own
     /// motion ([`Registrator::align_sweep`](crate::Registrator::align_sweep)): the pose at the
-    /// sweep's start, its information, the correction to the velocity it was deskewed with, and
-    /// the share of points matched.
+    /// sweep's start with its fit and information, and the correction to the velocity it was
+    /// deskewed with.
     /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
     /// pose, too small a gain over the scan's registration:
     /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain)).
-    fn sweep_motion(
-        &self,
-        prepared: &Prepared<R::Source>,
-        pose: &Pose3,
-    ) -> Option<(Pose3, Matrix6<f64>, Vector6<f64>, f64)> {
+    fn sweep_motion(&self, prepared: &Prepared<R::Source>, pose: &Pose3) -> Option<SweepAlignment> {
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
@@ -113,7 +147,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 pose,
             )?
             .ok()?;
-        let a = sweep.alignment;
+        let a = &sweep.alignment;
         let gain = self.config.sweep_min_gain;
         let better = self
             .last_fit
@@ -121,11 +155,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         (pose3_is_finite(&a.pose)
             && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
             && better)
-            .then_some((
-                a.pose,
-                a.information,
-                sweep.velocity_correction,
-                a.inlier_ratio,
-            ))
+            .then_some(sweep)
     }
 }

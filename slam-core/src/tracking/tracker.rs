@@ -53,7 +53,8 @@ pub struct TrackerConfig {
     /// scan with no larger RMS error. The wide stages fix the rotation well but can carry the
     /// position into a neighbouring basin along a corridor: on simulated hand-held walks the
     /// staged result sat 0.2 m short of the truth while the fine stage started from the
-    /// predicted position stayed at the truth with a better fit. 0 turns it off.
+    /// predicted position stayed at the truth with a better fit. The Graph-SLAM engine checks a
+    /// sweep's own motion the same way (`GraphSlamConfig::sweep_motion`). 0 turns it off.
     pub recheck_distance: f64,
 }
 
