@@ -12,6 +12,9 @@ use crate::floor::FloorMap;
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::{below_top, clip_to_bounds, floor_i64, traverse};
 
+/// The least and the greatest (x, y) of some points (metres, map frame).
+type Extent = (Vector2<f64>, Vector2<f64>);
+
 /// The cells of the grid so far, on the lattice of cells of `resolution` metres anchored at the
 /// map origin: global cell `(x, y)` covers `[x r, (x + 1) r) x [y r, (y + 1) r)`.
 #[derive(Clone, Debug)]
@@ -115,7 +118,7 @@ pub struct FloorBandAccumulator {
     floor: FloorMap,
     band: ObstacleBandConfig,
     /// Extent (x, y) of the origins, band points and floor points so far.
-    bounds: Option<(Vector2<f64>, Vector2<f64>)>,
+    bounds: Option<Extent>,
     any_hit: bool,
     window: Option<Window>,
     /// Scans added so far (numbers the stamps).
@@ -178,39 +181,20 @@ impl FloorBandAccumulator {
         scans: &[(Pose3, &[Point3<f32>])],
     ) -> Result<(), GridMapError> {
         // 1. The extent with this batch, checked before anything changes.
-        let mut bounds = self.bounds;
-        let mut any_hit = self.any_hit;
-        for (pose, cloud) in scans {
-            check_finite_points(cloud)?;
-            let mut grow = |p: Vector2<f64>| {
-                bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.inf(&p), hi.sup(&p))));
-            };
-            grow(pose.translation.vector.xy());
-            for p in world_points(pose, cloud) {
-                match classify(p.z, band_at(&self.floor, &self.band, p.x, p.y)) {
-                    Height::Obstacle => {
-                        any_hit = true;
-                        grow(p.coords.xy());
-                    }
-                    Height::Floor => grow(p.coords.xy()),
-                    Height::Overhang => {}
-                }
-            }
-        }
+        let (bounds, any_hit) = self.extent_with(scans)?;
         let Some((min, max)) = bounds else {
             return Ok(());
         };
-        let (x0, y0, width, height) = self.cells_over(min, max)?;
-        let mut window = match self.window.take() {
-            Some(w) if (w.x0, w.y0, w.width, w.height) == (x0, y0, width, height) => w,
-            Some(w) => w.regrown(x0, y0, width, height),
-            None => Window::empty(x0, y0, width, height),
-        };
+        let mut window = self.window_over(min, max)?;
         // 2. The beams, on the grown window.
         let r = self.builder.config().resolution;
+        let (x0, y0) = (window.x0, window.y0);
         let (lo, hi) = (
             Vector2::new(x0 as f64, y0 as f64),
-            Vector2::new((x0 + width as i64) as f64, (y0 + height as i64) as f64),
+            Vector2::new(
+                (x0 + window.width as i64) as f64,
+                (y0 + window.height as i64) as f64,
+            ),
         );
         let mut beams: Vec<(Vector2<f64>, Vector2<f64>, bool)> = Vec::new();
         for (pose, cloud) in scans {
@@ -268,6 +252,68 @@ impl FloorBandAccumulator {
         self.bounds = bounds;
         self.any_hit = any_hit;
         Ok(())
+    }
+
+    /// Grows the grid to the extent adding `scans` would give it, without adding them: for a
+    /// caller that adds a map's scans a batch at a time (reading them from a file, say) and
+    /// wants the grid of adding them all as one batch. Extended over every batch first, the
+    /// accumulator then traces each batch's beams to overhangs up to the edge of the whole
+    /// map's grid, so adding the batches in order gives the grid [`Self::add_scan_points`]
+    /// gives for all of them at once. Nothing changes when it fails.
+    ///
+    /// # Errors
+    /// As [`Self::add_scans`].
+    pub fn extend_over(&mut self, scans: &[(Pose3, &[Point3<f32>])]) -> Result<(), GridMapError> {
+        let (bounds, _) = self.extent_with(scans)?;
+        let Some((min, max)) = bounds else {
+            return Ok(());
+        };
+        self.window = Some(self.window_over(min, max)?);
+        self.bounds = bounds;
+        Ok(())
+    }
+
+    /// The extent (x, y) of the origins, band points and floor points so far and in `scans`,
+    /// and whether any point so far or in `scans` lies in the band.
+    fn extent_with(
+        &self,
+        scans: &[(Pose3, &[Point3<f32>])],
+    ) -> Result<(Option<Extent>, bool), GridMapError> {
+        let mut bounds = self.bounds;
+        let mut any_hit = self.any_hit;
+        for (pose, cloud) in scans {
+            check_finite_points(cloud)?;
+            let mut grow = |p: Vector2<f64>| {
+                bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.inf(&p), hi.sup(&p))));
+            };
+            grow(pose.translation.vector.xy());
+            for p in world_points(pose, cloud) {
+                match classify(p.z, band_at(&self.floor, &self.band, p.x, p.y)) {
+                    Height::Obstacle => {
+                        any_hit = true;
+                        grow(p.coords.xy());
+                    }
+                    Height::Floor => grow(p.coords.xy()),
+                    Height::Overhang => {}
+                }
+            }
+        }
+        Ok((bounds, any_hit))
+    }
+
+    /// The window over `min`..`max` (the builder's margin added): the current one when it
+    /// covers those cells already, else the current one's counts in a new one.
+    fn window_over(
+        &mut self,
+        min: Vector2<f64>,
+        max: Vector2<f64>,
+    ) -> Result<Window, GridMapError> {
+        let (x0, y0, width, height) = self.cells_over(min, max)?;
+        Ok(match self.window.take() {
+            Some(w) if (w.x0, w.y0, w.width, w.height) == (x0, y0, width, height) => w,
+            Some(w) => w.regrown(x0, y0, width, height),
+            None => Window::empty(x0, y0, width, height),
+        })
     }
 
     /// The occupancy grid of the scans added so far.

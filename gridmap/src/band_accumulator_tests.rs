@@ -57,6 +57,26 @@ fn one_shot(scans: &[(Pose3, PointCloud)]) -> OccupancyGrid {
         .unwrap()
 }
 
+/// Nine scans of the room from along its middle.
+fn nine_room_scans() -> Vec<(Pose3, PointCloud)> {
+    (0..9u64)
+        .map(|k| {
+            let at = (0.5 + 0.6 * k as f64, 0.6 + 0.3 * (k % 3) as f64);
+            room_scan(at, k + 1)
+        })
+        .collect()
+}
+
+/// An accumulator over the flat floor at 0 with the default band.
+fn empty() -> FloorBandAccumulator {
+    FloorBandAccumulator::new(
+        config(),
+        FloorMap::flat(0.0).unwrap(),
+        ObstacleBandConfig::default(),
+    )
+    .unwrap()
+}
+
 /// The cells that differ between two grids of the same extent, as (one-shot, batched) states.
 fn differences(a: &OccupancyGrid, b: &OccupancyGrid) -> Vec<(CellState, CellState)> {
     assert_eq!(a.geometry(), b.geometry());
@@ -77,12 +97,7 @@ fn differences(a: &OccupancyGrid, b: &OccupancyGrid) -> Vec<(CellState, CellStat
 /// cells freed by a beam to an overhang beyond the grid of the batches before (left unknown).
 #[test]
 fn batches_give_the_grid_of_all_scans_at_once() {
-    let scans: Vec<(Pose3, PointCloud)> = (0..9u64)
-        .map(|k| {
-            let at = (0.5 + 0.6 * k as f64, 0.6 + 0.3 * (k % 3) as f64);
-            room_scan(at, k + 1)
-        })
-        .collect();
+    let scans = nine_room_scans();
     let whole = one_shot(&scans);
     let (free, occupied, unknown) = whole.counts();
     assert!(
@@ -90,12 +105,7 @@ fn batches_give_the_grid_of_all_scans_at_once() {
         "{occupied} {free} {unknown}"
     );
     for batch in [1, 2, 4, 9] {
-        let mut acc = FloorBandAccumulator::new(
-            config(),
-            FloorMap::flat(0.0).unwrap(),
-            ObstacleBandConfig::default(),
-        )
-        .unwrap();
+        let mut acc = empty();
         for part in scans.chunks(batch) {
             let refs: Vec<(Pose3, &PointCloud)> = part.iter().map(|(p, c)| (*p, c)).collect();
             acc.add_scans(&refs).unwrap();
@@ -116,6 +126,38 @@ fn batches_give_the_grid_of_all_scans_at_once() {
     }
 }
 
+/// Extended over every batch first, scans added in batches of every size give the grid of all
+/// of them at once to the cell, overhangs included (the builder's one-shot grid is the oracle).
+#[test]
+fn batches_after_extending_over_them_all_give_the_one_shot_grid() {
+    let scans = nine_room_scans();
+    let whole = one_shot(&scans);
+    let points: Vec<(Pose3, &[Point3<f32>])> =
+        scans.iter().map(|(p, c)| (*p, c.points())).collect();
+    for batch in [1, 2, 4, 9] {
+        let mut acc = empty();
+        for part in points.chunks(batch) {
+            acc.extend_over(part).unwrap();
+        }
+        assert_eq!(acc.scans(), 0);
+        for part in points.chunks(batch) {
+            acc.add_scan_points(part).unwrap();
+        }
+        assert_eq!(acc.scans(), scans.len());
+        let got = acc.grid().unwrap();
+        assert!(differences(&whole, &got).is_empty(), "batch {batch}");
+        assert_eq!(got.counts(), whole.counts(), "batch {batch}");
+    }
+    // A bad scan is refused before anything changes.
+    let mut acc = empty();
+    let bad = [Point3::new(f32::NAN, 0.0, 0.0)];
+    assert!(matches!(
+        acc.extend_over(&[(Pose3::identity(), &bad[..])]),
+        Err(GridMapError::NonFinitePoints { .. })
+    ));
+    assert!(matches!(acc.grid(), Err(GridMapError::EmptyCloud)));
+}
+
 /// Without overhangs the order and batching of the scans changes no cell at all.
 #[test]
 fn without_overhangs_batches_change_nothing() {
@@ -132,12 +174,7 @@ fn without_overhangs_batches_change_nothing() {
         })
         .collect();
     let whole = one_shot(&scans);
-    let mut acc = FloorBandAccumulator::new(
-        config(),
-        FloorMap::flat(0.0).unwrap(),
-        ObstacleBandConfig::default(),
-    )
-    .unwrap();
+    let mut acc = empty();
     for (pose, cloud) in scans.iter().rev() {
         acc.add_scans(&[(*pose, cloud)]).unwrap();
     }
@@ -148,12 +185,7 @@ fn without_overhangs_batches_change_nothing() {
 /// accumulator and one without band points say so.
 #[test]
 fn bad_scans_are_refused_and_change_nothing() {
-    let mut acc = FloorBandAccumulator::new(
-        config(),
-        FloorMap::flat(0.0).unwrap(),
-        ObstacleBandConfig::default(),
-    )
-    .unwrap();
+    let mut acc = empty();
     assert!(matches!(acc.grid(), Err(GridMapError::EmptyCloud)));
     let floor_only = PointCloud::from_points(vec![Point3::new(1.0, 0.0, -0.6)]);
     acc.add_scans(&[(Pose3::translation(0.0, 0.0, 0.6), &floor_only)])

@@ -140,11 +140,7 @@ impl FloorMap {
         config: &FloorConfig,
     ) -> Result<Self, GridMapError> {
         crate::OccupancyGridBuilder::check_cloud(cloud)?;
-        let points = cloud
-            .points()
-            .iter()
-            .map(|p| Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)));
-        Self::estimate_points(points, hints, config)
+        Self::estimate_points(&CloudPasses(cloud.points()), hints, config)
     }
 
     /// [`FloorMap::estimate`] for scans, each in its sensor frame placed by `world_T_sensor`.
@@ -171,31 +167,45 @@ impl FloorMap {
         hints: &[Point3<f64>],
         config: &FloorConfig,
     ) -> Result<Self, GridMapError> {
-        if scans.iter().all(|(_, c)| c.is_empty()) {
+        Self::estimate_from_scan_passes(|visit| visit(scans), hints, config)
+    }
+
+    /// [`FloorMap::estimate_from_scan_points`] for scans handed over in batches, pass after
+    /// pass: `scans` gives every batch to its argument, in order, each time it is called (four
+    /// times), the same scans in the same order every time. For a caller that reads a map's
+    /// scans from a file a batch at a time rather than holding them all in memory; the floor is
+    /// the one [`FloorMap::estimate_from_scan_points`] gives for all the batches' scans in
+    /// order.
+    ///
+    /// # Errors
+    /// As [`FloorMap::estimate_from_scans`].
+    pub fn estimate_from_scan_passes(
+        scans: impl Fn(&mut dyn FnMut(&[(Pose3, &[Point3<f32>])])),
+        hints: &[Point3<f64>],
+        config: &FloorConfig,
+    ) -> Result<Self, GridMapError> {
+        let (mut any, mut bad) = (false, 0usize);
+        scans(&mut |batch| {
+            for (_, c) in batch {
+                any |= !c.is_empty();
+                bad += c
+                    .iter()
+                    .filter(|p| !p.iter().all(|v| v.is_finite()))
+                    .count();
+            }
+        });
+        if !any {
             return Err(GridMapError::EmptyCloud);
         }
-        let bad: usize = scans
-            .iter()
-            .map(|(_, c)| {
-                c.iter()
-                    .filter(|p| !p.iter().all(|v| v.is_finite()))
-                    .count()
-            })
-            .sum();
         if bad > 0 {
             return Err(GridMapError::NonFinitePoints { count: bad });
         }
         // Transformed on every pass rather than stored: a map's scans hold millions of points.
-        let points = scans.iter().flat_map(|(pose, cloud)| {
-            cloud
-                .iter()
-                .map(move |p| pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
-        });
-        Self::estimate_points(points, hints, config)
+        Self::estimate_points(&ScanPasses(scans), hints, config)
     }
 
     fn estimate_points(
-        points: impl IntoIterator<Item = Point3<f64>> + Clone,
+        points: &impl PointPasses,
         hints: &[Point3<f64>],
         config: &FloorConfig,
     ) -> Result<Self, GridMapError> {
@@ -219,10 +229,10 @@ impl FloorMap {
             Vector2::repeat(f64::INFINITY),
             Vector2::repeat(f64::NEG_INFINITY),
         );
-        for p in points.clone() {
+        points.pass(|p| {
             lo = lo.inf(&p.coords.xy());
             hi = hi.sup(&p.coords.xy());
-        }
+        });
         if lo.x > hi.x {
             // No point near the hints' heights: one tile at the hints' mean height.
             let mean = hints.iter().map(|h| h.z).sum::<f64>() / hints.len() as f64;
@@ -305,24 +315,19 @@ impl FloorMap {
 
     /// The heights of `points` sorted by tile (counting sort): tile `k`'s are
     /// `z[start[k]..start[k + 1]]`.
-    fn heights_by_tile(
-        &self,
-        points: impl IntoIterator<Item = Point3<f64>> + Clone,
-    ) -> (Vec<u32>, Vec<f32>) {
+    fn heights_by_tile(&self, points: &impl PointPasses) -> (Vec<u32>, Vec<f32>) {
         let mut start = vec![0u32; self.floors.len() + 1];
-        for p in points.clone() {
-            start[self.tile_index(p.x, p.y) + 1] += 1;
-        }
+        points.pass(|p| start[self.tile_index(p.x, p.y) + 1] += 1);
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
         let mut fill = start.clone();
         let mut z = vec![0f32; start[start.len() - 1] as usize];
-        for p in points {
+        points.pass(|p| {
             let k = self.tile_index(p.x, p.y);
             z[fill[k] as usize] = p.z as f32;
             fill[k] += 1;
-        }
+        });
         (start, z)
     }
 
@@ -376,6 +381,39 @@ impl FloorMap {
     #[must_use]
     pub fn measured_tiles(&self) -> usize {
         self.measured
+    }
+}
+
+/// Points (map frame) visited pass after pass, the same points in the same order on each: the
+/// estimate looks at them three times (their extent, then their tiles, then their heights).
+trait PointPasses {
+    /// Calls `visit` with every point, in order.
+    fn pass(&self, visit: impl FnMut(Point3<f64>));
+}
+
+/// A map cloud's points.
+struct CloudPasses<'a>(&'a [Point3<f32>]);
+
+impl PointPasses for CloudPasses<'_> {
+    fn pass(&self, mut visit: impl FnMut(Point3<f64>)) {
+        for p in self.0 {
+            visit(Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)));
+        }
+    }
+}
+
+/// Placed scans handed over in batches ([`FloorMap::estimate_from_scan_passes`]).
+struct ScanPasses<F>(F);
+
+impl<F: Fn(&mut dyn FnMut(&[(Pose3, &[Point3<f32>])]))> PointPasses for ScanPasses<F> {
+    fn pass(&self, mut visit: impl FnMut(Point3<f64>)) {
+        (self.0)(&mut |batch| {
+            for (pose, cloud) in batch {
+                for p in *cloud {
+                    visit(pose * Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)));
+                }
+            }
+        });
     }
 }
 

@@ -80,6 +80,95 @@ fn floor_follows_a_gentle_ramp_and_skips_the_crate() {
     // 8 cm, but an estimate per tile follows the floor wherever it goes.
 }
 
+/// The floor of scans handed over in batches, pass after pass, is the floor of their points
+/// merged into one map cloud (the oracle), whatever the batches; bad input is refused as one
+/// batch of all the scans is.
+#[test]
+fn floor_from_scans_in_batches_is_the_merged_clouds() {
+    // The ramp and crate above on a lattice of 1/16 m, heights to 1/1024 m: values f32 holds
+    // exactly, so a scan placed by a whole-metre translation lands exactly where the merged
+    // cloud has its points.
+    let truth = |x: f64| ((FLOOR + 0.01 * x) * 1024.0).round() / 1024.0;
+    let mut world = Vec::new();
+    for i in 0..192 {
+        for j in 0..96 {
+            let (x, y) = (f64::from(i) / 16.0, f64::from(j) / 16.0);
+            let on_crate = (2.0..3.0).contains(&x) && (4.0..5.0).contains(&y);
+            world.push(Point3::new(
+                x,
+                y,
+                truth(x) + if on_crate { 0.5625 } else { 0.0 },
+            ));
+        }
+    }
+    let merged = PointCloud::from_points(world.iter().map(|p| p.cast::<f32>()).collect());
+    // Scans of 2 m strips, each in the frame of a sensor standing in its strip.
+    let scans: Vec<(Pose3, Vec<Point3<f32>>)> = (0..6)
+        .map(|k: i32| {
+            let at = Vector2::new(2.0 * f64::from(k) + 1.0, 3.0);
+            let local = world
+                .iter()
+                .filter(|p| (p.x / 2.0).floor() as i32 == k)
+                .map(|p| Point3::new(p.x - at.x, p.y - at.y, p.z).cast::<f32>())
+                .collect();
+            (Pose3::translation(at.x, at.y, 0.0), local)
+        })
+        .collect();
+    let points: Vec<(Pose3, &[Point3<f32>])> = scans
+        .iter()
+        .map(|(pose, p)| (*pose, p.as_slice()))
+        .collect();
+    let hints: Vec<Point3<f64>> = (0..12)
+        .map(|k| Point3::new(f64::from(k) + 0.5, 3.0, truth(f64::from(k) + 0.5) + 0.03))
+        .collect();
+    let config = FloorConfig::default();
+    let oracle = FloorMap::estimate(&merged, &hints, &config).unwrap();
+    assert_eq!(oracle.measured_tiles(), 12 * 6 - 1);
+    for batch in [1, 2, 4, 6] {
+        let passes = std::cell::Cell::new(0);
+        let floor = FloorMap::estimate_from_scan_passes(
+            |visit| {
+                passes.set(passes.get() + 1);
+                for part in points.chunks(batch) {
+                    visit(part);
+                }
+            },
+            &hints,
+            &config,
+        )
+        .unwrap();
+        assert_eq!(floor, oracle, "batches of {batch}");
+        assert_eq!(passes.get(), 4);
+    }
+    assert_eq!(
+        FloorMap::estimate_from_scan_points(&points, &hints, &config).unwrap(),
+        oracle
+    );
+    // Every scan empty, or a non-finite point in any batch: refused.
+    let empty: Vec<(Pose3, &[Point3<f32>])> = vec![(Pose3::identity(), &[]); 3];
+    let err = FloorMap::estimate_from_scan_passes(
+        |visit| empty.chunks(1).for_each(&mut *visit),
+        &hints,
+        &config,
+    );
+    assert!(matches!(err, Err(GridMapError::EmptyCloud)));
+    let nan = [
+        Point3::new(f32::NAN, 0.0, 0.0),
+        Point3::new(0.0, f32::INFINITY, 0.0),
+    ];
+    let mut bad = points.clone();
+    bad.push((Pose3::identity(), &nan));
+    let err = FloorMap::estimate_from_scan_passes(
+        |visit| bad.chunks(2).for_each(&mut *visit),
+        &hints,
+        &config,
+    );
+    assert!(matches!(
+        err,
+        Err(GridMapError::NonFinitePoints { count: 2 })
+    ));
+}
+
 #[test]
 fn band_from_the_map_cloud_takes_low_and_high_furniture_not_overhangs() {
     let world = room(FLOOR);
