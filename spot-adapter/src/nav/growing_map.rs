@@ -14,8 +14,9 @@ use slam_core::{
 use crate::nav::NavError;
 use crate::nav::config::NavigationMapConfig;
 use crate::nav::error::ExplorationError;
+use crate::nav::keyframe_batches::KeyframeBatches;
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::scan_blocks::ScanBlocks;
+use crate::nav::scan_blocks::{BLOCK_POINTS, ScanBlocks};
 
 /// A rendered keyframe that moved farther than this share of a grid cell (or turned so far that
 /// a point [`GrowingMap`]'s `range` away moved so far) since it was rendered calls for a full
@@ -50,6 +51,8 @@ pub(crate) struct GrowingMap {
     cloud: VoxelCentroids,
     /// Full renders so far.
     full_renders: usize,
+    /// Points a full render reads at once, [`BLOCK_POINTS`] (48 MB).
+    batch_points: usize,
 }
 
 impl GrowingMap {
@@ -73,6 +76,7 @@ impl GrowingMap {
             rendered_at_full: 0,
             cloud: VoxelCentroids::new(voxel),
             full_renders: 0,
+            batch_points: BLOCK_POINTS,
         }
     }
 
@@ -145,7 +149,11 @@ impl GrowingMap {
         self.cloud.within(at, reach)
     }
 
-    /// Everything rendered afresh from `keyframes` at their current poses.
+    /// Everything rendered afresh from `keyframes` at their current poses, their points read a
+    /// batch at a time ([`KeyframeBatches`]): the floor from every batch (four passes), the
+    /// band's grid grown over every batch, then each batch added to the band and the cloud. The
+    /// same floor, grid and cloud as all the keyframes' points read at once and added as one
+    /// batch (`FloorMap::estimate_from_scan_passes`, `FloorBandAccumulator::extend_over`).
     fn full_render<E: std::error::Error + Send + Sync + 'static>(
         &mut self,
         keyframes: &(impl Keyframes + ?Sized),
@@ -158,18 +166,49 @@ impl GrowingMap {
         self.squares.clear();
         self.seen = 0;
         let picked = self.pick(keyframes);
-        let loaded = load(keyframes, &picked)?;
-        let scans = loaded.scans();
-        let poses: Vec<Pose3> = scans.iter().map(|(p, _)| *p).collect();
+        let poses: Vec<Pose3> = picked
+            .iter()
+            .map(|&k| keyframes.pose(k).unwrap_or_else(Pose3::identity))
+            .collect();
         let hints = floor_hints_below(&poses, self.lidar_height);
-        let floor = FloorMap::estimate_from_scan_points(&scans, &hints, &self.config.floor)
-            .map_err(grid_error)?;
-        let mut band =
-            FloorBandAccumulator::new(self.config.grid.clone(), floor, self.config.band.clone())
-                .map_err(grid_error)?;
-        band.add_scan_points(&scans).map_err(grid_error)?;
+        let batches = KeyframeBatches::new(keyframes, &picked, self.batch_points);
+        let floor = FloorMap::estimate_from_scan_passes(
+            |visit| batches.pass(visit),
+            &hints,
+            &self.config.floor,
+        );
+        if let Some(e) = batches.error() {
+            return Err(ExplorationError::Map(e));
+        }
+        let mut band = FloorBandAccumulator::new(
+            self.config.grid.clone(),
+            floor.map_err(grid_error)?,
+            self.config.band.clone(),
+        )
+        .map_err(grid_error)?;
+        let mut extended = Ok(());
+        batches.pass(&mut |scans| {
+            if extended.is_ok() {
+                extended = band.extend_over(scans);
+            }
+        });
+        if let Some(e) = batches.error() {
+            return Err(ExplorationError::Map(e));
+        }
+        extended.map_err(grid_error)?;
         self.cloud.clear();
-        self.cloud.add(&scans).map_err(map_error)?;
+        let (mut added, mut thinned) = (Ok(()), Ok(()));
+        batches.pass(&mut |scans| {
+            if added.is_ok() && thinned.is_ok() {
+                added = band.add_scan_points(scans);
+                thinned = self.cloud.add(scans);
+            }
+        });
+        if let Some(e) = batches.error() {
+            return Err(ExplorationError::Map(e));
+        }
+        added.map_err(grid_error)?;
+        thinned.map_err(map_error)?;
         self.band = Some(band);
         self.rendered = picked.iter().zip(&poses).map(|(&k, &p)| (k, p)).collect();
         self.rendered_at_full = self.rendered.len();
@@ -254,8 +293,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> Keyframes
     }
 }
 
-/// The poses and points of keyframes `picked`, read one at a time into [`ScanBlocks`]: a full
-/// render holds every rendered keyframe's points at once.
+/// The poses and points of keyframes `picked` (an update's few new ones), read one at a time
+/// into [`ScanBlocks`].
 fn load<E: std::error::Error + Send + Sync + 'static>(
     keyframes: &(impl Keyframes + ?Sized),
     picked: &[usize],

@@ -214,6 +214,95 @@ fn the_map_grows_by_its_new_keyframes_and_is_rendered_afresh_when_they_move() {
     assert!(m.rendered.len() <= before + before.div_ceil(2) + 1);
 }
 
+/// A full render read in batches (here of two keyframes' points) gives the floor, the grid and
+/// the cloud of one read at once, and those of the oracles: the floor estimated from every
+/// rendered scan, the builder's one-shot grid over it and the centroids of every scan added in
+/// order.
+#[test]
+fn a_render_in_batches_is_the_render_of_every_keyframe_at_once() {
+    // Keyframes every 0.3 m along the corridor, turning a little: 14 rendered, one a square.
+    let scans: Vec<(Pose3, PointCloud)> = (0..45)
+        .map(|k| {
+            let (pose, cloud) = corridor_scan(0.3 * f64::from(k));
+            let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.002 * f64::from(k));
+            (Pose3::from_parts(pose.translation, turn), cloud)
+        })
+        .collect();
+    let render = |batch_points: usize| {
+        let mut m = map();
+        m.batch_points = batch_points;
+        let navigation = m.update_from::<std::io::Error>(&refs(&scans)[..]).unwrap();
+        assert_eq!(m.full_renders(), 1);
+        (m, navigation)
+    };
+    let (whole, at_once) = render(BLOCK_POINTS);
+    let (batched, in_batches) = render(2 * scans[0].1.len());
+    assert_eq!(whole.rendered, batched.rendered);
+    assert_eq!(whole.rendered.len(), 14);
+    assert_eq!(in_batches.floor(), at_once.floor());
+    assert_eq!(in_batches.occupancy(), at_once.occupancy());
+    assert_eq!(batched.cloud.cloud().points(), whole.cloud.cloud().points());
+    // The oracles, from the rendered scans.
+    let rendered: Vec<(Pose3, &PointCloud)> = whole
+        .rendered
+        .iter()
+        .map(|&(k, _)| (scans[k].0, &scans[k].1))
+        .collect();
+    let poses: Vec<Pose3> = rendered.iter().map(|(p, _)| *p).collect();
+    let config = &whole.config;
+    let floor =
+        FloorMap::estimate_from_scans(&rendered, &floor_hints_below(&poses, 0.6), &config.floor)
+            .unwrap();
+    assert_eq!(in_batches.floor(), &floor);
+    let grid = gridmap::OccupancyGridBuilder::new(config.grid.clone())
+        .unwrap()
+        .build_floor_band_from_scans(&rendered, &floor, &config.band)
+        .unwrap();
+    assert_eq!(in_batches.occupancy(), &grid);
+    assert!(
+        grid.counts().0 > 100 && grid.counts().1 > 100,
+        "{:?}",
+        grid.counts()
+    );
+    let mut centroids = VoxelCentroids::new(0.1);
+    for (pose, cloud) in &rendered {
+        centroids.add(&[(*pose, cloud.points())]).unwrap();
+    }
+    assert_eq!(batched.cloud.cloud().points(), centroids.cloud().points());
+}
+
+/// A keyframe that cannot be read ends the render with its error.
+#[test]
+fn a_keyframe_that_cannot_be_read_ends_the_render() {
+    struct Unreadable(Vec<(Pose3, PointCloud)>);
+    impl Keyframes for Unreadable {
+        fn count(&self) -> usize {
+            self.0.len()
+        }
+        fn pose(&self, k: usize) -> Option<Pose3> {
+            self.0.get(k).map(|(p, _)| *p)
+        }
+        fn scan(&self, k: usize) -> Result<Cow<'_, PointCloud>, KeyframeCloudError> {
+            if k == 3 {
+                return Err(KeyframeCloudError::Cloud(CloudError::InvalidVoxelSize {
+                    size: -1.0,
+                }));
+            }
+            Ok(Cow::Borrowed(&self.0[k].1))
+        }
+    }
+    let scans = Unreadable((0..8).map(|k| corridor_scan(f64::from(k))).collect());
+    for batch_points in [BLOCK_POINTS, 5000] {
+        let mut m = map();
+        m.batch_points = batch_points;
+        let err = m.update_from::<std::io::Error>(&scans).unwrap_err();
+        assert!(
+            matches!(err, Error::Map(KeyframeCloudError::Cloud(_))),
+            "{err:?}"
+        );
+    }
+}
+
 /// Scans without any point in the obstacle band give no map, and say why.
 #[test]
 fn a_map_without_obstacles_is_refused_by_name() {

@@ -71,6 +71,7 @@ mod floors_drive;
 mod frontier;
 mod frontier_tour;
 mod growing_map;
+mod keyframe_batches;
 mod localiser;
 mod navigation_map;
 mod navigator;
