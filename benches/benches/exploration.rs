@@ -5,7 +5,8 @@
 //! - per-scan SLAM time (`GraphSlam::process`, as the engine's report keeps it) over the last
 //!   tenth of the scans against the first tenth, mean and p99 (bar: p99 at most 1.5x);
 //! - resident memory at the end against that when the grid first knew a quarter of the floor it
-//!   knows free at the end (bar: at most 2x);
+//!   knows free at the end (bar: at most 2x), and the run's peak (the kernel's high-water mark,
+//!   `VmHWM`);
 //! - the navigation cycle with the explorer's decisions spread over it: the engine and the
 //!   navigator on every scan plus every decision, divided by the scans (bar: mean at most
 //!   10 ms);
@@ -30,7 +31,7 @@ use spot_adapter::pipelines::{
 use spot_adapter::sim::{
     Building, BuildingConfig, CommandedSpot, SimulationConfig, floor_coverage,
 };
-use spot_nav_benches::{quantile, resident_mb};
+use spot_nav_benches::{peak_resident_mb, quantile, resident_mb};
 
 /// Mean of `v`, 0 when empty.
 fn mean(v: &[f64]) -> f64 {
@@ -81,14 +82,14 @@ fn settings() -> Result<(String, u64, usize, SimulationConfig), String> {
 
 /// Prints the table of the first and last tenths of the scans (SLAM alone, SLAM with the
 /// navigator) and of resident memory: `resident` is (MB, scan) at a quarter of the floor
-/// known, then MB at the end.
-fn print_table(slam_ms: &[f64], compute_ms: &[f64], resident: (f64, usize, f64)) {
+/// known, MB at the end, then the peak MB over the run.
+fn print_table(slam_ms: &[f64], compute_ms: &[f64], resident: (f64, usize, f64, f64)) {
     let [(first_mean, first_p99), (last_mean, last_p99)] = tenths(slam_ms);
     let [
         (nav_first_mean, nav_first_p99),
         (nav_last_mean, nav_last_p99),
     ] = tenths(compute_ms);
-    let (at_quarter, quarter, at_end) = resident;
+    let (at_quarter, quarter, at_end, peak) = resident;
     println!("| measure | first tenth | last tenth | last / first | issue's bar |");
     println!("|---|---|---|---|---|");
     println!(
@@ -100,7 +101,7 @@ fn print_table(slam_ms: &[f64], compute_ms: &[f64], resident: (f64, usize, f64))
         nav_last_p99 / nav_first_p99
     );
     println!(
-        "| resident MB (at a quarter of the floor known / at the end) | {at_quarter:.0} (scan {}) | {at_end:.0} | {:.2} | at most 2x |",
+        "| resident MB (at a quarter of the floor known / at the end; peak {peak:.0}) | {at_quarter:.0} (scan {}) | {at_end:.0} | {:.2} | at most 2x |",
         quarter + 1,
         at_end / at_quarter
     );
@@ -187,6 +188,7 @@ fn run() -> Result<(), String> {
     .map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     let resident_at_end = resident_mb();
+    let resident_peak = peak_resident_mb();
     let coverage = floor_coverage(
         spot.building(),
         start,
@@ -225,7 +227,7 @@ fn run() -> Result<(), String> {
     print_table(
         &slam_report.scan_ms,
         &compute_ms,
-        (resident_at_quarter, quarter, resident_at_end),
+        (resident_at_quarter, quarter, resident_at_end, resident_peak),
     );
     print_frontiers(&report);
     let stages = report.decision_stages;

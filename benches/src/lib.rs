@@ -192,11 +192,23 @@ pub mod mapped_building {
 /// Resident memory of this process in MB (`VmRSS`), 0 where `/proc` has none.
 #[must_use]
 pub fn resident_mb() -> f64 {
+    status_mb("VmRSS:")
+}
+
+/// The process's peak resident memory so far in MB (`VmHWM` in `/proc/self/status`, 0 where that
+/// is unavailable): the high-water mark the kernel keeps, peaks between samples included.
+#[must_use]
+pub fn peak_resident_mb() -> f64 {
+    status_mb("VmHWM:")
+}
+
+/// The `/proc/self/status` field `field` (a size in kB) in MB, 0 where unavailable.
+fn status_mb(field: &str) -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find_map(|l| l.strip_prefix("VmRSS:"))
+                .find_map(|l| l.strip_prefix(field))
                 .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
         })
         .map_or(0.0, |kb| kb / 1024.0)
