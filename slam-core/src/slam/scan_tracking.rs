@@ -3,6 +3,7 @@
 
 use nalgebra::{Matrix6, Vector6};
 
+use crate::tracking::replaces;
 use crate::traits::registrator::SweepAlignment;
 
 use super::engine::{GraphSlam, ScanInput};
@@ -72,25 +73,19 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         guesses: &[Pose3],
         found: SweepAlignment,
     ) -> SweepAlignment {
-        let distance = self.config.tracker.recheck_distance;
         let (Some(prediction), Some(map)) = (guesses.first(), self.local_map.as_ref()) else {
             return found;
         };
-        let a = &found.alignment;
-        let moved = (a.pose.translation.vector - prediction.translation.vector).norm();
-        if distance == 0.0 || moved <= distance {
+        let Some(start) = self
+            .config
+            .tracker
+            .recheck_start(prediction, &found.alignment.pose)
+        else {
             return found;
-        }
-        let start = Pose3::from_parts(prediction.translation, a.pose.rotation);
+        };
         let sweep = prepared.coarse.as_ref().unwrap_or(&prepared.cloud);
         match self.odometry.align_sweep(sweep, &map.target, &start) {
-            Some(Ok(other))
-                if pose3_is_finite(&other.alignment.pose)
-                    && other.alignment.inlier_ratio >= a.inlier_ratio
-                    && other.alignment.rmse <= a.rmse =>
-            {
-                other
-            }
+            Some(Ok(other)) if replaces(&other.alignment, &found.alignment) => other,
             _ => found,
         }
     }

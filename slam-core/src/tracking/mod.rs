@@ -23,5 +23,6 @@ mod turn_persistence;
 pub use extent::scan_extent;
 pub use health::{FallbackCounts, FallbackReason, TrackingHealth};
 pub use reach::{AdaptiveReach, ReachConfig, point_displacement};
+pub(crate) use tracker::replaces;
 pub use tracker::{TrackOutcome, Tracker, TrackerConfig};
 pub use turn_persistence::{TURN_SHARES, TurnPersistence};

@@ -528,22 +528,34 @@ impl Tracker {
         guess: &Pose3,
         a: Alignment,
     ) -> Alignment {
-        let moved = (a.pose.translation.vector - guess.translation.vector).norm();
-        if self.config.recheck_distance == 0.0 || moved <= self.config.recheck_distance {
+        let Some(start) = self.config.recheck_start(guess, &a.pose) else {
             return a;
-        }
-        let start = Pose3::from_parts(guess.translation, a.pose.rotation);
+        };
         match registrator.align(source, target, &start) {
-            Ok(b)
-                if pose3_is_finite(&b.pose)
-                    && b.inlier_ratio >= a.inlier_ratio
-                    && b.rmse <= a.rmse =>
-            {
-                b
-            }
+            Ok(b) if replaces(&b, &a) => b,
             _ => a,
         }
     }
+}
+
+impl TrackerConfig {
+    /// Where to register again when `found` ended more than [`Self::recheck_distance`] from
+    /// `prediction`'s position: that position with `found`'s rotation; `None` when it ended
+    /// within it, or the recheck is off.
+    #[must_use]
+    pub fn recheck_start(&self, prediction: &Pose3, found: &Pose3) -> Option<Pose3> {
+        let moved = (found.translation.vector - prediction.translation.vector).norm();
+        (self.recheck_distance > 0.0 && moved > self.recheck_distance)
+            .then(|| Pose3::from_parts(prediction.translation, found.rotation))
+    }
+}
+
+/// Whether the recheck's registration `other` replaces `found`: a finite pose that matched at
+/// least as much of the scan with no larger RMS error.
+pub(crate) fn replaces(other: &Alignment, found: &Alignment) -> bool {
+    pose3_is_finite(&other.pose)
+        && other.inlier_ratio >= found.inlier_ratio
+        && other.rmse <= found.rmse
 }
 
 #[cfg(test)]
