@@ -49,6 +49,14 @@ impl Matcher {
         Self { chunks }
     }
 
+    /// The same cache answering within `max_distance`, searching `first_radius` away first.
+    pub(crate) fn with_reach(mut self, max_distance: f64, first_radius: f64) -> Self {
+        for chunk in &mut self.chunks {
+            chunk.cache.set_reach(max_distance, first_radius);
+        }
+        self
+    }
+
     /// Each source point moved by `pose` and its target point within reach, into `pairs` in
     /// source order: the nearest target point when `k` is 1, the mean of the `k` nearest when
     /// more; points without a neighbour within reach, or whose nearest target point has no

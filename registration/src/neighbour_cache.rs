@@ -88,6 +88,14 @@ impl NeighbourCache {
         self
     }
 
+    /// Answers within `max_distance` from now on, searching `first_radius` away first. What a
+    /// slot holds stays true: its kept points and the radius clear of any other do not depend
+    /// on the reach.
+    pub(crate) fn set_reach(&mut self, max_distance: f64, first_radius: f64) {
+        self.max_distance = max_distance;
+        self.first_radius = first_radius;
+    }
+
     /// The `k` points of `target` nearest `p` within reach for point `slot`, into `out`
     /// (cleared; in no particular order), and whether they changed since this slot's previous
     /// answer.
@@ -241,6 +249,49 @@ mod tests {
                     prop_assert_eq!(Some(&ids), last.as_ref(), "step {}: unchanged, but not the previous set", i);
                 }
                 last = Some(ids);
+            }
+        }
+
+        /// A cache carried from one reach to another (wide stages narrowing to the fine one, a
+        /// recheck, the sweep) answers every step as a fresh search within the current reach.
+        #[test]
+        fn answers_equal_a_fresh_search_as_the_reach_changes(
+            points in prop::collection::vec((0.0..3.0f64, 0.0..3.0f64, 0.0..0.5f64), 10..600),
+            steps in prop::collection::vec(
+                ((-0.05..0.05f64, -0.05..0.05f64, -0.05..0.05f64), 0usize..5),
+                1..40,
+            ),
+            start in (0.0..3.0f64, 0.0..3.0f64, 0.0..0.5f64),
+            k in 1usize..5,
+        ) {
+            const REACHES: [f64; 5] = [0.1, 0.3, 0.5, 1.0, 3.0];
+            let mut map = VoxelHashMap::new(0.4, 0.0).unwrap();
+            for &(x, y, z) in &points {
+                map.insert(0, &Point3::new(x, y, z));
+            }
+            let mut cache = NeighbourCache::new(1, k, 2 * k, 1.0).with_first_radius(0.5);
+            let mut p = Point3::new(start.0, start.1, start.2);
+            let (mut out, mut fresh) = (Vec::new(), Vec::new());
+            for (i, &((dx, dy, dz), r)) in steps.iter().enumerate() {
+                let reach = REACHES[r];
+                cache.set_reach(reach, (0.5 * reach).max(0.2));
+                p += nalgebra::Vector3::new(dx, dy, dz);
+                let answer = cache.nearest(0, &map, &p, &mut out);
+                map.nearest_into(&p, k, reach, &mut fresh);
+                if answer == Neighbours::TooFew {
+                    prop_assert!(fresh.len() < k, "step {}: too few at reach {}", i, reach);
+                    continue;
+                }
+                let mut got: Vec<f64> = out.iter().map(|c| {
+                    (Point3::new(f64::from(c.p[0]), f64::from(c.p[1]), f64::from(c.p[2])) - p).norm_squared()
+                }).collect();
+                let mut want: Vec<f64> = fresh.iter().map(|c| f64::from(c.d2)).collect();
+                got.sort_by(f64::total_cmp);
+                want.sort_by(f64::total_cmp);
+                prop_assert_eq!(got.len(), want.len(), "step {} at reach {}", i, reach);
+                for (g, w) in got.iter().zip(&want) {
+                    prop_assert!((g - w).abs() < 1e-5, "step {}: {:?} vs {:?}", i, got, want);
+                }
             }
         }
     }

@@ -21,7 +21,7 @@ use slam_core::{
 use crate::alignment_inputs::checked_target_index;
 use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
-use crate::icp::{Pair, inliers_and_rmse, thin_source};
+use crate::icp::{Pair, first_search_radius, inliers_and_rmse, thin_source};
 use crate::matcher::Matcher;
 use crate::target::{PreparedTarget, TargetIndex};
 
@@ -88,20 +88,20 @@ pub(crate) fn align_sweep(
         _ => (points, times),
     };
     // The scan's own registration usually paired these same points against this target just
-    // before: its neighbours start this one (the same answers as fresh searches).
-    let matcher = target
-        .take_matcher(&points, config.max_correspondence_distance, 1)
-        .unwrap_or_else(|| {
-            Matcher::new(
-                points.len(),
-                1,
-                4,
-                config.max_correspondence_distance,
-                f64::INFINITY,
-            )
-        });
+    // before: its neighbours start this one (the same answers as fresh searches), and this
+    // one's start the next (a recheck from another position).
+    let mut matcher = target.matcher_for(
+        &points,
+        1,
+        config.max_correspondence_distance,
+        first_search_radius(config),
+    );
     // On a worker of the thread pool, as `icp::align`.
-    rayon::scope(|_| align_sweep_indexed(config, &points, &times, matcher, index, initial))
+    let result = rayon::scope(|_| {
+        align_sweep_indexed(config, &points, &times, &mut matcher, index, initial)
+    });
+    target.keep_matcher(&points, 1, matcher);
+    result
 }
 
 /// [`align_sweep`] once the target is indexed and the sweep thinned.
@@ -109,7 +109,7 @@ fn align_sweep_indexed(
     config: &IcpConfig,
     points: &[Point3<f64>],
     times: &[f64],
-    mut matcher: Matcher,
+    matcher: &mut Matcher,
     target: &TargetIndex,
     initial: &Pose3,
 ) -> Result<SweepAlignment, RegistrationError> {
@@ -141,7 +141,7 @@ fn align_sweep_indexed(
     };
     for _ in 0..config.max_iterations {
         iterations += 1;
-        matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
+        matched(&pose, &correction, &mut moved, matcher, &mut pairs)?;
         let (h, b) = normal_equations(config, &pairs, times, &pose, &correction, &mut weights);
         let Some(step) = h.cholesky().map(|c| -c.solve(&b)) else {
             return Err(RegistrationError::Degenerate {
@@ -164,7 +164,7 @@ fn align_sweep_indexed(
         }
     }
     pose.rotation.renormalize();
-    matched(&pose, &correction, &mut moved, &mut matcher, &mut pairs)?;
+    matched(&pose, &correction, &mut moved, matcher, &mut pairs)?;
     let (h, _) = normal_equations(config, &pairs, times, &pose, &correction, &mut weights);
     let information = h.fixed_view::<6, 6>(0, 0).into_owned();
     let (inliers, rmse) = inliers_and_rmse(&pairs, &weights, residual);

@@ -31,8 +31,7 @@ pub struct PreparedTarget {
 struct MatcherMemo {
     /// The source points, in order, whose slots it holds.
     points: Vec<Point3<f64>>,
-    /// The reach and the neighbours a pair reads.
-    max_distance: f64,
+    /// The neighbours a pair reads.
     pair_points: usize,
     matcher: Matcher,
 }
@@ -234,37 +233,50 @@ impl PreparedTarget {
         });
     }
 
-    /// Keeps `matcher`, the neighbour cache an alignment of `points` (`pair_points` a pair,
-    /// within `max_distance`) built against this target, for [`Self::take_matcher`].
+    /// Keeps `matcher`, the neighbour cache an alignment of `points` (`pair_points` a pair)
+    /// built against this target, for [`Self::take_matcher`].
     pub(crate) fn keep_matcher(
         &self,
         points: &[Point3<f64>],
-        max_distance: f64,
         pair_points: usize,
         matcher: Matcher,
     ) {
         *self.last_matcher.borrow_mut() = Some(MatcherMemo {
             points: points.to_vec(),
-            max_distance,
             pair_points,
             matcher,
         });
     }
 
-    /// The kept neighbour cache when it was built for exactly `points` with the same reach and
-    /// pair size since the target last changed: its answers are those of fresh searches
-    /// ([`crate::neighbour_cache`]), so reusing it changes no result, only the searches run.
-    pub(crate) fn take_matcher(
+    /// The kept neighbour cache when it was built for exactly `points` with the same pair size
+    /// since the target last changed, set to reach `max_distance` and search `first_radius`
+    /// away first; otherwise a new one. What a kept slot proves (no target point outside its
+    /// kept ones lies nearer than its clear radius) holds whatever the reach, so its answers
+    /// are those of fresh searches ([`crate::neighbour_cache`]): reusing it changes no result,
+    /// only the searches run. An alignment run again from another start, the wide stages one
+    /// after the other and the sweep after the scan's registration all pair the same points.
+    pub(crate) fn matcher_for(
         &self,
         points: &[Point3<f64>],
-        max_distance: f64,
         pair_points: usize,
-    ) -> Option<Matcher> {
-        let memo = self.last_matcher.borrow_mut().take()?;
-        (memo.points == points
-            && memo.max_distance.to_bits() == max_distance.to_bits()
-            && memo.pair_points == pair_points)
-            .then_some(memo.matcher)
+        max_distance: f64,
+        first_radius: f64,
+    ) -> Matcher {
+        let kept = self
+            .last_matcher
+            .borrow_mut()
+            .take()
+            .filter(|memo| memo.points == points && memo.pair_points == pair_points);
+        match kept {
+            Some(memo) => memo.matcher.with_reach(max_distance, first_radius),
+            None => Matcher::new(
+                points.len(),
+                pair_points,
+                (2 * pair_points).max(4),
+                max_distance,
+                first_radius,
+            ),
+        }
     }
 }
 
