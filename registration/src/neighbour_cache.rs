@@ -199,6 +199,33 @@ mod tests {
     use super::*;
     use crate::voxel_hash_map::VoxelHashMap;
     use proptest::prelude::*;
+    use proptest::test_runner::TestCaseError;
+
+    /// Whether the cache's answer `out` for `p` holds the same distances as the fresh search's
+    /// `fresh` (to rounding); why not otherwise.
+    fn same_distances(
+        out: &[Candidate],
+        fresh: &[Candidate],
+        p: &Point3<f64>,
+    ) -> Result<(), String> {
+        let mut got: Vec<f64> = out
+            .iter()
+            .map(|c| {
+                (Point3::new(f64::from(c.p[0]), f64::from(c.p[1]), f64::from(c.p[2])) - p)
+                    .norm_squared()
+            })
+            .collect();
+        let mut want: Vec<f64> = fresh.iter().map(|c| f64::from(c.d2)).collect();
+        got.sort_by(f64::total_cmp);
+        want.sort_by(f64::total_cmp);
+        let same =
+            got.len() == want.len() && got.iter().zip(&want).all(|(g, w)| (g - w).abs() < 1e-5);
+        if same {
+            Ok(())
+        } else {
+            Err(format!("{got:?} vs {want:?}"))
+        }
+    }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
@@ -233,16 +260,7 @@ mod tests {
                     continue;
                 }
                 let key = |c: &Candidate| f64::from(c.p[0]) * 1e6 + f64::from(c.p[1]) * 1e3 + f64::from(c.p[2]);
-                let mut got: Vec<f64> = out.iter().map(|c| {
-                    (Point3::new(f64::from(c.p[0]), f64::from(c.p[1]), f64::from(c.p[2])) - p).norm_squared()
-                }).collect();
-                let mut want: Vec<f64> = fresh.iter().map(|c| f64::from(c.d2)).collect();
-                got.sort_by(f64::total_cmp);
-                want.sort_by(f64::total_cmp);
-                prop_assert_eq!(got.len(), want.len());
-                for (g, w) in got.iter().zip(&want) {
-                    prop_assert!((g - w).abs() < 1e-5, "step {}: {:?} vs {:?}", i, got, want);
-                }
+                same_distances(&out, &fresh, &p).map_err(|e| TestCaseError::fail(format!("step {i}: {e}")))?;
                 let mut ids: Vec<f64> = out.iter().map(key).collect();
                 ids.sort_by(f64::total_cmp);
                 if answer == Neighbours::Unchanged {
@@ -282,16 +300,8 @@ mod tests {
                     prop_assert!(fresh.len() < k, "step {}: too few at reach {}", i, reach);
                     continue;
                 }
-                let mut got: Vec<f64> = out.iter().map(|c| {
-                    (Point3::new(f64::from(c.p[0]), f64::from(c.p[1]), f64::from(c.p[2])) - p).norm_squared()
-                }).collect();
-                let mut want: Vec<f64> = fresh.iter().map(|c| f64::from(c.d2)).collect();
-                got.sort_by(f64::total_cmp);
-                want.sort_by(f64::total_cmp);
-                prop_assert_eq!(got.len(), want.len(), "step {} at reach {}", i, reach);
-                for (g, w) in got.iter().zip(&want) {
-                    prop_assert!((g - w).abs() < 1e-5, "step {}: {:?} vs {:?}", i, got, want);
-                }
+                same_distances(&out, &fresh, &p)
+                    .map_err(|e| TestCaseError::fail(format!("step {i} at reach {reach}: {e}")))?;
             }
         }
     }
