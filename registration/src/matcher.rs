@@ -9,10 +9,15 @@ use crate::icp::Pair;
 use crate::neighbour_cache::{Candidate, NeighbourCache, Neighbours};
 use crate::target::TargetIndex;
 
-/// Source points a chunk. Fixed, not derived from the number of cores, so that the pairs (and
-/// every result computed from them) are the same on every machine: each chunk's pairs are the
-/// serial loop's for its points, and the chunks are joined in order.
-const CHUNK: usize = 256;
+/// Source points a chunk: an eighth of the source, from 32 to 256 points. Derived from the
+/// source's size only, not from the number of cores, so that the pairs (and every result
+/// computed from them) are the same on every machine: each chunk's pairs are the serial loop's
+/// for its points, and the chunks are joined in order. A wide stage's 600 points in eight
+/// chunks keep both cores busy to the end, where three of 256 left one idle for a third of
+/// each search.
+fn chunk_len(len: usize) -> usize {
+    len.div_ceil(8).clamp(32, 256)
+}
 
 /// One chunk's neighbour cache and pairs.
 struct Chunk {
@@ -25,6 +30,8 @@ struct Chunk {
 /// one alignment (see [`NeighbourCache`]).
 pub(crate) struct Matcher {
     chunks: Vec<Chunk>,
+    /// Points a chunk ([`chunk_len`]).
+    chunk: usize,
 }
 
 impl Matcher {
@@ -37,16 +44,17 @@ impl Matcher {
         max_distance: f64,
         first_radius: f64,
     ) -> Self {
+        let chunk = chunk_len(len);
         let chunks = (0..len)
-            .step_by(CHUNK)
+            .step_by(chunk)
             .map(|start| Chunk {
-                cache: NeighbourCache::new(CHUNK.min(len - start), k, kept, max_distance)
+                cache: NeighbourCache::new(chunk.min(len - start), k, kept, max_distance)
                     .with_first_radius(first_radius),
                 pairs: Vec::new(),
                 nearest: Vec::with_capacity(kept),
             })
             .collect();
-        Self { chunks }
+        Self { chunks, chunk }
     }
 
     /// The same cache answering within `max_distance`, searching `first_radius` away first.
@@ -68,9 +76,10 @@ impl Matcher {
         pose: &Pose3,
         pairs: &mut Vec<Pair>,
     ) {
+        let chunk_len = self.chunk;
         self.chunks
             .par_iter_mut()
-            .zip(source.par_chunks(CHUNK))
+            .zip(source.par_chunks(chunk_len))
             .enumerate()
             .for_each(|(c, (chunk, points))| {
                 chunk.pairs.clear();
@@ -96,7 +105,7 @@ impl Matcher {
                         Point3::from(sum / nearest.len() as f64)
                     };
                     chunk.pairs.push(Pair {
-                        slot: c * CHUNK + i,
+                        slot: c * chunk_len + i,
                         p,
                         q,
                         n,
