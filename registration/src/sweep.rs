@@ -14,8 +14,8 @@
 use nalgebra::{Point3, SMatrix, SVector, Vector6};
 use rayon::prelude::*;
 use slam_core::{
-    Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment, se3_adjoint,
-    se3_exp,
+    Degeneracy, InvalidSetting, PointCloud, Pose3, RegistrationError, SweepAlignment, SweepPath,
+    se3_adjoint, se3_exp,
 };
 
 use crate::alignment_inputs::checked_target_index;
@@ -119,17 +119,25 @@ fn align_sweep_indexed(
     let mut pairs = Vec::with_capacity(points.len());
     let (mut converged, mut iterations) = (false, 0);
     let mut weights = Vec::with_capacity(points.len());
+    let (lo, hi) = times
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+            (lo.min(t), hi.max(t))
+        });
     // Every point moved by its own pose, paired with the target; too few pairs is an error.
+    // The poses over the sweep are blended between steps of at most 1 mrad (`SweepPath`): one
+    // exponential a step instead of one a point and iteration.
     let matched = |pose: &Pose3,
                    correction: &Vector6<f64>,
                    moved: &mut [Point3<f64>],
                    matcher: &mut Matcher,
                    pairs: &mut Vec<Pair>| {
+        let path = SweepPath::over(lo, hi, correction);
         moved
             .par_iter_mut()
             .zip(points.par_iter().zip(times.par_iter()))
             .with_min_len(256)
-            .for_each(|(m, (p, &t))| *m = pose * se3_exp(&(correction * t)) * p);
+            .for_each(|(m, (p, &t))| *m = pose * path.moved(p, t));
         matcher.correspondences(moved, target, &Pose3::identity(), pairs);
         if pairs.len() < config.min_correspondences {
             return Err(RegistrationError::TooFewCorrespondences {

@@ -61,8 +61,8 @@ pub use pose_graph::{Edge, GraphPose, Node, PoseGraph};
 pub use robust_kernel::RobustKernel;
 pub use slam::{
     EdgeInformation, GraphSlam, GraphSlamConfig, KeyframeCloudError, LoopOutcome, LoopRejection,
-    LoopRejections, ScanInput, ScanOutcome, SkipReason, SlamReport, TurnPrediction, deskew,
-    level_on_gravity,
+    LoopRejections, ScanInput, ScanOutcome, SkipReason, SlamReport, SweepPath, TurnPrediction,
+    deskew, level_on_gravity,
 };
 pub use traits::optimizer::{
     IncrementalOptimizer, IncrementalReport, OptimizationReport, Optimizer, StopReason,

@@ -38,7 +38,7 @@ pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
         .zip(times.par_chunks(CHUNK))
         .for_each(|(points, times)| {
             for (p, &t) in points.iter_mut().zip(times) {
-                *p = path.moved(&p.cast::<f64>(), t).cast::<f32>();
+                *p = path.moved(&p.cast::<f64>(), f64::from(t)).cast::<f32>();
             }
         });
     Some(out)
@@ -46,8 +46,22 @@ pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
 
 /// The sensor's poses over a sweep, `exp(t * twist)`, as poses at evenly spaced times that a
 /// point's own time blends between: one exponential per step of time instead of one per point
-/// (a dense scan's 44,000 voxels have as many distinct times).
-struct SweepPath {
+/// (a dense scan's 44,000 voxels have as many distinct times). A point moved by it lands within
+/// `r * 1.25e-7` of where its own exact pose puts it, `r` metres from the sensor (0.025 mm at
+/// 200 m).
+///
+/// ```
+/// use nalgebra::{Point3, Vector6};
+/// use slam_core::SweepPath;
+/// use slam_core::geometry::se3_exp;
+///
+/// let twist = Vector6::new(1.0, 0.0, 0.0, 0.0, 0.0, 2.0);
+/// let path = SweepPath::over(0.0, 0.1, &twist);
+/// let p = Point3::new(20.0, 5.0, 1.0);
+/// let exact = se3_exp(&(twist * 0.037)) * p;
+/// assert!((path.moved(&p, 0.037) - exact).norm() < 1e-5);
+/// ```
+pub struct SweepPath {
     twist: Vector6<f64>,
     /// The first time, and steps per second.
     start: f64,
@@ -78,6 +92,7 @@ const STEP_TURN: f64 = 1e-3;
 const MAX_STEPS: usize = 4096;
 
 impl SweepPath {
+    /// The path over the finite ones of `times` (seconds).
     fn new(times: &[f32], twist: &Vector6<f64>) -> Self {
         let (lo, hi) = times
             .iter()
@@ -85,6 +100,13 @@ impl SweepPath {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
                 (lo.min(f64::from(t)), hi.max(f64::from(t)))
             });
+        Self::over(lo, hi, twist)
+    }
+
+    /// The path of `twist` from time `lo` to `hi` (seconds): points at times outside, or on a
+    /// path that turns more than 4 rad, are moved by their own exact pose.
+    #[must_use]
+    pub fn over(lo: f64, hi: f64, twist: &Vector6<f64>) -> Self {
         let turn = twist.fixed_rows::<3>(3).norm() * (hi - lo);
         // A straight move (no turn) is linear in time: one step is exact.
         let steps = (turn / STEP_TURN).ceil();
@@ -120,9 +142,9 @@ impl SweepPath {
         path
     }
 
-    /// `p`, measured at time `t`, in the frame of the sweep's start.
-    fn moved(&self, p: &Point3<f64>, t: f32) -> Point3<f64> {
-        let t = f64::from(t);
+    /// `p`, measured at time `t` (seconds), moved by the pose at `t`: `exp(t * twist) * p`.
+    #[must_use]
+    pub fn moved(&self, p: &Point3<f64>, t: f64) -> Point3<f64> {
         let s = (t - self.start) * self.rate;
         let last = self.steps.len();
         if last == 0 || !(0.0..=last as f64).contains(&s) {

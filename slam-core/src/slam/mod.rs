@@ -38,7 +38,7 @@ mod scan_tracking;
 
 pub use cloud_store::KeyframeCloudError;
 pub use config::{EdgeInformation, GraphSlamConfig, TurnPrediction};
-pub use deskew::deskew;
+pub use deskew::{SweepPath, deskew};
 pub use engine::{GraphSlam, ScanInput};
 pub use gravity::level_on_gravity;
 pub use report::{LoopOutcome, LoopRejection, LoopRejections, ScanOutcome, SkipReason, SlamReport};
