@@ -181,11 +181,14 @@ fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
 }
 
 /// Seed 11's hand-held walk to just past its fourth corner (150 scans, 75 s), where at 71 s the
-/// sensor turns 39° between two scans and the wide stages slide the scan 1.9 m along the new
+/// sensor turns 39° between two scans and the wide stages once slid the scan 1.9 m along the new
 /// corridor; on the way, scans carried about 0.2 m short (10.5 s). The fine stage and the sweep's
 /// motion run again from the predicted position (`TrackerConfig::recheck_distance`) hold it.
-/// Measured (no loop closes in these 75 s): ATE 4.6 cm and no step more than 0.9° off with the
-/// recheck; without it ATE 0.30 m and a step 23° off (the scan after the slide).
+/// Measured (no loop closes in these 75 s): ATE 3.9 cm and no step more than 0.9° off with the
+/// recheck; without it ATE 6.8 cm and two steps 3.8° off at 39 s. (Before the sweep's points were
+/// moved along a blended path, `slam_core::SweepPath`, the run without the recheck slid at the
+/// corner: ATE 0.30 m and a step 23° off. Which scan a run without the recheck loses moves with
+/// such changes; that it loses one does not.)
 #[test]
 fn a_scan_slid_along_a_corridor_at_a_sharp_corner_is_found_again_from_the_predicted_position() {
     let (samples, body_t_lidar) = hand_held_walk_of_seed(11, 150);
@@ -201,7 +204,7 @@ fn a_scan_slid_along_a_corridor_at_a_sharp_corner_is_found_again_from_the_predic
     let without = lidar_only(config, &samples, &body_t_lidar);
     eprintln!("no recheck: {without:?}");
     assert!(
-        without.worst_step_deg > 10.0 && without.ate > 0.2,
+        without.worst_step_deg > 2.0 && without.ate > with.ate + 0.02,
         "{without:?}"
     );
 }
