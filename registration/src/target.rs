@@ -14,7 +14,7 @@ use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
-use crate::voxel_window::{KeptNormal, VoxelKey, VoxelWindow};
+use crate::voxel_window::{KeptNormal, VoxelWindow};
 
 /// A prepared target: its points indexed for queries, or, for a local map updated in place
 /// ([`MapRegistrator::empty_map`](slam_core::MapRegistrator::empty_map)), the voxel window
@@ -49,7 +49,7 @@ struct Window {
 
 /// The voxels an index of a window was built from, in its slot order.
 struct BuiltFrom {
-    keys: Vec<VoxelKey>,
+    slots: Vec<u32>,
     counts: Vec<u32>,
     kept: Vec<Option<KeptNormal>>,
 }
@@ -134,7 +134,7 @@ impl PreparedTarget {
         let (Some(Ok(index)), Some(built)) = (self.index.take(), w.built.take()) else {
             return;
         };
-        for (i, key) in built.keys.iter().enumerate() {
+        for (i, &slot) in built.slots.iter().enumerate() {
             let Some(&normal) = index.computed_normal(i) else {
                 continue;
             };
@@ -149,7 +149,7 @@ impl PreparedTarget {
                     reused: 0,
                 },
             };
-            w.voxels.keep_normal(key, kept);
+            w.voxels.keep_normal(slot, kept);
         }
     }
 
@@ -198,7 +198,7 @@ impl PreparedTarget {
                 }
                 // Set only here, right after the index it describes is built.
                 let _ = w.built.set(BuiltFrom {
-                    keys: snapshot.keys,
+                    slots: snapshot.slots,
                     counts: snapshot.counts,
                     kept: snapshot.kept,
                 });

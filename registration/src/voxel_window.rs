@@ -8,12 +8,14 @@ use slam_core::Pose3;
 /// Integer voxel coordinates.
 pub(crate) type VoxelKey = [i64; 3];
 
-/// One source's points as added: each moved point with its voxel.
-type Part = Vec<(VoxelKey, Vector3<f64>)>;
+/// One source's points as added: each moved point with its voxel's slot.
+type Part = Vec<(u32, Vector3<f64>)>;
 
 /// Running sum of one voxel's points.
 #[derive(Clone, Copy, Debug)]
 struct Cell {
+    /// The voxel (to drop it from the key map once it is empty).
+    key: VoxelKey,
     sum: Vector3<f64>,
     count: u32,
     /// The voxel's normal as an index of the window last computed or reused it.
@@ -37,7 +39,8 @@ pub(crate) const MAX_NORMAL_REUSE: u32 = 8;
 
 /// The window's centroids with their voxels and the normals kept for them.
 pub(crate) struct Snapshot {
-    pub(crate) keys: Vec<VoxelKey>,
+    /// Per centroid: its voxel's slot in the window, valid until the window next changes.
+    pub(crate) slots: Vec<u32>,
     pub(crate) centroids: Vec<Point3<f64>>,
     /// Per centroid: the voxel's kept normal when it may be reused (its count within a factor
     /// two of the count it was computed at, reused fewer than [`MAX_NORMAL_REUSE`] times).
@@ -53,7 +56,12 @@ pub(crate) struct Snapshot {
 pub(crate) struct VoxelWindow {
     /// One over the voxel size.
     inv: f64,
-    cells: FxHashMap<VoxelKey, Cell>,
+    /// Each occupied voxel's slot in `slots`.
+    cells: FxHashMap<VoxelKey, u32>,
+    /// The voxels' sums by slot; a slot on `free` is empty. A source's points and the normals
+    /// an index keeps find their voxel by slot, without hashing its key again.
+    slots: Vec<Cell>,
+    free: Vec<u32>,
     /// Each key's moved points with their voxels, to subtract exactly what was added.
     parts: FxHashMap<u32, Part>,
 }
@@ -65,6 +73,8 @@ impl VoxelWindow {
         Self {
             inv: 1.0 / f64::from(voxel),
             cells: FxHashMap::default(),
+            slots: Vec::new(),
+            free: Vec::new(),
             parts: FxHashMap::default(),
         }
     }
@@ -84,14 +94,30 @@ impl VoxelWindow {
                 continue;
             }
             let k = [voxel(w.x), voxel(w.y), voxel(w.z)];
-            let cell = self.cells.entry(k).or_insert(Cell {
-                sum: Vector3::zeros(),
-                count: 0,
-                normal: None,
+            let (slots, free) = (&mut self.slots, &mut self.free);
+            let slot = *self.cells.entry(k).or_insert_with(|| {
+                let cell = Cell {
+                    key: k,
+                    sum: Vector3::zeros(),
+                    count: 0,
+                    normal: None,
+                };
+                match free.pop() {
+                    Some(s) => {
+                        slots[s as usize] = cell;
+                        s
+                    }
+                    None => {
+                        slots.push(cell);
+                        // A window holds fewer than 2^32 voxels.
+                        (slots.len() - 1) as u32
+                    }
+                }
             });
+            let cell = &mut slots[slot as usize];
             cell.sum += w;
             cell.count += 1;
-            part.push((k, w));
+            part.push((slot, w));
         }
         self.parts.insert(key, part);
     }
@@ -102,14 +128,15 @@ impl VoxelWindow {
         let Some(part) = self.parts.remove(&key) else {
             return;
         };
-        for (k, w) in part {
-            if let Some(cell) = self.cells.get_mut(&k) {
-                cell.count -= 1;
-                if cell.count == 0 {
-                    self.cells.remove(&k);
-                } else {
-                    cell.sum -= w;
-                }
+        for (slot, w) in part {
+            // A part's slots stay occupied while it is in the window.
+            let cell = &mut self.slots[slot as usize];
+            cell.count -= 1;
+            if cell.count == 0 {
+                self.cells.remove(&cell.key);
+                self.free.push(slot);
+            } else {
+                cell.sum -= w;
             }
         }
     }
@@ -124,13 +151,15 @@ impl VoxelWindow {
     pub(crate) fn snapshot(&self) -> Snapshot {
         let n = self.cells.len();
         let mut snapshot = Snapshot {
-            keys: Vec::with_capacity(n),
+            slots: Vec::with_capacity(n),
             centroids: Vec::with_capacity(n),
             kept: Vec::with_capacity(n),
             counts: Vec::with_capacity(n),
         };
-        for (k, c) in &self.cells {
-            snapshot.keys.push(*k);
+        // In the key map's order: the index's points, and every result, stay as they were.
+        for &slot in self.cells.values() {
+            let c = &self.slots[slot as usize];
+            snapshot.slots.push(slot);
             snapshot
                 .centroids
                 .push(Point3::from(c.sum / f64::from(c.count)));
@@ -144,9 +173,10 @@ impl VoxelWindow {
         snapshot
     }
 
-    /// Keeps `normal` for voxel `key` (ignored when the voxel is gone).
-    pub(crate) fn keep_normal(&mut self, key: &VoxelKey, normal: KeptNormal) {
-        if let Some(cell) = self.cells.get_mut(key) {
+    /// Keeps `normal` for the voxel in `slot` of a [`Snapshot`] taken since the window last
+    /// changed.
+    pub(crate) fn keep_normal(&mut self, slot: u32, normal: KeptNormal) {
+        if let Some(cell) = self.slots.get_mut(slot as usize) {
             cell.normal = Some(normal);
         }
     }
