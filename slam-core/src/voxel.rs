@@ -1,5 +1,7 @@
 //! Voxel-grid downsampling: one point per occupied voxel, at the centroid of the points inside.
 
+use std::cell::RefCell;
+
 use nalgebra::{Point3, Vector3};
 use rustc_hash::FxHashMap;
 
@@ -68,21 +70,60 @@ fn pack((x, y, z): (i64, i64, i64)) -> Option<u64> {
     Some(axis(x)? | (axis(y)? << 21) | (axis(z)? << 42))
 }
 
+/// The thinning's working memory: the voxels' index and their sums.
+struct Scratch<K> {
+    index: FxHashMap<K, u32>,
+    acc: Vec<Accumulator>,
+}
+
+impl<K> Default for Scratch<K> {
+    fn default() -> Self {
+        Self {
+            index: FxHashMap::default(),
+            acc: Vec::new(),
+        }
+    }
+}
+
+/// Voxels a thread's kept [`Scratch`] may hold room for (about 3 MB): enough for any scan's
+/// thinning; what a larger cloud (a whole map) grew it to is given back after its call.
+const KEPT_SCRATCH_VOXELS: usize = 1 << 16;
+
+thread_local! {
+    /// The packed keys' scratch, kept from cloud to cloud on each thread: a scan's thinning
+    /// then allocates nothing but its result. Allocated afresh for every scan, the index and
+    /// the sums (about 1 MB for a VLP-16 scan at 5 cm) were the transients that most often
+    /// found no hole in the heap below what a walk keeps (its keyframes) and moved its top up,
+    /// so that resident memory grew with the walk without being used.
+    static PACKED_SCRATCH: RefCell<Scratch<u64>> = RefCell::new(Scratch::default());
+}
+
+impl<K: std::hash::Hash + Eq + Copy> Scratch<K> {
+    /// Whether this scratch holds room for more than [`KEPT_SCRATCH_VOXELS`] voxels.
+    fn oversized(&self) -> bool {
+        self.index.capacity().max(self.acc.capacity()) > KEPT_SCRATCH_VOXELS
+    }
+}
+
 impl PointCloud {
-    /// Per-voxel sums of the points, in the order each voxel's first point comes, with voxels
-    /// keyed by `key` (`Ok(None)`: a point skipped); the first refusal with its point's index.
+    /// Per-voxel sums of the points into `scratch.acc`, in the order each voxel's first point
+    /// comes, with voxels keyed by `key` (`Ok(None)`: a point skipped); the first refusal with
+    /// its point's index. `scratch` is cleared first: what it held does not matter.
     fn accumulate<K: std::hash::Hash + Eq + Copy>(
         &self,
+        scratch: &mut Scratch<K>,
         key: impl Fn(&Point3<f32>) -> Result<Option<K>, Fallback>,
-    ) -> Result<Vec<Accumulator>, (Fallback, usize)> {
-        let mut index: FxHashMap<K, u32> = FxHashMap::default();
+    ) -> Result<(), (Fallback, usize)> {
+        let Scratch { index, acc } = scratch;
+        index.clear();
+        acc.clear();
         // Room for a voxel every four points, up to 32,768: a dense scan thins to about a
         // third of its points at 5 cm, and a table sized for every point spreads the voxels
         // over more memory than the core's cache holds (an OS1-128 sweep of 131,072 points at
         // 5 cm: 3.4 ms against 5.2 ms with room for all). Growing past it rehashes once or twice.
         let room = (self.len() / 4).min(1 << 15);
         index.reserve(room);
-        let mut acc: Vec<Accumulator> = Vec::with_capacity(room);
+        acc.reserve(room);
         let ring = self.ring();
         let intensity = self.intensity();
         let time = self.time();
@@ -118,7 +159,38 @@ impl PointCloud {
                 a.time += f64::from(v[i]);
             }
         }
-        Ok(acc)
+        Ok(())
+    }
+
+    /// The cloud of the voxels' centroids in `acc`, with the channels this cloud has averaged
+    /// (the ring: the voxel's first point's).
+    fn centroids(&self, acc: &[Accumulator]) -> Result<PointCloud, CloudError> {
+        let points = acc
+            .iter()
+            .map(|a| {
+                let c = a.sum / f64::from(a.count);
+                Point3::new(c.x as f32, c.y as f32, c.z as f32)
+            })
+            .collect();
+        let mut out = PointCloud::from_points(points);
+        if self.ring().is_some() {
+            out = out.with_ring(acc.iter().map(|a| a.ring).collect())?;
+        }
+        if self.intensity().is_some() {
+            out = out.with_intensity(
+                acc.iter()
+                    .map(|a| (a.intensity / f64::from(a.count)) as f32)
+                    .collect(),
+            )?;
+        }
+        if self.time().is_some() {
+            out = out.with_time(
+                acc.iter()
+                    .map(|a| (a.time / f64::from(a.count)) as f32)
+                    .collect(),
+            )?;
+        }
+        Ok(out)
     }
 
     /// [`Self::voxel_downsample`], but a finite point too far out for any voxel key (more than
@@ -195,47 +267,34 @@ impl PointCloud {
         // hash map then holds 16-byte entries instead of 32, and a 131,072-point scan at 5 cm,
         // one voxel per point or nearly, runs about twice as fast. Farther clouds take the
         // general keys.
-        let packed = self.accumulate(|p| match voxel_key(p, inv) {
-            Ok(Some(k)) => pack(k).map(Some).ok_or(Fallback::Wide),
-            Ok(None) => Ok(None),
-            Err(()) => Err(Fallback::OutOfRange),
-        });
-        let acc = match packed {
-            Ok(acc) => acc,
-            Err((Fallback::OutOfRange, i)) => return Err(out_of_range(i)),
-            Err((Fallback::Wide, _)) => self
-                .accumulate(|p| voxel_key(p, inv).map_err(|()| Fallback::OutOfRange))
-                .map_err(|(_, i)| out_of_range(i))?,
+        let packed = |scratch: &mut Scratch<u64>| {
+            let summed = self.accumulate(scratch, |p| match voxel_key(p, inv) {
+                Ok(Some(k)) => pack(k).map(Some).ok_or(Fallback::Wide),
+                Ok(None) => Ok(None),
+                Err(()) => Err(Fallback::OutOfRange),
+            });
+            let out = summed.map(|()| self.centroids(&scratch.acc));
+            if scratch.oversized() {
+                *scratch = Scratch::default();
+            }
+            out
         };
-        let ring = self.ring();
-        let intensity = self.intensity();
-        let time = self.time();
-        let points = acc
-            .iter()
-            .map(|a| {
-                let c = a.sum / f64::from(a.count);
-                Point3::new(c.x as f32, c.y as f32, c.z as f32)
-            })
-            .collect();
-        let mut out = PointCloud::from_points(points);
-        if ring.is_some() {
-            out = out.with_ring(acc.iter().map(|a| a.ring).collect())?;
+        let thinned = PACKED_SCRATCH.with(|kept| match kept.try_borrow_mut() {
+            Ok(mut scratch) => packed(&mut scratch),
+            Err(_) => packed(&mut Scratch::default()),
+        });
+        match thinned {
+            Ok(out) => out,
+            Err((Fallback::OutOfRange, i)) => Err(out_of_range(i)),
+            Err((Fallback::Wide, _)) => {
+                let mut scratch = Scratch::default();
+                self.accumulate(&mut scratch, |p| {
+                    voxel_key(p, inv).map_err(|()| Fallback::OutOfRange)
+                })
+                .map_err(|(_, i)| out_of_range(i))?;
+                self.centroids(&scratch.acc)
+            }
         }
-        if intensity.is_some() {
-            out = out.with_intensity(
-                acc.iter()
-                    .map(|a| (a.intensity / f64::from(a.count)) as f32)
-                    .collect(),
-            )?;
-        }
-        if time.is_some() {
-            out = out.with_time(
-                acc.iter()
-                    .map(|a| (a.time / f64::from(a.count)) as f32)
-                    .collect(),
-            )?;
-        }
-        Ok(out)
     }
 }
 
