@@ -62,6 +62,13 @@ impl std::fmt::Debug for CellCostMemory {
     }
 }
 
+/// A search record no query has written.
+const FRESH: Node = Node {
+    g: 0,
+    parent: 0,
+    stamp: 0,
+};
+
 /// Generations run from 1 to this value, then the stamps are cleared once.
 const MAX_GENERATION: u32 = u32::MAX >> 1;
 
@@ -178,6 +185,8 @@ pub struct CellCostAStar<'g> {
     units: Units,
     /// Whether the octile heuristic guides the search (off: Dijkstra's order, an ablation).
     heuristic: bool,
+    /// The memory's copy of its grid, overwritten by [`Self::into_memory`]'s.
+    labelled: Option<BitGrid>,
 }
 
 /// The grid's size and whether the heuristic guides the search; not the costs and records.
@@ -251,10 +260,17 @@ impl<'g> CellCostAStar<'g> {
     /// What a later planner on the same grid can reuse ([`Self::with_memory`]).
     #[must_use]
     pub fn into_memory(self) -> CellCostMemory {
+        // A copy, so that a planner built from this memory can tell whether its grid is the one
+        // the labels are of (in the memory's own copy, when it came with one).
+        let labelled = match self.labelled {
+            Some(mut labelled) => {
+                labelled.clone_from(self.grid);
+                labelled
+            }
+            None => self.grid.clone(),
+        };
         CellCostMemory {
-            // A copy, so that a planner built from this memory can tell whether its grid is
-            // the one the labels are of.
-            labelled: self.grid.clone(),
+            labelled,
             components: self.components,
             closed: self.closed,
             nodes: self.nodes,
@@ -291,28 +307,37 @@ impl<'g> CellCostAStar<'g> {
         } else {
             Queue::Heap(KeyHeap::default())
         };
-        let same_size = |m: &CellCostMemory| {
-            (m.labelled.width(), m.labelled.height()) == (grid.width(), grid.height())
-        };
-        let (components, closed, nodes, generation) = if let Some(m) = memory.filter(same_size) {
-            let components = if m.labelled == *grid {
-                m.components
-            } else {
-                Components::new(grid)
-            };
-            (components, m.closed, m.nodes, m.generation)
-        } else {
-            let fresh = Node {
-                g: 0,
-                parent: 0,
-                stamp: 0,
-            };
-            (
+        // A memory of another grid lends its allocations: the same as fresh records, with no
+        // new memory while the grid keeps its size, and otherwise grown in place when it can
+        // (the navigator's grids grow as the map does).
+        let (components, closed, nodes, generation, labelled) = match memory {
+            Some(mut m) => {
+                if (m.labelled.width(), m.labelled.height()) == (grid.width(), grid.height()) {
+                    if m.labelled != *grid {
+                        m.components.relabel(grid);
+                    }
+                } else {
+                    m.components.relabel(grid);
+                    m.closed.renew(grid);
+                    m.nodes.clear();
+                    m.nodes.resize(grid.len(), FRESH);
+                    m.generation = 0;
+                }
+                (
+                    m.components,
+                    m.closed,
+                    m.nodes,
+                    m.generation,
+                    Some(m.labelled),
+                )
+            }
+            None => (
                 Components::new(grid),
                 ClosedSet::new(grid),
-                vec![fresh; grid.len()],
+                vec![FRESH; grid.len()],
                 0,
-            )
+                None,
+            ),
         };
         Ok(Self {
             grid,
@@ -326,6 +351,7 @@ impl<'g> CellCostAStar<'g> {
             current_f: 0,
             units,
             heuristic: true,
+            labelled,
         })
     }
 

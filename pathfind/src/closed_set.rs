@@ -25,6 +25,14 @@ impl ClosedSet {
     }
 
     /// Clear every word (keeping the padding bits past the east edge set).
+    /// This set made empty over `grid` (the same as [`ClosedSet::new`]), in the same memory
+    /// when it has room.
+    pub(crate) fn renew(&mut self, grid: &BitGrid) {
+        self.bits.clone_from(grid);
+        self.set.clear();
+        self.clear_all();
+    }
+
     fn clear_all(&mut self) {
         for y in 0..self.bits.height() {
             self.bits.row_words_mut(y).fill(0);

@@ -19,8 +19,21 @@ impl Components {
     /// Label the free cells of `grid` (linear time, a flood fill per component).
     #[must_use]
     pub fn new(grid: &BitGrid) -> Self {
+        Self::labelled_in(Vec::new(), grid)
+    }
+
+    /// These labels replaced by those of `grid` (the same as [`Components::new`]), in the same
+    /// memory when it has room.
+    pub(crate) fn relabel(&mut self, grid: &BitGrid) {
+        let labels = std::mem::take(&mut self.labels);
+        *self = Self::labelled_in(labels, grid);
+    }
+
+    /// The labels of `grid`'s free cells written into `labels` (its contents do not matter).
+    fn labelled_in(mut labels: Vec<u32>, grid: &BitGrid) -> Self {
         let (w, h) = (grid.width() as usize, grid.height() as usize);
-        let mut labels = vec![Self::BLOCKED; w * h];
+        labels.clear();
+        labels.resize(w * h, Self::BLOCKED);
         let mut count = 0u32;
         let mut stack: Vec<usize> = Vec::new();
         for start in 0..w * h {

@@ -96,7 +96,7 @@ impl GridGeometry {
 /// assert_eq!(grid.row_words(1)[1], (1u64 << 6) | !((1u64 << 36) - 1));
 /// # Ok::<(), slam_core::GridError>(())
 /// ```
-#[derive(Clone, PartialEq, Eq, Debug)]
+#[derive(PartialEq, Eq, Debug)]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
@@ -108,6 +108,28 @@ pub struct BitGrid {
     stride: usize,
     words: Vec<u64>,
     geometry: GeometryBits,
+}
+
+impl Clone for BitGrid {
+    fn clone(&self) -> Self {
+        Self {
+            width: self.width,
+            height: self.height,
+            stride: self.stride,
+            words: self.words.clone(),
+            geometry: self.geometry,
+        }
+    }
+
+    /// A copy of `source` in this grid's words, reallocated only when `source` has more: a
+    /// planner that copies its grid at every query allocates nothing while the size holds.
+    fn clone_from(&mut self, source: &Self) {
+        self.width = source.width;
+        self.height = source.height;
+        self.stride = source.stride;
+        self.words.clone_from(&source.words);
+        self.geometry = source.geometry;
+    }
 }
 
 /// `GridGeometry` stored so that `BitGrid` can stay `Eq` (compares the raw bits of the floats).

@@ -171,13 +171,19 @@ proptest! {
             }
             memory = reused.into_memory();
         }
-        // A grid of another size starts afresh.
-        let other = random_grid(w + 1, h, density, seed);
-        let other_costs = vec![1.0; other.len()];
-        let mut planner = CellCostAStar::with_memory(&other, &other_costs, memory).unwrap();
-        let mut fresh = CellCostAStar::new(&other, &other_costs).unwrap();
-        if let (Some(start), Some(goal)) = (free_cell(&other, 1), free_cell(&other, 99)) {
-            prop_assert_eq!(planner.plan(start, goal).unwrap(), fresh.plan(start, goal).unwrap());
+        // A grid of another size, larger or smaller, starts afresh in the memory's allocations.
+        for (ow, oh) in [(w + 1, h), (w, h + 3), (w - 1, h)] {
+            let other = random_grid(ow, oh, density, seed ^ u64::from(ow));
+            let other_costs = random_costs(other.len(), kind, seed.rotate_left(3));
+            let mut planner = CellCostAStar::with_memory(&other, &other_costs, memory).unwrap();
+            let mut fresh = CellCostAStar::new(&other, &other_costs).unwrap();
+            if let (Some(start), Some(goal)) = (free_cell(&other, 1), free_cell(&other, 99)) {
+                prop_assert_eq!(
+                    planner.plan_with_cost(start, goal).unwrap(),
+                    fresh.plan_with_cost(start, goal).unwrap()
+                );
+            }
+            memory = planner.into_memory();
         }
     }
 }
