@@ -19,6 +19,7 @@ use crate::nav::frontier::is_frontier_cell;
 use crate::nav::growing_map::GrowingMap;
 use crate::nav::navigation_map::NavigationMap;
 use crate::nav::navigator::Navigator;
+use crate::nav::planner::PlannerMemory;
 use crate::nav::step::NavigationStep;
 use crate::robot::{MobilityCommand, Robot, Sample};
 
@@ -159,6 +160,10 @@ struct Exploration {
     /// that one refreshed over the cells that changed, when the grid kept its size and place
     /// (a whole layer of the large building cost 16 ms a decision).
     planned_on: Option<(OccupancyGrid, PlanningGrid)>,
+    /// What the last walk's planner kept, for the next walk's to plan in: its per-cell records
+    /// allocated once and grown with the map, not afresh for every walk among the keyframes
+    /// the walks add (which left holes the larger grid's records no longer fitted).
+    planner_memories: Option<[PlannerMemory; 2]>,
 }
 
 /// One walk toward a frontier: where to and from, and how much floor the decision's grid knew
@@ -219,6 +224,7 @@ impl Exploration {
             failures: Vec::new(),
             last_odometry: None,
             planned_on: None,
+            planner_memories: None,
         })
     }
 
@@ -320,7 +326,9 @@ impl Exploration {
                 known_free_m2: known_free_area(navigation.occupancy()),
                 from: position,
             };
-            match self.walk(robot, slam, &mut walker, &walk, max_cycles, observe)? {
+            let end = self.walk(robot, slam, &mut walker, &walk, max_cycles, observe)?;
+            self.planner_memories = Some(walker.into_planner_memories());
+            match end {
                 WalkEnd::Decide => {}
                 WalkEnd::Arrived => self.arrived_at = Some(chosen.goal),
                 WalkEnd::GiveUp(reason) => self.failed(chosen.goal, reason),
@@ -362,7 +370,7 @@ impl Exploration {
     /// [`ExplorerConfig::localise_within`] of the robot (the walk is re-decided before it
     /// leaves that), from the odometry of the last sample.
     fn walker<L: Registrator + Clone, Rb: Robot>(
-        &self,
+        &mut self,
         localiser: &L,
         cloud: &PointCloud,
         navigation: &NavigationMap,
@@ -379,6 +387,10 @@ impl Exploration {
             robot.description(),
             self.navigator.clone(),
         )?;
+        let walker = match self.planner_memories.take() {
+            Some(memories) => walker.with_planner_memories(memories),
+            None => walker,
+        };
         // The pose is the last sample's: the walk from there on is the odometry's.
         match self.last_odometry {
             Some(odom_t_body) => walker.with_start_odometry(odom_t_body),

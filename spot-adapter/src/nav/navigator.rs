@@ -228,6 +228,23 @@ impl<R: Registrator> Navigator<R> {
 }
 
 impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
+    /// This navigator planning with `memories` (on the live grid, then on the map's own), what
+    /// an earlier navigator's planner kept ([`Navigator::into_planner_memories`]): each walk of
+    /// an exploration then plans in the records of the last, grown when the map grew, instead
+    /// of allocating them afresh (about 20 bytes a cell on each grid), and a planner tells by
+    /// the grid whether what it kept still holds. Call it before the first [`Navigator::step`].
+    pub(crate) fn with_planner_memories(mut self, [live, map]: [P::Memory; 2]) -> Self {
+        self.memory = live;
+        self.static_memory = map;
+        self
+    }
+
+    /// What the planner kept on the live grid and on the map's own, for the next navigator
+    /// ([`Navigator::with_planner_memories`]).
+    pub(crate) fn into_planner_memories(self) -> [P::Memory; 2] {
+        [self.memory, self.static_memory]
+    }
+
     /// Localise on `sample` by a search of the seeds within `radius` metres of the estimate in
     /// x and y, `step` apart, at its heading, with the full scan; the best match is taken when
     /// it is good enough. For a start known to be off by up to `radius`, such as the pose a
