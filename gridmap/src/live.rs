@@ -185,6 +185,21 @@ pub struct LiveLayer {
     corner: (i64, i64),
 }
 
+/// The side of `config`'s window in cells of `static_map` (validating `config`).
+fn window_cells(config: &LiveLayerConfig, static_map: &OccupancyGrid) -> Result<u32, GridMapError> {
+    config.validate()?;
+    let n = (config.window / static_map.geometry().resolution)
+        .round()
+        .max(1.0);
+    check(
+        n <= 2_000.0,
+        "LiveLayerConfig::window",
+        config.window,
+        "at most 2,000 cells a side at the map's resolution",
+    )?;
+    Ok(n as u32)
+}
+
 impl LiveLayer {
     /// A live layer over `static_map` (the combined grid starts equal to it).
     ///
@@ -192,17 +207,7 @@ impl LiveLayer {
     /// [`GridMapError::InvalidConfig`] for invalid settings or a window above 2,000 cells a
     /// side at the map's resolution (the scratch window takes 11 bytes per cell).
     pub fn new(static_map: OccupancyGrid, config: LiveLayerConfig) -> Result<Self, GridMapError> {
-        config.validate()?;
-        let n = (config.window / static_map.geometry().resolution)
-            .round()
-            .max(1.0);
-        check(
-            n <= 2_000.0,
-            "LiveLayerConfig::window",
-            config.window,
-            "at most 2,000 cells a side at the map's resolution",
-        )?;
-        let n = n as u32;
+        let n = window_cells(&config, &static_map)?;
         let cells = n as usize * n as usize;
         let queued = BitGrid::new(static_map.width(), static_map.height())?;
         Ok(Self {
@@ -225,6 +230,47 @@ impl LiveLayer {
             beams: Vec::new(),
             corner: (0, 0),
         })
+    }
+
+    /// This layer made anew over `static_map` with `config`: the same as
+    /// [`LiveLayer::new`]`(static_map.clone(), config)`, in this layer's memory (its grids and
+    /// the per-cell observation times, 8 bytes a cell), reallocated only where `static_map` is
+    /// larger. Left as it was on an error.
+    ///
+    /// # Errors
+    /// As [`LiveLayer::new`].
+    pub fn renew(
+        &mut self,
+        static_map: &OccupancyGrid,
+        config: LiveLayerConfig,
+    ) -> Result<(), GridMapError> {
+        let n = window_cells(&config, static_map)?;
+        let cells = n as usize * n as usize;
+        let queued = BitGrid::new(static_map.width(), static_map.height())?;
+        self.static_map.clone_from(static_map);
+        self.combined.clone_from(static_map);
+        self.last_seen.clear();
+        self.last_seen.resize(
+            static_map.width() as usize * static_map.height() as usize,
+            f64::NEG_INFINITY,
+        );
+        self.config = config;
+        self.queued = queued;
+        self.due.clear();
+        self.previous_stamp = f64::NEG_INFINITY;
+        self.n = n;
+        self.state.clear();
+        self.state.resize(cells, UNSEEN);
+        for stamps in [&mut self.hit_stamp, &mut self.free_stamp] {
+            stamps.clear();
+            stamps.resize(cells, 0);
+        }
+        self.counts.clear();
+        self.counts.resize(cells, 0);
+        self.stamp = 0;
+        self.beams.clear();
+        self.corner = (0, 0);
+        Ok(())
     }
 
     /// The static map with the live changes.

@@ -33,11 +33,28 @@ pub enum UnknownCells {
 
 /// A 2D occupancy grid. Cell (0, 0) is the lower-left corner at `geometry().origin`, row `y` grows
 /// along world +y, each cell is `geometry().resolution` metres wide.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Debug, PartialEq, Eq)]
 pub struct OccupancyGrid {
     occupied: BitGrid,
     free: BitGrid,
     stairs: BitGrid,
+}
+
+impl Clone for OccupancyGrid {
+    fn clone(&self) -> Self {
+        Self {
+            occupied: self.occupied.clone(),
+            free: self.free.clone(),
+            stairs: self.stairs.clone(),
+        }
+    }
+
+    /// A copy of `source` in this grid's memory, reallocated only when `source` is larger.
+    fn clone_from(&mut self, source: &Self) {
+        self.occupied.clone_from(&source.occupied);
+        self.free.clone_from(&source.free);
+        self.stairs.clone_from(&source.stairs);
+    }
 }
 
 impl OccupancyGrid {

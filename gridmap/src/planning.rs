@@ -284,7 +284,7 @@ impl CellRect {
 /// covers the rectangle grown by twice the reach, not the map. Plan with pathfind's
 /// `CellCostAStar::new(planning.blocked(), planning.step_costs())`, or with any shortest-path
 /// planner on [`PlanningGrid::blocked`] when the cost is off.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct PlanningGrid {
     config: PlanningGridConfig,
     blocked: BitGrid,
@@ -293,6 +293,31 @@ pub struct PlanningGrid {
     roomy: RoomyCache,
     /// Cells the robot walked ([`PlanningGrid::with_walked`]): inflated by the walked inflation.
     walked: Option<BitGrid>,
+}
+
+impl Clone for PlanningGrid {
+    fn clone(&self) -> Self {
+        Self {
+            config: self.config.clone(),
+            blocked: self.blocked.clone(),
+            clearance: self.clearance.clone(),
+            costs: self.costs.clone(),
+            roomy: self.roomy.clone(),
+            walked: self.walked.clone(),
+        }
+    }
+
+    /// A copy of `source` in this grid's memory (its clearance and costs, 8 bytes a cell),
+    /// reallocated only when `source` is larger: a navigator made for each walk of an
+    /// exploration copies its planning grid into the last one's.
+    fn clone_from(&mut self, source: &Self) {
+        self.config.clone_from(&source.config);
+        self.blocked.clone_from(&source.blocked);
+        self.clearance.clone_from(&source.clearance);
+        self.costs.clone_from(&source.costs);
+        self.roomy.clone_from(&source.roomy);
+        self.walked.clone_from(&source.walked);
+    }
 }
 
 /// The last roomy mask asked for ([`PlanningGrid::roomy`]) with its clearance, kept up to date

@@ -375,3 +375,37 @@ fn beams_passing_over_a_low_box_do_not_clear_it() {
         "clearing with every beam loses it"
     );
 }
+
+#[test]
+fn a_renewed_layer_answers_as_a_new_one() {
+    let world = room(FLOOR);
+    let map = static_map(&world);
+    let floor = FloorMap::flat(FLOOR).unwrap();
+    let mut now = world.clone();
+    now.blocks.remove(7);
+    now.blocks
+        .push(block(4.2, 1.2, FLOOR, 4.8, 1.8, FLOOR + 0.6));
+    // A layer used on a smaller map with other settings, then renewed over the room's.
+    let small = OccupancyGrid::new(20, 30, *map.geometry(), CellState::Free).unwrap();
+    let mut renewed = LiveLayer::new(small, LiveLayerConfig::default()).unwrap();
+    let (pose, scan) = now.scan(sensor(1.0, 1.0), 900);
+    renewed.update(&scan, &pose, &floor, 0.0).unwrap();
+    renewed.renew(&map, every_beam_clears()).unwrap();
+    let mut fresh = LiveLayer::new(map.clone(), every_beam_clears()).unwrap();
+    assert_eq!(renewed.combined(), fresh.combined());
+    for (i, x) in [3.0, 4.0, 6.0].into_iter().enumerate() {
+        let (pose, scan) = now.scan(sensor(x, 3.0), 900);
+        let stamp = 2.0 * i as f64;
+        let a = renewed.update(&scan, &pose, &floor, stamp).unwrap();
+        let b = fresh.update(&scan, &pose, &floor, stamp).unwrap();
+        assert_eq!(a.window, b.window);
+        assert_eq!(renewed.combined(), fresh.combined());
+    }
+    // Invalid settings leave it as it was.
+    let bad = LiveLayerConfig {
+        window: -1.0,
+        ..LiveLayerConfig::default()
+    };
+    assert!(renewed.renew(&map, bad).is_err());
+    assert_eq!(renewed.combined(), fresh.combined());
+}
