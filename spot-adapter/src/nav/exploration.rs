@@ -18,8 +18,7 @@ use crate::nav::explorer_config::ExplorerConfig;
 use crate::nav::frontier::is_frontier_cell;
 use crate::nav::growing_map::GrowingMap;
 use crate::nav::navigation_map::NavigationMap;
-use crate::nav::navigator::Navigator;
-use crate::nav::planner::PlannerMemory;
+use crate::nav::navigator::{Leftovers, Navigator};
 use crate::nav::step::NavigationStep;
 use crate::robot::{MobilityCommand, Robot, Sample};
 
@@ -160,10 +159,11 @@ struct Exploration {
     /// that one refreshed over the cells that changed, when the grid kept its size and place
     /// (a whole layer of the large building cost 16 ms a decision).
     planned_on: Option<(OccupancyGrid, PlanningGrid)>,
-    /// What the last walk's planner kept, for the next walk's to plan in: its per-cell records
-    /// allocated once and grown with the map, not afresh for every walk among the keyframes
-    /// the walks add (which left holes the larger grid's records no longer fitted).
-    planner_memories: Option<[PlannerMemory; 2]>,
+    /// What the last walk's navigator left (its live layer, planning grids and planner
+    /// memories), for the next walk's to copy its map into: per-cell memory allocated once and
+    /// grown with the map, not afresh for every walk among the keyframes the walks add (which
+    /// left holes in the heap that the larger grid's no longer fitted).
+    leftovers: Option<Leftovers>,
 }
 
 /// One walk toward a frontier: where to and from, and how much floor the decision's grid knew
@@ -224,7 +224,7 @@ impl Exploration {
             failures: Vec::new(),
             last_odometry: None,
             planned_on: None,
-            planner_memories: None,
+            leftovers: None,
         })
     }
 
@@ -277,7 +277,7 @@ impl Exploration {
             let cloud = map.cloud_within(position, self.explorer.config().localise_within);
             let mapped = Instant::now();
             self.stages.map += ms_between(started, mapped);
-            let planning = self
+            let (planned_on, planning) = self
                 .planning_layer(navigation.occupancy())
                 .map_err(|e| ExplorationError::Navigation(NavError::NavigationGrid(e)))?;
             let planned = Instant::now();
@@ -296,6 +296,7 @@ impl Exploration {
             {
                 self.explorer
                     .give_up(chosen.goal, GiveUpReason::StillUnknownFromGoal);
+                self.planned_on = Some((planned_on, planning));
                 continue;
             }
             let Some(chosen) = decision.chosen.clone() else {
@@ -316,9 +317,9 @@ impl Exploration {
                     map.full_renders(),
                 ));
             }
-            let mut walker = self
-                .walker(localiser, &cloud, &navigation, planning, map_t_body, robot)
-                .map_err(ExplorationError::Navigation)?;
+            let walker = self.walker(localiser, &cloud, &navigation, &planning, map_t_body, robot);
+            self.planned_on = Some((planned_on, planning));
+            let mut walker = walker.map_err(ExplorationError::Navigation)?;
             self.stages.navigator += chosen_at.elapsed().as_secs_f64() * 1e3;
             self.decision_ms.push(started.elapsed().as_secs_f64() * 1e3);
             let walk = Walk {
@@ -327,7 +328,7 @@ impl Exploration {
                 from: position,
             };
             let end = self.walk(robot, slam, &mut walker, &walk, max_cycles, observe)?;
-            self.planner_memories = Some(walker.into_planner_memories());
+            self.leftovers = Some(walker.into_leftovers());
             match end {
                 WalkEnd::Decide => {}
                 WalkEnd::Arrived => self.arrived_at = Some(chosen.goal),
@@ -346,23 +347,23 @@ impl Exploration {
         }
     }
 
-    /// The planning layer of `occupancy`: the last decision's refreshed over the cells that
-    /// changed since (the same layer as one built whole: `PlanningGrid::refresh`), or built
-    /// whole when the grid grew or moved.
+    /// The planning layer of `occupancy` with `occupancy` (taken out of `planned_on`, to be put
+    /// back when the decision is done with it): the last decision's refreshed over the cells
+    /// that changed since (the same layer as one built whole: `PlanningGrid::refresh`), or
+    /// built whole when the grid grew or moved.
     fn planning_layer(
         &mut self,
         occupancy: &OccupancyGrid,
-    ) -> Result<PlanningGrid, gridmap::GridMapError> {
-        if let Some((earlier, layer)) = self.planned_on.as_mut()
-            && let Ok(changed) = occupancy.changed_from(earlier)
+    ) -> Result<(OccupancyGrid, PlanningGrid), gridmap::GridMapError> {
+        if let Some((mut earlier, mut layer)) = self.planned_on.take()
+            && let Ok(changed) = occupancy.changed_from(&earlier)
         {
             layer.refresh(occupancy, changed)?;
             earlier.clone_from(occupancy);
-            return Ok(layer.clone());
+            return Ok((earlier, layer));
         }
         let layer = PlanningGrid::new(occupancy, self.navigator.planning.clone())?;
-        self.planned_on = Some((occupancy.clone(), layer.clone()));
-        Ok(layer)
+        Ok((occupancy.clone(), layer))
     }
 
     /// The navigator of a walk from `map_t_body`: on the planning grid the frontier was picked
@@ -374,7 +375,7 @@ impl Exploration {
         localiser: &L,
         cloud: &PointCloud,
         navigation: &NavigationMap,
-        planning: PlanningGrid,
+        planning: &PlanningGrid,
         map_t_body: Pose3,
         robot: &Rb,
     ) -> Result<Navigator<L>, NavError> {
@@ -383,14 +384,11 @@ impl Exploration {
             cloud,
             navigation,
             planning,
+            self.leftovers.take(),
             map_t_body,
             robot.description(),
             self.navigator.clone(),
         )?;
-        let walker = match self.planner_memories.take() {
-            Some(memories) => walker.with_planner_memories(memories),
-            None => walker,
-        };
         // The pose is the last sample's: the walk from there on is the odometry's.
         match self.last_odometry {
             Some(odom_t_body) => walker.with_start_odometry(odom_t_body),

@@ -73,6 +73,39 @@ pub struct Navigator<R: Registrator, P: NavPlanner = PlannerKind> {
     stuck: StuckMonitor,
 }
 
+/// What a walk's navigator leaves for the next one of an exploration
+/// ([`Navigator::into_leftovers`], [`Navigator::planned`]): its live layer, its two planning
+/// grids and its planner's memories. The next navigator copies its map into them (about 50
+/// bytes a cell of the grid in all) instead of allocating them afresh among the keyframes the
+/// walks add, which left holes in the heap that the next, larger grid's did not fit.
+pub(crate) struct Leftovers {
+    live: LiveLayer,
+    planning: PlanningGrid,
+    /// The map's own planning grid.
+    static_planning: PlanningGrid,
+    /// The planner's memories on `planning` and on `static_planning`.
+    memories: [PlannerMemory; 2],
+}
+
+impl Leftovers {
+    /// A navigator's parts made afresh for `navigation` and its planning grid `planning`.
+    fn new(
+        navigation: &NavigationMap,
+        planning: PlanningGrid,
+        config: &NavigatorConfig,
+    ) -> Result<Self, NavError> {
+        // The live layer starts equal to the map, so its planning grid is the map's.
+        let live = LiveLayer::new(navigation.occupancy().clone(), config.live.clone())
+            .map_err(NavError::NavigationGrid)?;
+        Ok(Self {
+            live,
+            static_planning: planning.clone(),
+            planning,
+            memories: Default::default(),
+        })
+    }
+}
+
 impl<R: Registrator> Navigator<R> {
     /// A navigator for `robot` on `map` (a map cloud to localise against, e.g.
     /// [`slam_core::GraphSlam::map`]) and `navigation` (its occupancy and floor, a
@@ -96,11 +129,15 @@ impl<R: Registrator> Navigator<R> {
         robot.limits.validate()?;
         let planning = PlanningGrid::new(navigation.occupancy(), config.planning.clone())
             .map_err(NavError::NavigationGrid)?;
-        Self::planned(
+        let target = registrator
+            .prepare_target(map)
+            .map_err(NavError::LocalisationMap)?;
+        let parts = Leftovers::new(navigation, planning, &config)?;
+        Self::assembled(
             registrator,
-            map,
+            target,
             navigation,
-            planning,
+            parts,
             map_t_body,
             robot,
             config,
@@ -108,12 +145,19 @@ impl<R: Registrator> Navigator<R> {
     }
 
     /// [`Navigator::new`] with `planning`, the planning grid of `navigation`'s occupancy with
-    /// `config.planning`, made already (the explorer's, which it picked its frontier on).
+    /// `config.planning`, made already (the explorer's, which it picked its frontier on), in
+    /// the memory of `leftovers` when given (the last walk's navigator's: the same navigator as
+    /// one made afresh).
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "Navigator::new's, and what to reuse"
+    )]
     pub(crate) fn planned(
         registrator: R,
         map: &PointCloud,
         navigation: &NavigationMap,
-        planning: PlanningGrid,
+        planning: &PlanningGrid,
+        leftovers: Option<Leftovers>,
         map_t_body: Pose3,
         robot: &RobotDescription,
         config: NavigatorConfig,
@@ -123,10 +167,45 @@ impl<R: Registrator> Navigator<R> {
         let target = registrator
             .prepare_target(map)
             .map_err(NavError::LocalisationMap)?;
-        // The live layer starts equal to the map, so its planning grid is the map's.
-        let live = LiveLayer::new(navigation.occupancy().clone(), config.live.clone())
-            .map_err(NavError::NavigationGrid)?;
-        let static_planning = planning.clone();
+        let parts = match leftovers {
+            Some(mut parts) => {
+                parts
+                    .live
+                    .renew(navigation.occupancy(), config.live.clone())
+                    .map_err(NavError::NavigationGrid)?;
+                parts.planning.clone_from(planning);
+                parts.static_planning.clone_from(planning);
+                parts
+            }
+            None => Leftovers::new(navigation, planning.clone(), &config)?,
+        };
+        Self::assembled(
+            registrator,
+            target,
+            navigation,
+            parts,
+            map_t_body,
+            robot,
+            config,
+        )
+    }
+
+    /// The navigator of `new` and `planned` from its parts.
+    fn assembled(
+        registrator: R,
+        target: R::Target,
+        navigation: &NavigationMap,
+        parts: Leftovers,
+        map_t_body: Pose3,
+        robot: &RobotDescription,
+        config: NavigatorConfig,
+    ) -> Result<Self, NavError> {
+        let Leftovers {
+            live,
+            planning,
+            static_planning,
+            memories: [memory, static_memory],
+        } = parts;
         let planner = config.planner;
         Ok(Self {
             localiser: Localiser::new(registrator, target, map_t_body, config.localiser.clone())?,
@@ -139,14 +218,24 @@ impl<R: Registrator> Navigator<R> {
             config,
             limits: robot.limits.clone(),
             planner,
-            memory: PlannerMemory::default(),
-            static_memory: PlannerMemory::default(),
+            memory,
+            static_memory,
             plan: Plan::default(),
             planned_for: None,
             cycles_since_plan: 0,
             replans: 0,
             recoveries: 0,
         })
+    }
+
+    /// What this navigator leaves for the next walk's ([`Navigator::planned`]).
+    pub(crate) fn into_leftovers(self) -> Leftovers {
+        Leftovers {
+            live: self.live,
+            planning: self.planning,
+            static_planning: self.static_planning,
+            memories: [self.memory, self.static_memory],
+        }
     }
 
     /// This navigator told the robot's odometry at the instant its starting pose `map_t_body`
@@ -228,23 +317,6 @@ impl<R: Registrator> Navigator<R> {
 }
 
 impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
-    /// This navigator planning with `memories` (on the live grid, then on the map's own), what
-    /// an earlier navigator's planner kept ([`Navigator::into_planner_memories`]): each walk of
-    /// an exploration then plans in the records of the last, grown when the map grew, instead
-    /// of allocating them afresh (about 20 bytes a cell on each grid), and a planner tells by
-    /// the grid whether what it kept still holds. Call it before the first [`Navigator::step`].
-    pub(crate) fn with_planner_memories(mut self, [live, map]: [P::Memory; 2]) -> Self {
-        self.memory = live;
-        self.static_memory = map;
-        self
-    }
-
-    /// What the planner kept on the live grid and on the map's own, for the next navigator
-    /// ([`Navigator::with_planner_memories`]).
-    pub(crate) fn into_planner_memories(self) -> [P::Memory; 2] {
-        [self.memory, self.static_memory]
-    }
-
     /// Localise on `sample` by a search of the seeds within `radius` metres of the estimate in
     /// x and y, `step` apart, at its heading, with the full scan; the best match is taken when
     /// it is good enough. For a start known to be off by up to `radius`, such as the pose a
