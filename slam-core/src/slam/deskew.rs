@@ -61,6 +61,7 @@ pub fn deskew(cloud: &PointCloud, twist: &Vector6<f64>) -> Option<PointCloud> {
 /// let exact = se3_exp(&(twist * 0.037)) * p;
 /// assert!((path.moved(&p, 0.037) - exact).norm() < 1e-5);
 /// ```
+#[derive(Clone, Debug)]
 pub struct SweepPath {
     twist: Vector6<f64>,
     /// The first time, and steps per second.
@@ -74,7 +75,7 @@ pub struct SweepPath {
 
 /// One step of a [`SweepPath`]: `p` at fraction `a` of it moves to
 /// `rotation * p + translation + a * (d_rotation * p + d_translation)`.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct Blend {
     rotation: nalgebra::Matrix3<f64>,
     translation: nalgebra::Vector3<f64>,
