@@ -102,16 +102,13 @@ impl VoxelWindow {
                     count: 0,
                     normal: None,
                 };
-                match free.pop() {
-                    Some(s) => {
-                        slots[s as usize] = cell;
-                        s
-                    }
-                    None => {
-                        slots.push(cell);
-                        // A window holds fewer than 2^32 voxels.
-                        (slots.len() - 1) as u32
-                    }
+                if let Some(s) = free.pop() {
+                    slots[s as usize] = cell;
+                    s
+                } else {
+                    slots.push(cell);
+                    // A window holds fewer than 2^32 voxels.
+                    (slots.len() - 1) as u32
                 }
             });
             let cell = &mut slots[slot as usize];
