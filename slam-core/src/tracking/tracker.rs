@@ -326,7 +326,7 @@ impl Tracker {
                 // A retry replaces a registration that was taken only when it matches clearly
                 // more: along a corridor a pose slid by a few centimetres can match a little
                 // more by chance.
-                match self.retry(registrator, source, target, &prediction, None) {
+                match self.retry(registrator, source, target, &prediction) {
                     Some(b) if b.inlier_ratio > a.inlier_ratio + CLEARLY_MORE => (0, b, true),
                     _ => (i, a, false),
                 }
@@ -341,10 +341,7 @@ impl Tracker {
                 let retried = self
                     .config
                     .retry
-                    .then(|| {
-                        let turn = refused.as_ref().map(|a| a.pose.rotation);
-                        self.retry(registrator, source, target, &prediction, turn)
-                    })
+                    .then(|| self.retry(registrator, source, target, &prediction))
                     .flatten();
                 if let Some(a) = retried {
                     (0, a, true)
@@ -424,10 +421,9 @@ impl Tracker {
     }
 
     /// The best registration of the prediction at the initial and the widest reach and turned
-    /// either side, if any is taken: first, when given, the predicted position with `turn` (the
-    /// rotation a refused registration found); then the prediction, then the headings nearest
-    /// it on both sides, farther ones only while the best so far is suspect (most sudden turns
-    /// are found by the first tries; each costs a whole coarse-to-fine registration).
+    /// either side, if any is taken: the prediction first, then the headings nearest it on
+    /// both sides, farther ones only while the best so far is suspect (most sudden turns are
+    /// found by the first tries; each costs a whole coarse-to-fine registration).
     ///
     /// The prediction at both reaches, the initial one when the widest gave nothing or a suspect
     /// fit: a wide reach pulls in a scan turned far from its guess, but in a corridor its far
@@ -440,26 +436,11 @@ impl Tracker {
         source: &R::Source,
         target: &R::Target,
         prediction: &Pose3,
-        turn: Option<nalgebra::UnitQuaternion<f64>>,
     ) -> Option<Alignment> {
         let widest = self.config.reach.max;
         let narrow = self.config.reach.initial.min(widest);
         let step = self.config.retry_turn_step;
         let mut best: Option<Alignment> = None;
-        // A registration refused for sliding metres at a sudden turn has mostly found the turn:
-        // from the predicted position with that turn, at the initial reach, it is often taken
-        // at once (the hand-held walk's retries 10-100 ms -> 2-60 ms).
-        if let Some(rotation) = turn {
-            let guess = Pose3::from_parts(prediction.translation, rotation);
-            if pose3_is_finite(&guess)
-                && let Ok(a) = self.attempt(registrator, source, target, &guess, narrow)
-            {
-                if !self.suspect(&a) {
-                    return Some(a);
-                }
-                best = Some(a);
-            }
-        }
         for k in 0..=self.config.retry_turns {
             let a = k as f64 * step;
             let tries: &[(f64, f64)] = if k == 0 {
