@@ -123,9 +123,9 @@ fn a_turn_beyond_the_basin_is_recovered_from_a_turned_heading() {
     assert!((outcome.pose.rotation.angle().to_degrees() - 20.0).abs() < 1e-9);
 }
 
-/// A corridor whose far pairs slide a scan: a stage reaching farther than 3 m moves the
-/// guess 5 m along it; nearer, a guess within 1 m of `answer` converges to it, and a farther
-/// one stays where it is (matching 70 %).
+/// A corridor whose far pairs slide a scan: a stage reaching farther than 3 m finds `answer`'s
+/// heading but moves the guess 5 m along; nearer, a guess within 1 m and 5 degrees of `answer`
+/// converges to it, and any other stays where it is (matching 70 %).
 struct SlidingCorridor {
     answer: Pose3,
 }
@@ -141,7 +141,8 @@ impl Registrator for SlidingCorridor {
     }
     fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
         let off = (guess.translation.vector - self.answer.translation.vector).norm();
-        Ok(if off <= 1.0 {
+        let turned = guess.rotation.angle_to(&self.answer.rotation);
+        Ok(if off <= 1.0 && turned <= 5f64.to_radians() {
             alignment(self.answer, 0.9)
         } else {
             alignment(*guess, 0.7)
@@ -155,7 +156,10 @@ impl Registrator for SlidingCorridor {
         reach: &Reach,
     ) -> Result<Alignment, RegistrationError> {
         if reach.distance > 3.0 {
-            let slid = Translation3::new(5.0, 0.0, 0.0) * *guess;
+            let slid = Pose3::from_parts(
+                Translation3::new(guess.translation.x + 5.0, guess.translation.y, 0.0),
+                self.answer.rotation,
+            );
             Ok(alignment(slid, 0.7))
         } else {
             self.align(s, t, guess)
@@ -437,4 +441,48 @@ fn a_registration_carried_short_along_a_corridor_is_rechecked_from_the_predicted
             Some("TrackerConfig::recheck_distance")
         );
     }
+}
+
+#[test]
+fn a_registration_refused_for_sliding_at_a_sudden_turn_is_retried_with_its_turn() {
+    // Turns the prediction misses by 15 degrees widen the reach beyond 3 m; no recheck, so that
+    // only the retry can find the scan.
+    let no_recheck = TrackerConfig {
+        recheck_distance: 0.0,
+        ..TrackerConfig::default()
+    };
+    let (mut tracker, _) = warmed_up_with(no_recheck, 20.0, 15.0, 10);
+    assert!(tracker.reach() > 3.0, "{}", tracker.reach());
+    // Turned 47 degrees: none of the retry's turned headings (20, 40, 60) is within 5 degrees,
+    // and every one slides at the widest reach. From the predicted position with the refused
+    // registration's turn, at the initial reach, it converges.
+    let corridor = SlidingCorridor {
+        answer: Pose3::from_parts(
+            Translation3::new(0.3, 0.0, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 47f64.to_radians()),
+        ),
+    };
+    let outcome = tracker.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
+    assert!(outcome.tracked() && outcome.recovered, "{outcome:?}");
+    assert!(
+        (outcome.pose.translation.vector - corridor.answer.translation.vector).norm() < 1e-12
+            && outcome.pose.rotation.angle_to(&corridor.answer.rotation) < 1e-12,
+        "{outcome:?}"
+    );
+    // Without that first try the turned headings miss it, and only the prediction's own pose
+    // (47 degrees off, 70 % matched) is left to take.
+    let (mut tracker, _) = warmed_up_with(
+        TrackerConfig {
+            retry_found_turn: false,
+            ..no_recheck
+        },
+        20.0,
+        15.0,
+        10,
+    );
+    let outcome = tracker.track(&corridor, &(), Some(&()), &[Pose3::identity()], 10.0);
+    assert!(
+        outcome.pose.rotation.angle_to(&corridor.answer.rotation) > 40f64.to_radians(),
+        "{outcome:?}"
+    );
 }
