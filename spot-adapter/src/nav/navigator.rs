@@ -125,19 +125,16 @@ impl<R: Registrator> Navigator<R> {
         robot: &RobotDescription,
         config: NavigatorConfig,
     ) -> Result<Self, NavError> {
+        // Settings refused by name before the grid is built from them.
         config.validate()?;
-        robot.limits.validate()?;
         let planning = PlanningGrid::new(navigation.occupancy(), config.planning.clone())
             .map_err(NavError::NavigationGrid)?;
-        let target = registrator
-            .prepare_target(map)
-            .map_err(NavError::LocalisationMap)?;
-        let parts = Leftovers::new(navigation, planning, &config)?;
-        Self::assembled(
+        Self::planned(
             registrator,
-            target,
+            map,
             navigation,
-            parts,
+            &planning,
+            None,
             map_t_body,
             robot,
             config,
