@@ -9,7 +9,7 @@ use spot_adapter::pipelines::{
     LoamSlam, PointToPlaneSlam, loam_slam, point_to_plane_slam, scan_context_places, slam_config,
 };
 
-use crate::arrays::{cloud_from, cloud_to, pose_from, pose_to, poses_to};
+use crate::arrays::{cloud_from, cloud_to, pose_from, pose_to, poses_to, times_from};
 use crate::config::Settings;
 use crate::error::{ToPyErr, invalid};
 
@@ -152,7 +152,8 @@ impl Slam {
     /// frame when scans come with odometry, else the first scan's LiDAR frame.
     ///
     /// `stamp`: seconds, increasing (default: the last plus 0.1 s). `point_times`: per-point
-    /// seconds relative to the stamp, for deskewing. `odometry`: the robot's `odom_T_body`
+    /// seconds relative to the stamp, for deskewing (a 1-D float32 or float64 array, read in
+    /// place, or a sequence of numbers). `odometry`: the robot's `odom_T_body`
     /// (4 x 4) at the stamp; without it the engine predicts from its own velocity.
     #[pyo3(signature = (points, stamp = None, point_times = None, odometry = None))]
     fn register_frame<'py>(
@@ -160,12 +161,13 @@ impl Slam {
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
         stamp: Option<f64>,
-        point_times: Option<Vec<f32>>,
+        point_times: Option<&Bound<'py, PyAny>>,
         odometry: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Option<Bound<'py, numpy::PyArray2<f64>>>> {
         let mut cloud: PointCloud = cloud_from(points, "points")?;
-        if let Some(t) = point_times {
-            cloud = cloud.with_time(t).map_err(|e| e.to_py())?;
+        if let Some(t) = point_times.filter(|t| !t.is_none()) {
+            let times = times_from(t, "point_times")?;
+            cloud = cloud.with_time(times).map_err(|e| e.to_py())?;
         }
         let odom_t_body = match odometry {
             Some(o) if !o.is_none() => Some(pose_from(o, "odometry")?),

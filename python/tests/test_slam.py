@@ -104,3 +104,26 @@ def test_slam_closes_a_loop_between_places_it_revisits():
     for t, p in zip(truth, slam.poses):
         dt, dr = pose_error(np.linalg.inv(truth[0]) @ t, p)
         assert dt < 0.05 and dr < 0.5, (dt, dr)
+
+
+def test_point_times_are_read_from_arrays_and_sequences_alike():
+    # The same moving sensor's scans with per-point times (seconds into each sweep): as a
+    # float64 array, a float32 array and a list they give the same poses; a wrong length or a
+    # 2-D array is refused by name.
+    rng = np.random.default_rng(5)
+    world = room(rng)
+    truth = trajectory(12)
+    clouds = list(scans(world, truth, rng))
+    times = [np.linspace(0.0, 0.1, len(c)) for c in clouds]
+    runs = []
+    for form in (lambda t: t, lambda t: t.astype(np.float32), lambda t: t.astype(np.float32).tolist()):
+        slam = spot_nav.Slam(keyframe_distance=0.5)
+        for i, (cloud, t) in enumerate(zip(clouds, times)):
+            assert slam.register_frame(cloud, stamp=0.5 * i, point_times=form(t)) is not None
+        runs.append(slam.poses)
+    assert np.array_equal(runs[0], runs[1]) and np.array_equal(runs[1], runs[2])
+    slam = spot_nav.Slam()
+    with pytest.raises(spot_nav.CloudError, match="time channel"):
+        slam.register_frame(clouds[0], stamp=0.0, point_times=times[0][:-1])
+    with pytest.raises(spot_nav.InvalidInputError, match="point_times"):
+        slam.register_frame(clouds[0], stamp=0.0, point_times=np.zeros((len(clouds[0]), 2)))

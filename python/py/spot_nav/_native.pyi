@@ -1,7 +1,7 @@
 """Type stubs of the extension module (spot_nav._native); spot_nav re-exports every name."""
 
 from os import PathLike
-from typing import Literal, Optional, Union
+from typing import Literal, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -150,7 +150,7 @@ class Slam:
         self,
         points: Cloud,
         stamp: Optional[float] = None,
-        point_times: Optional[list[float]] = None,
+        point_times: Optional[Union[npt.NDArray[np.floating], Sequence[float]]] = None,
         odometry: Optional[Matrix4] = None,
     ) -> Optional[npt.NDArray[np.float64]]:
         """Feed one scan (LiDAR frame); its ``map_T_lidar`` or None when skipped. The map frame
