@@ -176,6 +176,14 @@ impl MapRegistrator for CountingIcp {
         self.icp.target_from_sources(parts)
     }
 
+    fn fit_to_scan(&mut self, points: usize) {
+        self.icp.fit_to_scan(points);
+    }
+
+    fn map_voxel(&self) -> Option<f32> {
+        self.icp.map_voxel()
+    }
+
     fn keyframe_source(&self, source: Self::Source) -> Self::Source {
         self.icp.keyframe_source(source)
     }

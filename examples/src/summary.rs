@@ -20,8 +20,9 @@ pub struct SlamSummary {
     pub input: Input,
     /// The registration backend (`p2plane` or `loam`).
     pub registration: String,
-    /// Point-to-plane: the voxel (metres) the tracker's local map is kept at
-    /// (`--tracker-map-voxel`, `IcpConfig::target_voxel`); `None` for LOAM.
+    /// Point-to-plane: the voxel (metres) the tracker's local map was kept at
+    /// (`--tracker-map-voxel`, or the tracker's own for the sensor's density:
+    /// `IcpConfig::target_voxel` after `MapRegistrator::fit_to_scan`); `None` for LOAM.
     pub tracker_map_voxel: Option<f32>,
     /// Scans given to the engine.
     pub scans: usize,

@@ -78,6 +78,15 @@ pub struct IcpConfig {
     /// or more at a 0.25 m voxel) then costs what a VLP-16's does (about 2,000), while the
     /// scan kept for a map (a keyframe's) stays whole.
     pub max_source_points: usize,
+    /// Scans of at most this many points (as the sensor gave them) get their maps thinned to
+    /// [`IcpConfig::sparse_target_voxel`] instead of [`IcpConfig::target_voxel`], once an
+    /// engine has set the backend up for its first scan
+    /// ([`MapRegistrator::fit_to_scan`](slam_core::MapRegistrator::fit_to_scan)); 0 (the
+    /// default) never.
+    pub sparse_scan_points: usize,
+    /// The map voxel for scans of at most [`IcpConfig::sparse_scan_points`] points (0 keeps
+    /// every point).
+    pub sparse_target_voxel: f32,
 }
 
 impl Default for IcpConfig {
@@ -98,11 +107,34 @@ impl Default for IcpConfig {
             degeneracy_threshold: 0.0,
             min_planarity: 0.0,
             max_source_points: 0,
+            sparse_scan_points: 0,
+            sparse_target_voxel: 0.0,
         }
     }
 }
 
 impl IcpConfig {
+    /// These settings for a sensor whose first scan has `points` points: with
+    /// [`IcpConfig::sparse_scan_points`] above zero and `points` no more than it, the map voxel
+    /// becomes [`IcpConfig::sparse_target_voxel`]; the rule is then spent (set to 0), so that the
+    /// settings describe what the backend does from then on.
+    ///
+    /// ```
+    /// use registration::IcpConfig;
+    ///
+    /// let rule = IcpConfig { target_voxel: 0.2, sparse_scan_points: 50_000, sparse_target_voxel: 0.15, ..IcpConfig::default() };
+    /// let (mut vlp16, mut os1_128) = (rule, rule);
+    /// vlp16.fit_to_scan(28_800);
+    /// os1_128.fit_to_scan(131_072);
+    /// assert_eq!((vlp16.target_voxel, os1_128.target_voxel), (0.15, 0.2));
+    /// ```
+    pub fn fit_to_scan(&mut self, points: usize) {
+        if self.sparse_scan_points > 0 && points <= self.sparse_scan_points {
+            self.target_voxel = self.sparse_target_voxel;
+        }
+        self.sparse_scan_points = 0;
+    }
+
     /// These settings with the correspondence reach and the kernel's threshold of `reach` (a
     /// kernel without a threshold stays as it is), for a tracker's coarse stage: at most 600
     /// source points, a coarse stride of at least 4, tolerances of at least 1 mm and 1 mrad and
@@ -159,6 +191,7 @@ impl IcpConfig {
         for (setting, v) in [
             ("IcpConfig::source_voxel", c.source_voxel),
             ("IcpConfig::target_voxel", c.target_voxel),
+            ("IcpConfig::sparse_target_voxel", c.sparse_target_voxel),
         ] {
             InvalidSetting::check_f32(v.is_finite() && v >= 0.0, setting, v, NON_NEGATIVE)?;
         }

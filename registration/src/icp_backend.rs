@@ -66,6 +66,20 @@ macro_rules! icp_backend {
                 $crate::icp_target::target_from_sources::<$step>(&self.config, parts)
             }
 
+            /// With [`IcpConfig::sparse_scan_points`](crate::IcpConfig::sparse_scan_points)
+            /// above zero, a scan of at most that many points sets the map's voxel to
+            /// [`IcpConfig::sparse_target_voxel`](crate::IcpConfig::sparse_target_voxel) (and
+            /// the rule is then spent: a later call changes nothing).
+            fn fit_to_scan(&mut self, points: usize) {
+                self.config.fit_to_scan(points);
+            }
+
+            /// [`IcpConfig::target_voxel`](crate::IcpConfig::target_voxel) (0 when the map keeps
+            /// every point).
+            fn map_voxel(&self) -> Option<f32> {
+                Some(self.config.target_voxel)
+            }
+
             /// The source as it is: its voxel centroids are already as thin as a map takes them.
             fn keyframe_source(&self, source: Self::Source) -> Self::Source {
                 source

@@ -404,6 +404,14 @@ impl MapRegistrator for LoamRegistrator {
         None
     }
 
+    /// Nothing to set: LOAM's feature maps keep their own voxels whatever the sensor.
+    fn fit_to_scan(&mut self, _points: usize) {}
+
+    /// `None`: two feature maps, each with its own voxel.
+    fn map_voxel(&self) -> Option<f32> {
+        None
+    }
+
     fn keyframe_source(&self, mut source: Self::Source) -> Self::Source {
         let c = &self.config;
         source.edge_map = voxel_thin(source.edge_map, c.local_map_edge_voxel);

@@ -150,7 +150,7 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     Ok(SlamSummary {
         input: context.input.clone(),
         registration: value_name(&args.registration),
-        tracker_map_voxel: args.tracker_map_voxel_in_effect(),
+        tracker_map_voxel: slam.registrator().map_voxel(),
         scans: report.scans,
         keyframes: report.keyframes,
         revisits: report.revisits,

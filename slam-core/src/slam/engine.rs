@@ -112,6 +112,9 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Place recognition over keyframe scans, when set: loops sought by appearance too.
     pub(super) places: Option<Box<dyn PlaceRecognizer + Send>>,
     pub(super) report: SlamReport,
+    /// Whether the odometry backend was set up for the sensor
+    /// ([`MapRegistrator::fit_to_scan`], with the first scan).
+    pub(super) fitted_to_sensor: bool,
 }
 
 /// The settings, the backends and how far the map has grown; not the keyframes, their clouds
@@ -179,6 +182,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             last_odometry: None,
             places: None,
             report: SlamReport::default(),
+            fitted_to_sensor: false,
         })
     }
 
@@ -248,7 +252,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         &self.optimizer
     }
 
-    /// The odometry's registrator (scans against the local map).
+    /// The odometry's registrator (scans against the local map), set up for the sensor once the
+    /// first scan came ([`MapRegistrator::fit_to_scan`]).
     #[must_use]
     pub fn registrator(&self) -> &R {
         &self.odometry
@@ -333,6 +338,10 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let (guesses, velocity, lidar_only) = match self.predict(scan, odom_t_lidar, swept) {
             Err(reason) => return self.skip(reason, started),
             Ok(Prediction::First { pose, velocity }) => {
+                if !self.fitted_to_sensor {
+                    self.odometry.fit_to_scan(scan.cloud.len());
+                    self.fitted_to_sensor = true;
+                }
                 return match self.prepare(scan, velocity) {
                     Ok(prepared) => {
                         self.add_keyframe(scan, prepared, odom_t_lidar, pose, None, started)

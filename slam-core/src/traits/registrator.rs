@@ -195,6 +195,18 @@ pub trait MapRegistrator: Registrator {
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError>;
 
+    /// Sets the backend up for its sensor, from the number of points (`points`, as the sensor
+    /// gave them, before any thinning) of the first scan a caller registers with it: a backend
+    /// whose map settings follow the scan's density (a sparse 16-beam scan affords a finer map
+    /// than a dense 128-beam one) takes them from here. The engine calls it once, before its
+    /// first keyframe; a backend with nothing to set does nothing.
+    fn fit_to_scan(&mut self, points: usize);
+
+    /// The voxel (metres) its maps are thinned to, when it thins them by voxel (after
+    /// [`MapRegistrator::fit_to_scan`]; 0 when it keeps every point); `None` when it keeps its
+    /// maps another way.
+    fn map_voxel(&self) -> Option<f32>;
+
     /// The form in which a keyframe keeps a prepared source for the maps it will be part of: a
     /// backend may thin here what [`MapRegistrator::target_from_sources`] would thin anyway, so
     /// that each map rebuild touches fewer points. The result must still align as a source.
@@ -310,6 +322,12 @@ impl<R: WholeMapRegistrator> MapRegistrator for R {
         parts: &[(&Self::Source, Pose3)],
     ) -> Result<Self::Target, RegistrationError> {
         self.whole_map(parts)
+    }
+
+    fn fit_to_scan(&mut self, _points: usize) {}
+
+    fn map_voxel(&self) -> Option<f32> {
+        None
     }
 
     fn keyframe_source(&self, source: Self::Source) -> Self::Source {

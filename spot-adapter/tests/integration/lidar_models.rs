@@ -108,3 +108,45 @@ fn every_os1_128_point_lies_on_a_surface_of_the_building() {
     let sigma = (squares / noisy.len() as f64).sqrt();
     assert!((sigma - 0.015).abs() < 5e-4, "noise sigma {sigma}");
 }
+
+/// The SLAM tracker's local map follows the sensor's density, set from the first scan: a
+/// VLP-16 scan (at most 28,800 points) gets the sparse scans' 0.15 m map, an OS1-128 scan (over
+/// 100,000) the dense scans' 0.2 m, and a sparse scan after a dense first one changes nothing.
+/// The oracle: the scans' point counts against `point_to_plane_tracker`'s 60,000.
+#[test]
+fn the_trackers_map_voxel_follows_the_first_scans_density() {
+    use slam_core::MapRegistrator;
+    use spot_adapter::pipelines::{point_to_plane_slam, point_to_plane_tracker, slam_config};
+
+    let b = Building::generate(11, &BuildingConfig::default()).unwrap();
+    let scan = |config: LidarConfig| {
+        SpinningLidar::new(config)
+            .unwrap()
+            .scan(&b, &corridor_pose(&b), &mut SimRng::new(11, 1))
+    };
+    let (sparse, dense) = (scan(LidarConfig::vlp16()), scan(LidarConfig::os1_128()));
+    assert!(sparse.len() <= 28_800 && dense.len() > 100_000);
+    let rule = point_to_plane_tracker().config;
+    assert_eq!(rule.sparse_scan_points, 60_000);
+    let input = |stamp: f64, cloud| slam_core::ScanInput {
+        stamp,
+        odom_t_body: None,
+        body_t_lidar: Pose3::identity(),
+        cloud,
+        gyro_orientation: None,
+    };
+    for (first, then, voxel) in [(&sparse, &dense, 0.15), (&dense, &sparse, 0.2)] {
+        let mut slam = point_to_plane_slam(slam_config()).unwrap();
+        assert_eq!(slam.registrator().map_voxel(), Some(0.2), "before any scan");
+        slam.process(&input(0.0, first));
+        assert_eq!(slam.registrator().map_voxel(), Some(voxel));
+        slam.process(&input(0.1, then));
+        assert_eq!(slam.registrator().map_voxel(), Some(voxel));
+        assert_eq!(
+            slam.registrator().config.sparse_scan_points,
+            0,
+            "the rule is spent"
+        );
+        assert_eq!(slam.report().keyframes, 1);
+    }
+}

@@ -76,6 +76,10 @@ impl MapRegistrator for InPlaceIcp {
             union: self.0.target_from_sources(parts)?,
         })
     }
+    fn fit_to_scan(&mut self, _points: usize) {}
+    fn map_voxel(&self) -> Option<f32> {
+        None
+    }
     fn keyframe_source(&self, source: Prepared) -> Prepared {
         source
     }
