@@ -153,6 +153,8 @@ pub(crate) enum FrontierRule {
     Greedy,
     /// The first frontier of the shortest walk through them all.
     Tour,
+    /// The nearest frontier that would reveal at least 1 m².
+    Revealing,
 }
 
 impl FrontierRule {
@@ -162,10 +164,12 @@ impl FrontierRule {
         match (self, choice) {
             (Self::InformationGain, FrontierChoice::InformationGain { .. })
             | (Self::Greedy, FrontierChoice::GreedyNearestFrontier)
-            | (Self::Tour, FrontierChoice::Tour { .. }) => choice,
+            | (Self::Tour, FrontierChoice::Tour { .. })
+            | (Self::Revealing, FrontierChoice::NearestRevealing { .. }) => choice,
             (Self::InformationGain, _) => FrontierChoice::default(),
             (Self::Greedy, _) => FrontierChoice::GreedyNearestFrontier,
             (Self::Tour, _) => FrontierChoice::Tour { keep_margin: 2.0 },
+            (Self::Revealing, _) => FrontierChoice::NearestRevealing { min_gain: 1.0 },
         }
     }
 
@@ -175,6 +179,7 @@ impl FrontierRule {
             FrontierChoice::InformationGain { .. } => Some(Self::InformationGain),
             FrontierChoice::GreedyNearestFrontier => Some(Self::Greedy),
             FrontierChoice::Tour { .. } => Some(Self::Tour),
+            FrontierChoice::NearestRevealing { .. } => Some(Self::Revealing),
             _ => None,
         }
     }

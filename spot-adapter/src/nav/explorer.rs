@@ -182,8 +182,19 @@ impl Explorer {
                     (f64::NEG_INFINITY, -c.cost)
                 }
             }
-            FrontierChoice::GreedyNearestFrontier | FrontierChoice::Tour { .. } => (0.0, -c.cost),
+            FrontierChoice::GreedyNearestFrontier
+            | FrontierChoice::Tour { .. }
+            | FrontierChoice::NearestRevealing { .. } => (0.0, -c.cost),
         };
+        if let FrontierChoice::NearestRevealing { min_gain } = self.config.choice {
+            // Nearest first, the gain (rays) only until one reveals enough.
+            candidates.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            decision.chosen = candidates.into_iter().find_map(|mut c| {
+                c.gain = self.gain(occupancy, c.frontier.middle);
+                (c.gain >= min_gain).then_some(c)
+            });
+            return decision;
+        }
         if let FrontierChoice::Tour { keep_margin } = self.config.choice
             && candidates.len() > 1
         {
@@ -469,6 +480,7 @@ mod tests {
             FrontierChoice::default(),
             FrontierChoice::GreedyNearestFrontier,
             FrontierChoice::Tour { keep_margin: 2.0 },
+            FrontierChoice::NearestRevealing { min_gain: 1.0 },
         ] {
             let mut explorer = Explorer::new(ExplorerConfig {
                 choice,
@@ -665,5 +677,153 @@ mod tests {
         let decision = explorer.decide(&g, &planning, Vector2::new(5.4, 1.5));
         assert_eq!(decision.chosen, None);
         assert_eq!(decision.unreachable.len(), 2);
+    }
+
+    /// A corridor 6 m long and 1.9 m wide, walled on three sides and open to the east unless
+    /// `east_closed`, with a niche in its north wall near the robot: a gap of 6 cells opening on
+    /// an unknown pocket 6 cells wide and 2 deep, walled all round (a scrap behind furniture).
+    fn corridor_with_a_niche(east_closed: bool) -> (OccupancyGrid, PlanningGrid) {
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let mut g = OccupancyGrid::new(80, 26, geometry, CellState::Unknown).unwrap();
+        for y in 0..=20 {
+            for x in 0..60 {
+                let gap = y == 20 && (10..16).contains(&x);
+                let wall = x == 0 || y == 0 || (y == 20 && !gap) || (east_closed && x == 59);
+                let state = if wall {
+                    CellState::Occupied
+                } else {
+                    CellState::Free
+                };
+                g.set(Cell::new(x, y), state).unwrap();
+            }
+        }
+        // The pocket (y 21-22, x 10-15) stays unknown; its walls.
+        for x in 9..=16 {
+            g.set(Cell::new(x, 23), CellState::Occupied).unwrap();
+        }
+        for y in 21..=22 {
+            g.set(Cell::new(9, y), CellState::Occupied).unwrap();
+            g.set(Cell::new(16, y), CellState::Occupied).unwrap();
+        }
+        let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+        (g, planning)
+    }
+
+    fn decide_with(
+        choice: FrontierChoice,
+        g: &OccupancyGrid,
+        p: &PlanningGrid,
+    ) -> FrontierDecision {
+        Explorer::new(ExplorerConfig {
+            choice,
+            ..ExplorerConfig::default()
+        })
+        .unwrap()
+        .decide(g, p, Vector2::new(1.0, 1.0))
+    }
+
+    /// The niche is nearer, so the nearest-first rule walks to it; it can reveal at most its 12
+    /// unknown cells (0.12 m², the oracle: the pocket is walled all round), so the rule that
+    /// asks for 1 m² walks to the corridor's open end instead, and with that end closed it
+    /// stops (nothing worth a walk) where the nearest-first rule still walks to the niche.
+    #[test]
+    fn the_nearest_revealing_rule_leaves_a_scrap_and_takes_the_open_end() {
+        let revealing = FrontierChoice::NearestRevealing { min_gain: 1.0 };
+        let pocket = 12.0 * 0.1 * 0.1;
+        let (g, planning) = corridor_with_a_niche(false);
+        let greedy = decide_with(FrontierChoice::GreedyNearestFrontier, &g, &planning);
+        let scrap = greedy.chosen.unwrap();
+        assert_eq!(scrap.frontier.size(), 6, "{scrap:?}");
+        assert!(scrap.gain <= pocket + 1e-9, "{}", scrap.gain);
+        let decision = decide_with(revealing, &g, &planning);
+        assert_eq!(decision.reachable, 2);
+        let open_end = decision.chosen.unwrap();
+        assert_eq!(open_end.frontier.size(), 19, "{open_end:?}");
+        assert!(open_end.cost > scrap.cost);
+        assert!(open_end.gain >= 1.0, "{}", open_end.gain);
+
+        let (g, planning) = corridor_with_a_niche(true);
+        let greedy = decide_with(FrontierChoice::GreedyNearestFrontier, &g, &planning);
+        assert_eq!(greedy.chosen.unwrap().frontier.size(), 6);
+        let decision = decide_with(revealing, &g, &planning);
+        assert_eq!(decision.chosen, None, "only the scrap is left");
+        assert_eq!(decision.reachable, 1);
+    }
+
+    /// Random rooms of free, occupied and unknown blocks: the rule's choice is the oracle's, the
+    /// nearest-first rule asked again and again with each frontier it picks that reveals too
+    /// little given up, until one reveals enough or none is left; with no minimum, the two rules
+    /// are the same. (Where two frontiers share a goal, giving one up takes the other too: those
+    /// cases are left out.)
+    #[test]
+    fn the_nearest_revealing_rule_is_nearest_first_without_the_scraps() {
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
+        let (mut chosen, mut shared_goals) = (0, 0);
+        for _ in 0..60 {
+            // 4x4-cell blocks: mostly free near the robot's corner, unknown and walls beyond.
+            let mut g = OccupancyGrid::new(60, 48, geometry, CellState::Unknown).unwrap();
+            for by in 0..12 {
+                for bx in 0..15 {
+                    let state = match next() % 10 {
+                        _ if bx < 3 && by < 3 => CellState::Free,
+                        0..=5 => CellState::Free,
+                        6 | 7 => CellState::Unknown,
+                        _ => CellState::Occupied,
+                    };
+                    for y in 4 * by..4 * by + 4 {
+                        for x in 4 * bx..4 * bx + 4 {
+                            g.set(Cell::new(x, y), state).unwrap();
+                        }
+                    }
+                }
+            }
+            let planning = PlanningGrid::new(&g, PlanningGridConfig::default()).unwrap();
+            let at = Vector2::new(0.6, 0.6);
+            for min_gain in [0.0, 0.5, 2.0, 6.0] {
+                let config = |choice| ExplorerConfig {
+                    choice,
+                    // Only the goal given up: frontiers with goals nearby stay.
+                    give_up_radius: 1e-6,
+                    ..ExplorerConfig::default()
+                };
+                let mut rule =
+                    Explorer::new(config(FrontierChoice::NearestRevealing { min_gain })).unwrap();
+                let got = rule.decide(&g, &planning, at).chosen;
+                let mut greedy =
+                    Explorer::new(config(FrontierChoice::GreedyNearestFrontier)).unwrap();
+                let mut gave_up = 0;
+                let want = loop {
+                    let decision = greedy.decide(&g, &planning, at);
+                    if decision.given_up > gave_up {
+                        // Two frontiers with one goal: giving one up took the other too.
+                        break None;
+                    }
+                    match decision.chosen {
+                        Some(c) if c.gain < min_gain => {
+                            greedy.give_up(c.goal, GiveUpReason::Blocked);
+                            gave_up += 1;
+                        }
+                        other => break Some(other),
+                    }
+                };
+                let Some(want) = want else {
+                    shared_goals += 1;
+                    continue;
+                };
+                assert_eq!(got, want, "min gain {min_gain}");
+                chosen += usize::from(got.is_some());
+            }
+        }
+        assert!(
+            chosen > 60 && shared_goals < 60,
+            "{chosen} choices, {shared_goals} left out: the grids must leave frontiers to pick"
+        );
     }
 }

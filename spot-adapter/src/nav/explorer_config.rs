@@ -39,6 +39,18 @@ pub enum FrontierChoice {
         /// the explorer turns to another, 2 m.
         keep_margin: f64,
     },
+    /// The nearest frontier worth a walk: `explore_lite`'s rule over the frontiers that would
+    /// reveal at least `min_gain` square metres (unknown area in sight of the frontier's middle
+    /// within sensor range); the rest are left, and the exploration ends when only they are.
+    /// On the small buildings the nearest-first rule walked 40-60 % of its distance after its
+    /// map had stopped growing, to scraps along walls and behind furniture (0.1-1.4 m² in
+    /// sight each) whose goals mostly ended with no path, twice each, and again after the first
+    /// `NoPath` lapsed.
+    NearestRevealing {
+        /// Square metres a frontier must reveal to be walked to, 1 (a patch of floor 1 m
+        /// square; a corridor or a room seen through its door shows ten times that or more).
+        min_gain: f64,
+    },
 }
 
 impl Default for FrontierChoice {
@@ -146,6 +158,9 @@ impl ExplorerConfig {
             }
             FrontierChoice::Tour { keep_margin } => {
                 Some(("FrontierChoice::Tour::keep_margin", keep_margin))
+            }
+            FrontierChoice::NearestRevealing { min_gain } => {
+                Some(("FrontierChoice::NearestRevealing::min_gain", min_gain))
             }
             FrontierChoice::GreedyNearestFrontier => None,
         };
