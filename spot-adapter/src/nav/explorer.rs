@@ -90,8 +90,8 @@ pub struct FrontierDecision {
 pub struct Explorer {
     config: ExplorerConfig,
     given_up: Vec<GivenUpFrontier>,
-    /// Per give-up: the decision it was made at, and whether it lapses (a first `NoPath`).
-    given_up_at: Vec<(usize, bool)>,
+    /// Per give-up: the decision from which it lapses (a first `NoPath`), or `None` (for good).
+    lapses_at: Vec<Option<usize>>,
     /// Decisions made.
     decisions: usize,
     /// The goal of the last decision (metres, map frame), kept by [`FrontierChoice::Tour`].
@@ -108,7 +108,7 @@ impl Explorer {
         Ok(Self {
             config,
             given_up: Vec::new(),
-            given_up_at: Vec::new(),
+            lapses_at: Vec::new(),
             decisions: 0,
             heading_for: None,
         })
@@ -125,6 +125,22 @@ impl Explorer {
         position: Vector2<f64>,
     ) -> FrontierDecision {
         self.decisions += 1;
+        let decision = self.choose(occupancy, planning, position);
+        if decision.chosen.is_some() || !self.expire_pending_lapses() {
+            return decision;
+        }
+        // Nothing else left: a frontier given up for a first `NoPath` is tried again now, not
+        // left behind when the exploration ends before its lapse came.
+        self.choose(occupancy, planning, position)
+    }
+
+    /// [`Explorer::decide`]'s choice, on the give-ups as they stand.
+    fn choose(
+        &mut self,
+        occupancy: &OccupancyGrid,
+        planning: &PlanningGrid,
+        position: Vector2<f64>,
+    ) -> FrontierDecision {
         let blocked = planning.blocked();
         let frontiers = find_frontiers(occupancy, self.config.min_frontier_cells);
         let start = nearest_free(blocked, position, self.config.goal_reach);
@@ -237,7 +253,8 @@ impl Explorer {
         });
         let lapses = reason == GiveUpReason::NoPath && !again;
         self.given_up.push(GivenUpFrontier { goal, reason });
-        self.given_up_at.push((self.decisions, lapses));
+        self.lapses_at
+            .push(lapses.then_some(self.decisions + NO_PATH_LAPSES_AFTER));
     }
 
     /// The frontiers given up so far, in order.
@@ -252,15 +269,27 @@ impl Explorer {
         &self.config
     }
 
+    /// Lets every first `NoPath` that has not lapsed yet lapse now; whether there was one.
+    fn expire_pending_lapses(&mut self) -> bool {
+        let mut any = false;
+        for at in self.lapses_at.iter_mut().flatten() {
+            if *at > self.decisions {
+                *at = self.decisions;
+                any = true;
+            }
+        }
+        any
+    }
+
     /// Whether a frontier with its goal at `goal` was given up, and not for a first `NoPath`
     /// [`NO_PATH_LAPSES_AFTER`] decisions ago or more.
     fn is_given_up(&self, goal: Vector2<f64>) -> bool {
         self.given_up
             .iter()
-            .zip(&self.given_up_at)
-            .any(|(g, &(at, lapses))| {
+            .zip(&self.lapses_at)
+            .any(|(g, &lapses_at)| {
                 (g.goal - goal).norm() <= self.config.give_up_radius
-                    && !(lapses && self.decisions >= at + NO_PATH_LAPSES_AFTER)
+                    && lapses_at.is_none_or(|at| self.decisions < at)
             })
     }
 
@@ -587,34 +616,65 @@ mod tests {
     }
 
     /// A frontier given up for a first `NoPath` is tried again once the map has been decided
-    /// on `NO_PATH_LAPSES_AFTER` more times; a second `NoPath` there, or any other reason, is
-    /// for good.
+    /// on `NO_PATH_LAPSES_AFTER` more times, or at once when nothing else is left to explore; a
+    /// second `NoPath` there, or any other reason, is for good.
     #[test]
     fn a_first_no_path_lapses_and_a_second_does_not() {
-        let (g, planning) = corridor_and_patch();
         let at = Vector2::new(1.0, 1.0);
+        let greedy = || {
+            Explorer::new(ExplorerConfig {
+                choice: FrontierChoice::GreedyNearestFrontier,
+                ..ExplorerConfig::default()
+            })
+            .unwrap()
+        };
+        // Two frontiers: the niche (nearer) and the corridor's open end.
+        let (g, planning) = corridor_with_a_niche(false);
         for (reason, lapses) in [
             (GiveUpReason::NoPath, true),
             (GiveUpReason::Blocked, false),
             (GiveUpReason::StillUnknownFromGoal, false),
         ] {
-            let mut explorer = Explorer::new(ExplorerConfig::default()).unwrap();
+            let mut explorer = greedy();
+            let niche = explorer.decide(&g, &planning, at).chosen.unwrap().goal;
+            explorer.give_up(niche, reason);
+            let other = explorer.decide(&g, &planning, at).chosen.unwrap().goal;
+            assert!((other - niche).norm() > 1.0, "{reason:?}");
+            for _ in 2..NO_PATH_LAPSES_AFTER {
+                let goal = explorer.decide(&g, &planning, at).chosen.map(|c| c.goal);
+                assert_eq!(goal, Some(other), "{reason:?}");
+            }
+            let again = explorer.decide(&g, &planning, at).chosen.unwrap().goal;
+            assert_eq!(again, if lapses { niche } else { other }, "{reason:?}");
+            if lapses {
+                explorer.give_up(niche, GiveUpReason::NoPath);
+                for _ in 0..3 * NO_PATH_LAPSES_AFTER {
+                    let goal = explorer.decide(&g, &planning, at).chosen.map(|c| c.goal);
+                    assert_eq!(goal, Some(other));
+                }
+            }
+        }
+        // One frontier: a first `NoPath` is tried again at once, a second is for good.
+        let (g, planning) = corridor_and_patch();
+        for (reason, lapses) in [
+            (GiveUpReason::NoPath, true),
+            (GiveUpReason::Blocked, false),
+            (GiveUpReason::StillUnknownFromGoal, false),
+        ] {
+            let mut explorer = greedy();
             let goal = explorer.decide(&g, &planning, at).chosen.unwrap().goal;
             explorer.give_up(goal, reason);
-            for _ in 1..NO_PATH_LAPSES_AFTER {
+            let again = explorer.decide(&g, &planning, at).chosen.map(|c| c.goal);
+            assert_eq!(again, lapses.then_some(goal), "{reason:?}");
+            if lapses {
+                explorer.give_up(goal, GiveUpReason::NoPath);
+            }
+            for _ in 0..3 * NO_PATH_LAPSES_AFTER {
                 assert_eq!(
                     explorer.decide(&g, &planning, at).chosen,
                     None,
                     "{reason:?}"
                 );
-            }
-            let again = explorer.decide(&g, &planning, at).chosen;
-            assert_eq!(again.map(|c| c.goal), lapses.then_some(goal), "{reason:?}");
-            if lapses {
-                explorer.give_up(goal, GiveUpReason::NoPath);
-                for _ in 0..3 * NO_PATH_LAPSES_AFTER {
-                    assert_eq!(explorer.decide(&g, &planning, at).chosen, None);
-                }
             }
         }
     }
