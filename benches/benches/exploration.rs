@@ -1,6 +1,6 @@
 //! Exploration at flat cost: one autonomous exploration of a simulated building (no map, no
 //! route; the engine, the explorer and the navigator as the mission runs them: point-to-plane
-//! Graph-SLAM, information gain, the navigator's defaults, the full VLP-16), measured against
+//! Graph-SLAM, the default frontier rule, the navigator's defaults, the full VLP-16), measured against
 //! the exploration issue's bars:
 //! - per-scan SLAM time (`GraphSlam::process`, as the engine's report keeps it) over the last
 //!   tenth of the scans against the first tenth, mean and p99 (bar: p99 at most 1.5x);

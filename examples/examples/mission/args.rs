@@ -14,10 +14,10 @@ use spot_nav_examples::{Registration, SettingsArgs, parse_goal, parse_numbers};
 /// The main job on a simulated Spot: map an unknown building, then walk to goals in it.
 ///
 /// By default Spot starts at a random reachable spot of the generated building and explores it
-/// with no map and no route (Graph-SLAM mapping live, frontiers picked by what they would
-/// reveal against the walk to them) until no reachable frontier is left; with `--lap` it maps
-/// in one scripted lap of the corridor loop instead (a route from the true floor plan, as an
-/// operator would walk it). Then it walks to each goal in turn on that map with no recorded
+/// with no map and no route (Graph-SLAM mapping live, the nearest frontier that would reveal
+/// at least 1 m² walked to next) until no reachable frontier worth a walk is left; with `--lap`
+/// it maps in one scripted lap of the corridor loop instead (a route from the true floor plan,
+/// as an operator would walk it). Then it walks to each goal in turn on that map with no recorded
 /// route (localising against the map each scan, replanning on its inflated occupancy grid),
 /// around boxes dropped on the routes after mapping. Prints the mapping accuracy and every
 /// leg's result against the simulator's ground truth, and writes the map, the grid picture,
@@ -70,7 +70,7 @@ pub(crate) struct Args {
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub(crate) floors: usize,
     /// The rule the explorer picks the next frontier by [default: the settings'
-    /// `explorer.choice`, information gain].
+    /// `explorer.choice`, the nearest revealing one].
     #[arg(long, value_enum, conflicts_with = "lap")]
     pub(crate) frontier: Option<FrontierRule>,
     /// The exploration's scan budget (5 Hz): it stops there if frontiers are left.
@@ -166,7 +166,7 @@ impl FrontierRule {
             | (Self::Greedy, FrontierChoice::GreedyNearestFrontier)
             | (Self::Tour, FrontierChoice::Tour { .. })
             | (Self::Revealing, FrontierChoice::NearestRevealing { .. }) => choice,
-            (Self::InformationGain, _) => FrontierChoice::default(),
+            (Self::InformationGain, _) => FrontierChoice::InformationGain { detour: 4.0 },
             (Self::Greedy, _) => FrontierChoice::GreedyNearestFrontier,
             (Self::Tour, _) => FrontierChoice::Tour { keep_margin: 2.0 },
             (Self::Revealing, _) => FrontierChoice::NearestRevealing { min_gain: 1.0 },

@@ -3,9 +3,10 @@
 //!
 //! 1. Mapping, by default by exploring: Spot starts at a random reachable spot (seeded by
 //!    `--seed`) with no map and no route; the Graph-SLAM engine maps live while the explorer
-//!    sends the navigator from frontier to frontier (`--frontier`: information gain, greedy or
-//!    tour) until no reachable frontier is left. With `--lap`, Spot walks one scripted lap of
-//!    the building's corridor loop instead (a route from the true floor plan) while the engine
+//!    sends the navigator from frontier to frontier (`--frontier`: the nearest one that would
+//!    reveal at least 1 m², the default; information gain, greedy or tour) until no reachable
+//!    frontier worth a walk is left. With `--lap`, Spot walks one scripted lap of the
+//!    building's corridor loop instead (a route from the true floor plan) while the engine
 //!    maps it (point-to-plane ICP or LOAM odometry, loop closure, Levenberg-Marquardt).
 //! 2. Navigation: from where the mapping ended, the `Navigator` walks the robot (a
 //!    `CommandedSpot` that moves only as commanded, with drifting odometry) to each goal in

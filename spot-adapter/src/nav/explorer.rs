@@ -78,9 +78,11 @@ pub struct FrontierDecision {
 }
 
 /// Picks frontiers (known-free cells next to unknown ones) to explore by
-/// [`ExplorerConfig::choice`]: [`FrontierChoice::InformationGain`] weighs what a frontier would
-/// reveal against the walk to it, [`FrontierChoice::GreedyNearestFrontier`] takes the nearest,
-/// [`FrontierChoice::Tour`] the first of the shortest walk through them all.
+/// [`ExplorerConfig::choice`]: [`FrontierChoice::NearestRevealing`] (the default) takes the
+/// nearest that would reveal enough to be worth a walk, [`FrontierChoice::InformationGain`]
+/// weighs what a frontier would reveal against the walk to it,
+/// [`FrontierChoice::GreedyNearestFrontier`] takes the nearest, [`FrontierChoice::Tour`] the
+/// first of the shortest walk through them all.
 ///
 /// It keeps no map of its own: each [`Explorer::decide`] looks at the occupancy grid and the
 /// planning grid as they are (the map grows and is re-rendered when a loop closes), with one
