@@ -45,7 +45,7 @@ pub enum FrontierChoice {
     /// On the small buildings the nearest-first rule walked half its distance after its map had
     /// stopped growing, to scraps along walls and behind furniture (0.1-1.4 m² in sight each)
     /// whose goals mostly ended with no path, twice each, and again after the first `NoPath`
-    /// lapsed; this rule walked 0.60x its distance over seeds 11-28 (the default).
+    /// lapsed; this rule walked 0.66x its distance over seeds 11-28 (the default).
     NearestRevealing {
         /// Square metres a frontier must reveal to be walked to, 1 (a patch of floor 1 m
         /// square; a corridor or a room seen through its door shows ten times that or more).

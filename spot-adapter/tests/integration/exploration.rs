@@ -231,7 +231,7 @@ fn print(name: &str, e: &Explored) {
 /// Our explorer maps a small building to at least 97 % of the reachable floor with no collision
 /// and stops by itself, with no frontier left. How far it walks against the greedy
 /// nearest-frontier explorer is measured by [`against_the_greedy_explorer`], not here (ours, the
-/// nearest revealing rule, 0.40-0.86x its distance on seeds 11-28, 0.60x in all; on one building
+/// nearest revealing rule, 0.44-1.02x its distance on seeds 11-28, 0.66x in all; on one building
 /// small changes of the settings move either by 10-30 %).
 #[test]
 fn explores_a_small_building_to_full_coverage() {
