@@ -152,26 +152,25 @@ impl ExplorerConfig {
                 return Err(NavError::invalid(setting, 0.0, "at least 1"));
             }
         }
+        let metres = "finite and not negative (metres)";
         let margin = match self.choice {
             FrontierChoice::InformationGain { detour } => {
-                Some(("FrontierChoice::InformationGain::detour", detour))
+                Some(("FrontierChoice::InformationGain::detour", detour, metres))
             }
             FrontierChoice::Tour { keep_margin } => {
-                Some(("FrontierChoice::Tour::keep_margin", keep_margin))
+                Some(("FrontierChoice::Tour::keep_margin", keep_margin, metres))
             }
-            FrontierChoice::NearestRevealing { min_gain } => {
-                Some(("FrontierChoice::NearestRevealing::min_gain", min_gain))
-            }
+            FrontierChoice::NearestRevealing { min_gain } => Some((
+                "FrontierChoice::NearestRevealing::min_gain",
+                min_gain,
+                "finite and not negative (square metres)",
+            )),
             FrontierChoice::GreedyNearestFrontier => None,
         };
-        if let Some((setting, value)) = margin
+        if let Some((setting, value, expected)) = margin
             && !(value.is_finite() && value >= 0.0)
         {
-            return Err(NavError::invalid(
-                setting,
-                value,
-                "finite and not negative (metres)",
-            ));
+            return Err(NavError::invalid(setting, value, expected));
         }
         // The walk's map must hold what the robot sees of its frontier from where it stands.
         if self.localise_within < 2.0 * self.sensor_range {

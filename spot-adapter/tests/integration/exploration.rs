@@ -423,6 +423,20 @@ fn bad_exploration_settings_are_refused_by_name() {
             },
             "FrontierChoice::Tour::keep_margin",
         ),
+        (
+            ExplorerConfig {
+                choice: FrontierChoice::NearestRevealing { min_gain: f64::NAN },
+                ..ExplorerConfig::default()
+            },
+            "FrontierChoice::NearestRevealing::min_gain",
+        ),
+        (
+            ExplorerConfig {
+                choice: FrontierChoice::NearestRevealing { min_gain: -0.5 },
+                ..ExplorerConfig::default()
+            },
+            "FrontierChoice::NearestRevealing::min_gain",
+        ),
     ] {
         let mut spot = CommandedSpot::new(building.clone(), start, 0.0, &sim).unwrap();
         let mut slam = point_to_plane_slam(slam_config()).unwrap();
