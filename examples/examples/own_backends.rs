@@ -208,6 +208,10 @@ impl MapRegistrator for CountingIcp {
         self.icp.ready_map_beside(map, beside);
     }
 
+    fn ready_map_ahead(&self, map: &mut Self::Target) {
+        self.icp.ready_map_ahead(map);
+    }
+
     fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
         self.icp.stored_source(source)
     }

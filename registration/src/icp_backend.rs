@@ -129,6 +129,12 @@ macro_rules! icp_backend {
             fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
                 map.index_beside(beside);
             }
+
+            /// The map's k-d tree (after a change of an in-place map) built on a thread of its
+            /// own from now until the next alignment claims it.
+            fn ready_map_ahead(&self, map: &mut Self::Target) {
+                map.index_ahead();
+            }
         }
     };
 }

@@ -445,4 +445,7 @@ impl MapRegistrator for LoamRegistrator {
     fn ready_map_beside(&self, _map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
         beside();
     }
+
+    /// Nothing to rebuild (see [`MapRegistrator::ready_map_beside`]).
+    fn ready_map_ahead(&self, _map: &mut Self::Target) {}
 }

@@ -14,7 +14,7 @@ use crate::config::IcpConfig;
 use crate::matcher::Matcher;
 use crate::neighbour_cache::{Candidate, NearestSearch};
 use crate::sym3::symmetric_eigen3;
-use crate::voxel_window::{KeptNormal, VoxelWindow};
+use crate::voxel_window::{KeptNormal, Snapshot, VoxelWindow};
 
 /// A prepared target: its points indexed for queries, or, for a local map updated in place
 /// ([`MapRegistrator::empty_map`](slam_core::MapRegistrator::empty_map)), the voxel window
@@ -25,6 +25,44 @@ pub struct PreparedTarget {
     /// The neighbours the last alignment against this target found, for the next alignment of
     /// the same source points (a sweep's motion found right after the scan's registration).
     last_matcher: RefCell<Option<MatcherMemo>>,
+    /// An in-place map's index being built on a thread of its own for the window as it is now
+    /// ([`Self::index_ahead`]): claimed by the next query, or dropped unclaimed when the window
+    /// changes first.
+    pending: RefCell<Option<std::thread::JoinHandle<WindowIndex>>>,
+}
+
+/// An in-place map's index with the voxels it was built from (`None` when it could not be
+/// built).
+type WindowIndex = (Result<TargetIndex, RegistrationError>, Option<BuiltFrom>);
+
+/// The index of a window's `snapshot`: its centroids' k-d tree with the normals kept from
+/// earlier indexes set (and every other one computed with `normals_up_front`), with what it was
+/// built from. A function of the snapshot alone, so that it is the same on whichever thread
+/// and at whichever time it runs.
+fn window_index(
+    snapshot: Snapshot,
+    normals: Option<(usize, f64)>,
+    normals_up_front: bool,
+    min_points: usize,
+) -> WindowIndex {
+    let index = match TargetIndex::new(snapshot.centroids, normals, min_points) {
+        Ok(index) => index,
+        Err(e) => return (Err(e), None),
+    };
+    for (i, kept) in snapshot.kept.iter().enumerate() {
+        if let Some(k) = kept {
+            index.set_normal(i, k.normal);
+        }
+    }
+    if normals_up_front {
+        index.compute_all_normals();
+    }
+    let built = BuiltFrom {
+        slots: snapshot.slots,
+        counts: snapshot.counts,
+        kept: snapshot.kept,
+    };
+    (Ok(index), Some(built))
 }
 
 /// An alignment's neighbour cache with what it is valid for.
@@ -99,6 +137,7 @@ impl PreparedTarget {
             index: OnceCell::from(Ok(index)),
             window: None,
             last_matcher: RefCell::new(None),
+            pending: RefCell::new(None),
         })
     }
 
@@ -113,6 +152,7 @@ impl PreparedTarget {
         Self {
             index: OnceCell::new(),
             last_matcher: RefCell::new(None),
+            pending: RefCell::new(None),
             window: Some(Box::new(Window {
                 voxels: VoxelWindow::new(voxel),
                 normals,
@@ -128,6 +168,9 @@ impl PreparedTarget {
     /// and recomputing every normal an alignment touches cost more than the alignment itself
     /// (see [`crate::voxel_window::MAX_NORMAL_REUSE`] for how long one is kept).
     fn keep_normals(&mut self) {
+        // An index built ahead for a window that changed before any query was never used: as
+        // if it had not been built (the thread finishes alone and its result is dropped).
+        self.pending.get_mut().take();
         let Some(w) = self.window.as_mut() else {
             return;
         };
@@ -189,23 +232,22 @@ impl PreparedTarget {
                         required: 1,
                     });
                 };
-                let snapshot = w.voxels.snapshot();
-                let index = TargetIndex::new(snapshot.centroids, w.normals, w.min_points)?;
-                for (i, kept) in snapshot.kept.iter().enumerate() {
-                    if let Some(k) = kept {
-                        index.set_normal(i, k.normal);
-                    }
-                }
-                // Set only here, right after the index it describes is built.
-                let _ = w.built.set(BuiltFrom {
-                    slots: snapshot.slots,
-                    counts: snapshot.counts,
-                    kept: snapshot.kept,
+                let ahead = self.pending.borrow_mut().take();
+                // A thread that could not finish (it cannot panic on any window) leaves the
+                // index to be built here.
+                let (index, built) = ahead.and_then(|h| h.join().ok()).unwrap_or_else(|| {
+                    window_index(
+                        w.voxels.snapshot(),
+                        w.normals,
+                        w.normals_up_front,
+                        w.min_points,
+                    )
                 });
-                if w.normals_up_front {
-                    index.compute_all_normals();
+                if let Some(built) = built {
+                    // Set only here, right after the index it describes is built.
+                    let _ = w.built.set(built);
                 }
-                Ok(index)
+                index
             })
             .as_ref()
             .map_err(Clone::clone)
@@ -222,6 +264,12 @@ impl PreparedTarget {
             beside();
             return;
         }
+        // Being built ahead: `beside` meanwhile, then the index claimed.
+        if self.pending.get_mut().is_some() {
+            beside();
+            let _ = self.index();
+            return;
+        }
         let target = &mut *self;
         // A thread of its own, not the pool's: the pool's idle worker did not take the other
         // half of a `rayon::join` begun outside the pool before the first half was done.
@@ -231,6 +279,29 @@ impl PreparedTarget {
             });
             beside();
         });
+    }
+
+    /// Starts building the index of an in-place map that changed since its last one on a
+    /// thread of its own, and returns at once: the next query (or [`Self::index_beside`])
+    /// claims it, waiting for it if need be. The index is the one that query would build (its
+    /// window's snapshot, taken now, is all it reads); a change to the window before then
+    /// drops it unused. Nothing to do for a target prepared whole, an index built already or
+    /// one under way; without a thread the query builds it as before.
+    pub(crate) fn index_ahead(&mut self) {
+        if self.index.get().is_some() || self.pending.get_mut().is_some() {
+            return;
+        }
+        let Some(w) = self.window.as_ref() else {
+            return;
+        };
+        let snapshot = w.voxels.snapshot();
+        let (normals, up_front, min_points) = (w.normals, w.normals_up_front, w.min_points);
+        if let Ok(handle) = std::thread::Builder::new()
+            .name("local-map-index".into())
+            .spawn(move || window_index(snapshot, normals, up_front, min_points))
+        {
+            *self.pending.get_mut() = Some(handle);
+        }
     }
 
     /// Keeps `matcher`, the neighbour cache an alignment of `points` (`pair_points` a pair)

@@ -164,6 +164,60 @@ fn a_map_readied_beside_other_work_aligns_as_one_indexed_on_first_use() {
     assert_eq!(ran, 8, "the work beside ran once a call");
 }
 
+/// A map indexed ahead on another thread aligns every scan exactly as one indexed on its first
+/// query, keyframe after keyframe (the normals each index keeps for the next included), and an
+/// index built ahead for a window that changes before any query is dropped unused.
+#[test]
+fn a_map_indexed_ahead_aligns_as_one_indexed_on_first_use() {
+    use slam_core::{MapRegistrator, Registrator};
+    let icp = crate::PointToPlaneIcp::default();
+    let room = room_with(&[]);
+    let source = icp.prepare_source(&room).unwrap();
+    let (mut ahead, mut lazy) = (icp.empty_map().unwrap(), icp.empty_map().unwrap());
+    let guess = Pose3::new(
+        nalgebra::Vector3::new(0.08, -0.04, 0.02),
+        nalgebra::Vector3::new(0.0, 0.0, 0.02),
+    );
+    let mut ran = 0;
+    for k in 0u32..12 {
+        let pose = Pose3::new(
+            nalgebra::Vector3::new(0.03 * f64::from(k), 0.01 * f64::from(k % 3), 0.0),
+            nalgebra::Vector3::new(0.0, 0.0, 0.003 * f64::from(k % 4)),
+        );
+        for map in [&mut ahead, &mut lazy] {
+            icp.add_to_map(map, k, &source, &pose);
+            if let Some(old) = k.checked_sub(3) {
+                icp.remove_from_map(map, old);
+            }
+        }
+        icp.ready_map_ahead(&mut ahead);
+        if k % 4 == 1 {
+            // Changed again before any query: the index under way is dropped, the next one
+            // built for the map as it is then; the lazy twin sees the same changes.
+            assert!(ahead.pending.get_mut().is_some(), "keyframe {k}");
+            for map in [&mut ahead, &mut lazy] {
+                icp.remove_from_map(map, k);
+                icp.add_to_map(map, k, &source, &pose);
+            }
+            assert!(ahead.pending.get_mut().is_none(), "keyframe {k}: dropped");
+            icp.ready_map_ahead(&mut ahead);
+        }
+        if k % 2 == 0 {
+            icp.ready_map_beside(&mut ahead, &mut || ran += 1);
+            assert!(matches!(ahead.index.get(), Some(Ok(_))), "keyframe {k}");
+            assert!(ahead.pending.get_mut().is_none(), "keyframe {k}: claimed");
+        }
+        let a = icp.align(&source, &ahead, &guess).unwrap();
+        let b = icp.align(&source, &lazy, &guess).unwrap();
+        assert_eq!(a, b, "keyframe {k}");
+    }
+    assert_eq!(ran, 6, "the work beside ran once a call");
+    // A target prepared whole has nothing to build.
+    let mut whole = icp.target_from_sources(&[(&source, Pose3::identity())]).unwrap();
+    icp.ready_map_ahead(&mut whole);
+    assert!(whole.pending.get_mut().is_none());
+}
+
 #[test]
 fn without_a_target_voxel_the_map_is_built_whole() {
     use slam_core::MapRegistrator;

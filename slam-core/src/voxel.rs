@@ -70,6 +70,39 @@ fn pack((x, y, z): (i64, i64, i64)) -> Option<u64> {
     Some(axis(x)? | (axis(y)? << 21) | (axis(z)? << 42))
 }
 
+/// Half the packed span in voxels, as a float: a coordinate strictly within it floors to a
+/// packable voxel.
+const PACK_HALF_F64: f64 = PACK_HALF as f64;
+
+/// The packed key of `p`'s voxel: `Ok(None)` when `p` is not finite, [`Fallback::Wide`] when
+/// its voxel is beyond what packed keys hold, [`Fallback::OutOfRange`] beyond any key. The same
+/// keys as [`voxel_key`] then [`pack`], with one test a point for the usual case: a scan's
+/// points are all finite and within 2^20 voxels, and every thinned point passes here.
+#[inline]
+fn packed_key(p: &Point3<f32>, inv: f64) -> Result<Option<u64>, Fallback> {
+    let (x, y, z) = (
+        f64::from(p.x) * inv,
+        f64::from(p.y) * inv,
+        f64::from(p.z) * inv,
+    );
+    // NaN and infinities fail the comparison too, and take the general path below.
+    if x.abs() < PACK_HALF_F64 && y.abs() < PACK_HALF_F64 && z.abs() < PACK_HALF_F64 {
+        // Within the span: truncate, step down for negatives (the floor), offset. The casts
+        // cannot wrap: each value is below 2^20 in magnitude.
+        let axis = |v: f64| {
+            let t = v as i64;
+            let floor = if (t as f64) > v { t - 1 } else { t };
+            (floor + PACK_HALF) as u64
+        };
+        return Ok(Some(axis(x) | (axis(y) << 21) | (axis(z) << 42)));
+    }
+    match voxel_key(p, inv) {
+        Ok(Some(k)) => pack(k).map(Some).ok_or(Fallback::Wide),
+        Ok(None) => Ok(None),
+        Err(()) => Err(Fallback::OutOfRange),
+    }
+}
+
 /// The thinning's working memory: the voxels' index and their sums.
 struct Scratch<K> {
     index: FxHashMap<K, u32>,
@@ -268,11 +301,7 @@ impl PointCloud {
         // one voxel per point or nearly, runs about twice as fast. Farther clouds take the
         // general keys.
         let packed = |scratch: &mut Scratch<u64>| {
-            let summed = self.accumulate(scratch, |p| match voxel_key(p, inv) {
-                Ok(Some(k)) => pack(k).map(Some).ok_or(Fallback::Wide),
-                Ok(None) => Ok(None),
-                Err(()) => Err(Fallback::OutOfRange),
-            });
+            let summed = self.accumulate(scratch, |p| packed_key(p, inv));
             let out = summed.map(|()| self.centroids(&scratch.acc));
             if scratch.oversized() {
                 *scratch = Scratch::default();

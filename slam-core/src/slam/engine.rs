@@ -573,20 +573,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if self.insert_node(id, pose, edge.as_ref()).is_err() {
             return self.skip(SkipReason::NonFinitePose, started);
         }
-        // Appearance first (before this keyframe joins the recognizer); a scan the recognizer
-        // refuses is counted, and the keyframe goes on without a place match.
-        let look_alikes = match self
-            .places
-            .as_mut()
-            .map(|p| p.candidates_then_add(index, &cloud))
-        {
-            Some(Ok(found)) => found,
-            Some(Err(_)) => {
-                self.report.place_refusals += 1;
-                Vec::new()
-            }
-            None => Vec::new(),
-        };
         let walked = parent.map_or(0.0, |from| {
             self.keyframes[from].walked
                 + (pose.translation.vector - self.keyframe_pose(from).translation.vector).norm()
@@ -606,11 +592,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 .into_iter()
                 .collect(),
         });
-        if self.clouds.push(cloud).is_err() {
-            // Kept in memory instead; counted, the walk goes on.
-            self.report.keyframe_store_failures += 1;
-        }
-        self.stash_old_points();
         if let Some(from) = parent {
             self.keyframes[from].links.push(Link {
                 keyframe: index,
@@ -619,7 +600,27 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         self.report.keyframes += 1;
         self.anchor = None;
+        // The local map slid first: its index is then built on the other core meanwhile.
         self.visit_keyframe(index);
+        // Appearance (before this keyframe joins the recognizer); a scan the recognizer
+        // refuses is counted, and the keyframe goes on without a place match.
+        let look_alikes = match self
+            .places
+            .as_mut()
+            .map(|p| p.candidates_then_add(index, &cloud))
+        {
+            Some(Ok(found)) => found,
+            Some(Err(_)) => {
+                self.report.place_refusals += 1;
+                Vec::new()
+            }
+            None => Vec::new(),
+        };
+        if self.clouds.push(cloud).is_err() {
+            // Kept in memory instead; counted, the walk goes on.
+            self.report.keyframe_store_failures += 1;
+        }
+        self.stash_old_points();
         self.last_stamp = scan.stamp;
         self.scan_poses.push(ScanPose {
             stamp: scan.stamp,

@@ -137,6 +137,9 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
                 if let Some(old) = left {
                     self.odometry.remove_from_map(target, old as u32);
                 }
+                // Indexed on the other core while the keyframe's loop search and the next
+                // scan's thinning run on this one.
+                self.odometry.ready_map_ahead(target);
             }
             _ => self.local_map = None,
         }

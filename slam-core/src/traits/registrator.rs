@@ -243,6 +243,15 @@ pub trait MapRegistrator: Registrator {
     /// forwards it (required, as the others are, so that a wrapper cannot lose it unnoticed).
     fn ready_map_beside(&self, map: &mut Self::Target, beside: &mut (dyn FnMut() + Send));
 
+    /// Starts making `map` ready for the next alignment on another thread and returns at once,
+    /// where the backend can: a caller that has just changed its map in place and has other
+    /// work before the next alignment (a keyframe's loop search, the next scan's thinning) hides
+    /// the rebuild behind it; the next query or [`MapRegistrator::ready_map_beside`] waits for
+    /// it if it has not finished. A change to `map` before then drops it. Nothing a later
+    /// alignment returns may change. A backend with nothing to prepare does nothing; a wrapper
+    /// forwards it.
+    fn ready_map_ahead(&self, map: &mut Self::Target);
+
     /// A keyframe's source (as [`MapRegistrator::keyframe_source`] left it) as bytes, for an
     /// engine that keeps older keyframes in a file
     /// ([`GraphSlam::with_keyframe_store`](crate::GraphSlam::with_keyframe_store)); `None`
@@ -357,6 +366,9 @@ impl<R: WholeMapRegistrator> MapRegistrator for R {
     fn ready_map_beside(&self, _map: &mut Self::Target, beside: &mut (dyn FnMut() + Send)) {
         beside();
     }
+
+    /// A map built whole is ready when built: nothing to do.
+    fn ready_map_ahead(&self, _map: &mut Self::Target) {}
 
     fn stored_source(&self, source: &Self::Source) -> Option<Vec<u8>> {
         WholeMapRegistrator::stored_source(self, source)

@@ -106,6 +106,7 @@ impl MapRegistrator for InPlaceIcp {
     fn ready_map_beside(&self, _map: &mut InPlaceMap, beside: &mut (dyn FnMut() + Send)) {
         beside();
     }
+    fn ready_map_ahead(&self, _map: &mut InPlaceMap) {}
     fn stored_source(&self, _source: &Prepared) -> Option<Vec<u8>> {
         None
     }
