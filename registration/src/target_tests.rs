@@ -213,7 +213,9 @@ fn a_map_indexed_ahead_aligns_as_one_indexed_on_first_use() {
     }
     assert_eq!(ran, 6, "the work beside ran once a call");
     // A target prepared whole has nothing to build.
-    let mut whole = icp.target_from_sources(&[(&source, Pose3::identity())]).unwrap();
+    let mut whole = icp
+        .target_from_sources(&[(&source, Pose3::identity())])
+        .unwrap();
     icp.ready_map_ahead(&mut whole);
     assert!(whole.pending.get_mut().is_none());
 }
