@@ -6,6 +6,7 @@ use slam_core::{BitGrid, Cell};
 
 use crate::distance::{DistanceField, squared_distance_cells};
 use crate::error::{GridMapError, check, check_not_negative};
+use crate::extent::CellExtent;
 use crate::occupancy::{OccupancyGrid, UnknownCells};
 
 /// The clearance cost: entering a cell `d` metres from the nearest obstacle costs the step's
@@ -105,7 +106,9 @@ pub struct PlanningGridConfig {
     /// [`UnknownCells::Free`].
     pub unknown: UnknownCells,
     /// Hard inflation, 0.30 m: Spot's half width (0.25 m) plus 0.05 m. Cells whose centre lies
-    /// within it of an obstacle cell's centre are blocked.
+    /// within it of an obstacle are blocked: of the box of an occupied cell's points where the
+    /// grid records them ([`OccupancyGrid::extent`]), of the cell's centre otherwise (unknown
+    /// cells, cells set by hand).
     pub inflation: f64,
     /// How much less the cells the robot has walked ([`PlanningGrid::with_walked`]) are
     /// inflated, 0.05 m: the default's margin over Spot's half width. The robot fitted there,
@@ -191,6 +194,48 @@ fn obstacles(
     }
     sub.restore_padding();
     Ok(sub)
+}
+
+/// A cell's half diagonal in cells, rounded up: how far an obstacle point can lie from its
+/// cell's centre.
+const HALF_DIAGONAL: f64 = 0.707_2;
+
+/// Squared distance, in cells, from the centre of cell `(x, y)` of `occupancy` to the nearest
+/// obstacle point within `radius` cells (columns and rows) of it: the box of the points in each
+/// occupied cell ([`OccupancyGrid::extent`]), the centre of each other obstacle of `sub` (the
+/// obstacles over `source`: unknown cells when they count). Infinite when there is none.
+fn squared_distance_to_points(
+    occupancy: &OccupancyGrid,
+    sub: &BitGrid,
+    source: CellRect,
+    (x, y): (u32, u32),
+    radius: i64,
+) -> f64 {
+    let mut best = f64::INFINITY;
+    let (sx, sy) = (i64::from(x - source.x0), i64::from(y - source.y0));
+    let (w, h) = (i64::from(sub.width()), i64::from(sub.height()));
+    for dy in -radius..=radius {
+        let oy = sy + dy;
+        if oy < 0 || oy >= h {
+            continue;
+        }
+        let near_y = (dy.abs() as f64 - 0.5).max(0.0);
+        for dx in -radius..=radius {
+            let ox = sx + dx;
+            let near_x = (dx.abs() as f64 - 0.5).max(0.0);
+            // The nearest a point of that cell can be.
+            if ox < 0 || ox >= w || near_x * near_x + near_y * near_y >= best {
+                continue;
+            }
+            if !sub.is_blocked(Cell::new(ox as u32, oy as u32)) {
+                continue;
+            }
+            let cell = Cell::new(source.x0 + ox as u32, source.y0 + oy as u32);
+            let extent = occupancy.extent(cell).unwrap_or(CellExtent::CENTRE);
+            best = best.min(extent.squared_distance_from_centre((dx, dy)));
+        }
+    }
+    best
 }
 
 /// Every cell of `occupancy`.
@@ -438,17 +483,32 @@ impl PlanningGrid {
         let limit = r_cells * r_cells + 1e-9;
         let walked_cells = (self.config.inflation - self.config.walked_relief).max(0.0) / res;
         let walked_limit = walked_cells * walked_cells + 1e-9;
+        // Cells whose distance to the obstacles' points could fall on either side of a limit
+        // (a point lies within half a cell's diagonal of its cell's centre) are measured from
+        // the points; the others keep the distance between centres.
+        let (near, far) = (
+            walked_cells.min(r_cells) - HALF_DIAGONAL,
+            r_cells + HALF_DIAGONAL,
+        );
+        let search = far.ceil() as i64;
         let sub_w = sub.width() as usize;
         for y in written.y0..written.y1 {
             for x in written.x0..written.x1 {
                 let k = (y - source.y0) as usize * sub_w + (x - source.x0) as usize;
                 let i = y as usize * w as usize + x as usize;
-                let d2 = d2[k];
+                let centres = d2[k];
+                let d = centres.sqrt();
+                let d2 = if centres > 0.0 && d > near && d <= far {
+                    squared_distance_to_points(occupancy, &sub, source, (x, y), search)
+                        .min((d + HALF_DIAGONAL) * (d + HALF_DIAGONAL))
+                } else {
+                    centres
+                };
                 let metres = (d2.sqrt() * res).min(reach);
                 self.clearance[i] = metres as f32;
                 self.costs[i] = self.config.cost.multiplier(metres);
-                // The same test as `inflate`, so that the blocked cells are `inflate`'s (but for
-                // the cells walked).
+                // The same test as `inflate`, so that the blocked cells are `inflate`'s where
+                // no points are recorded (but for the cells walked).
                 let walked = self
                     .walked
                     .as_ref()
@@ -483,8 +543,9 @@ impl PlanningGrid {
         &self.costs
     }
 
-    /// Metres from every cell centre to the nearest obstacle cell centre (row-major), capped at
-    /// the reach (the larger of the inflation and the cost's `zero_beyond`; the inflation alone
+    /// Metres from every cell centre to the nearest obstacle (row-major): to its points where a
+    /// cell lies within a cell's diagonal of the inflation, to the obstacle cells' centres
+    /// elsewhere; capped at the reach (the larger of the inflation and the cost's `zero_beyond`; the inflation alone
     /// with the cost off).
     #[must_use]
     pub fn clearance(&self) -> &[f32] {
