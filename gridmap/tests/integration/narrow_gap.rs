@@ -1,5 +1,5 @@
 //! A gap beside a dropped box, a few centimetres wider (or narrower) than the robot needs at
-//! its hard inflation: the planning layer reads it open (or shut) wherever the grid's cells fall
+//! its hard inflation and point margin: the planning layer reads it open (or shut) wherever the grid's cells fall
 //! against the box's edge and the wall, and whether the box is seen close by (its face) or from
 //! afar (its top, sparser), because clearance is measured from the obstacles' points, not from
 //! their cells' centres.
@@ -77,12 +77,12 @@ fn lane_past_the_box(blocked: &BitGrid, gap: f64) -> bool {
 
 #[test]
 fn a_gap_a_few_cm_wider_than_the_robot_reads_open_wherever_the_cells_fall() {
-    // 0.30 m each side: 0.60 m needed. 0.72 m leaves 12 cm, more than a cell, so a column of
-    // centres always falls in it; 0.56 m leaves none.
+    // 0.30 m each side and the 0.05 m point margin: 0.70 m needed. 0.82 m leaves 12 cm, more
+    // than a cell, so a column of centres always falls in it; 0.66 m leaves none.
     for view in [View::Near, View::Far] {
         for k in 0..20 {
             let shift = 0.005 * f64::from(k);
-            for (gap, open) in [(0.72, true), (0.56, false)] {
+            for (gap, open) in [(0.82, true), (0.66, false)] {
                 let planning =
                     PlanningGrid::new(&scene(shift, gap, view), PlanningGridConfig::default())
                         .unwrap();
