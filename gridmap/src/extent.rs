@@ -14,10 +14,10 @@ use slam_core::GridGeometry;
 const STEPS: f64 = 16.0;
 
 /// The box round the obstacle points that fell in one cell, each side in sixteenths of the
-/// cell from its lower (west or south) edge, rounded outward so the box holds every point: its
-/// distance is never more than the points' by more than nothing and never less than theirs by
-/// more than a sixteenth of a cell's diagonal. A cell with no points recorded (set occupied by
-/// hand, unknown, stairs) reads as its centre, as clearances between cell centres had it.
+/// cell from its lower (west or south) edge, rounded outward so the box holds every point: a
+/// distance to it is never more than the distance to the nearest point, and at most a
+/// sixteenth of a cell's diagonal less. A cell with no points recorded (set occupied by hand,
+/// unknown, stairs) reads as its centre, as clearances between cell centres had it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CellExtent(u16);
 
