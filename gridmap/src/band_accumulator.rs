@@ -8,6 +8,7 @@ use crate::band::{Height, ObstacleBandConfig, band_at, classify};
 use crate::builder::OccupancyGridBuilder;
 use crate::config::OccupancyGridConfig;
 use crate::error::{GridMapError, check_finite_points};
+use crate::extent::CellExtent;
 use crate::floor::FloorMap;
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::{below_top, clip_to_bounds, floor_i64, traverse};
@@ -26,6 +27,8 @@ struct Window {
     height: usize,
     /// Band points that ended in each cell (over all scans).
     hits: Vec<u32>,
+    /// The box of those points in each cell.
+    extents: Vec<CellExtent>,
     /// Whether a beam crossed each cell.
     crossed: Vec<bool>,
     /// The last scan (its number) that traced a beam to an obstacle, and to a free end, in each
@@ -43,6 +46,7 @@ impl Window {
             width,
             height,
             hits: vec![0; cells],
+            extents: vec![CellExtent::CENTRE; cells],
             crossed: vec![false; cells],
             hit_stamp: vec![0; cells],
             free_stamp: vec![0; cells],
@@ -68,6 +72,7 @@ impl Window {
             };
             let from = row * self.width..(row + 1) * self.width;
             grown.hits[start..start + self.width].copy_from_slice(&self.hits[from.clone()]);
+            grown.extents[start..start + self.width].copy_from_slice(&self.extents[from.clone()]);
             grown.crossed[start..start + self.width].copy_from_slice(&self.crossed[from]);
         }
         grown
@@ -224,6 +229,8 @@ impl FloorBandAccumulator {
                 if kind == Height::Obstacle && !cut {
                     if let Some(i) = end {
                         window.hits[i] = window.hits[i].saturating_add(1);
+                        let within = Vector2::new(b.x - b.x.floor(), b.y - b.y.floor());
+                        window.extents[i] = window.extents[i].union(CellExtent::at(within));
                         if window.hit_stamp[i] == stamp {
                             continue;
                         }
@@ -334,15 +341,12 @@ impl FloorBandAccumulator {
         let mut grid = self.builder.empty_grid(min, max, CellState::Unknown)?;
         let min_points = self.builder.config().min_points;
         for (i, (&hits, &crossed)) in window.hits.iter().zip(&window.crossed).enumerate() {
-            let state = if hits >= min_points {
-                CellState::Occupied
-            } else if crossed {
-                CellState::Free
-            } else {
-                continue;
-            };
             let cell = slam_core::Cell::new((i % window.width) as u32, (i / window.width) as u32);
-            grid.set(cell, state)?;
+            if hits >= min_points {
+                grid.set_occupied_within(cell, window.extents[i])?;
+            } else if crossed {
+                grid.set(cell, CellState::Free)?;
+            }
         }
         Ok(grid)
     }

@@ -6,6 +6,7 @@ use slam_core::{Cell, GridGeometry, PointCloud, Pose3};
 
 use crate::config::OccupancyGridConfig;
 use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
+use crate::extent::CellExtent;
 use crate::occupancy::{CellState, OccupancyGrid};
 use crate::rays::traverse;
 
@@ -105,7 +106,8 @@ impl OccupancyGridBuilder {
         OccupancyGrid::new(w, h, geometry, fill)
     }
 
-    /// Mark occupied every cell holding at least `min_points` of `points` (world x, y).
+    /// Mark occupied every cell holding at least `min_points` of `points` (world x, y), with
+    /// the box of its points ([`CellExtent`]).
     pub(crate) fn mark_occupied(
         &self,
         grid: &mut OccupancyGrid,
@@ -114,25 +116,22 @@ impl OccupancyGridBuilder {
         let geometry = *grid.geometry();
         let (w, h) = (grid.width(), grid.height());
         let min_points = self.config.min_points;
-        let mut counts = if min_points > 1 {
-            vec![0u32; w as usize * h as usize]
-        } else {
-            Vec::new()
-        };
+        let mut counts = vec![0u32; w as usize * h as usize];
+        let mut extents = vec![CellExtent::CENTRE; w as usize * h as usize];
         for p in points {
-            let (x, y) = geometry.cell_coords(*p);
+            let ((x, y), extent) = CellExtent::of_point(&geometry, *p);
             if x < 0 || y < 0 || x >= i64::from(w) || y >= i64::from(h) {
                 continue;
             }
-            let cell = Cell::new(x as u32, y as u32);
-            if min_points > 1 {
-                let k = &mut counts[y as usize * w as usize + x as usize];
-                *k += 1;
-                if *k < min_points {
-                    continue;
-                }
+            let k = y as usize * w as usize + x as usize;
+            counts[k] = counts[k].saturating_add(1);
+            extents[k] = extents[k].union(extent);
+        }
+        for (k, (&n, &extent)) in counts.iter().zip(&extents).enumerate() {
+            if n > 0 && n >= min_points {
+                let cell = Cell::new((k % w as usize) as u32, (k / w as usize) as u32);
+                grid.set_occupied_within(cell, extent)?;
             }
-            grid.set(cell, CellState::Occupied)?;
         }
         Ok(())
     }

@@ -11,6 +11,7 @@ use slam_core::{BitGrid, Cell, InvalidSetting, PointCloud, Pose2, Pose3};
 
 use crate::band::{Height, ObstacleBandConfig, band_at, classify};
 use crate::error::{GridMapError, check, check_finite_points, check_not_negative};
+use crate::extent::CellExtent;
 use crate::floor::FloorMap;
 use crate::fusion::{LocalCell, LocalGrid};
 use crate::occupancy::{CellState, OccupancyGrid};
@@ -177,6 +178,8 @@ pub struct LiveLayer {
     /// Scratch window of the last update: states, band point counts, end-cell stamps.
     state: Vec<u8>,
     counts: Vec<u16>,
+    /// The box of the band points in each window cell.
+    extents: Vec<CellExtent>,
     hit_stamp: Vec<u32>,
     free_stamp: Vec<u32>,
     stamp: u32,
@@ -224,6 +227,7 @@ impl LiveLayer {
             n,
             state: vec![UNSEEN; cells],
             counts: vec![0; cells],
+            extents: vec![CellExtent::CENTRE; cells],
             hit_stamp: vec![0; cells],
             free_stamp: vec![0; cells],
             stamp: 0,
@@ -267,6 +271,8 @@ impl LiveLayer {
         }
         self.counts.clear();
         self.counts.resize(cells, 0);
+        self.extents.clear();
+        self.extents.resize(cells, CellExtent::CENTRE);
         self.stamp = 0;
         self.beams.clear();
         self.corner = (0, 0);
@@ -331,12 +337,14 @@ impl LiveLayer {
             for y in y0..y1 {
                 let row = (y - cy) as usize * self.n as usize;
                 for x in x0..x1 {
-                    let seen = match self.state[row + (x - cx) as usize] {
+                    let k = row + (x - cx) as usize;
+                    let seen = match self.state[k] {
                         SEEN_FREE => CellState::Free,
                         SEEN_OCCUPIED => CellState::Occupied,
                         _ => continue,
                     };
-                    self.observe(Cell::new(x as u32, y as u32), seen, stamp, &mut report)?;
+                    let cell = Cell::new(x as u32, y as u32);
+                    self.observe(cell, seen, self.extents[k], stamp, &mut report)?;
                 }
             }
         }
@@ -361,7 +369,7 @@ impl LiveLayer {
         self.previous_stamp = stamp;
         let mut report = LiveUpdate::default();
         if cell.x < self.combined.width() && cell.y < self.combined.height() {
-            self.observe(cell, state, stamp, &mut report)?;
+            self.observe(cell, state, CellExtent::CENTRE, stamp, &mut report)?;
         }
         Ok(report)
     }
@@ -404,11 +412,13 @@ impl LiveLayer {
         Ok(())
     }
 
-    /// Record that `cell` was seen in state `seen` at `stamp`.
+    /// Record that `cell` was seen in state `seen` (its obstacle points within `extent` when
+    /// occupied) at `stamp`.
     fn observe(
         &mut self,
         cell: Cell,
         seen: CellState,
+        extent: CellExtent,
         stamp: f64,
         report: &mut LiveUpdate,
     ) -> Result<(), GridMapError> {
@@ -417,17 +427,24 @@ impl LiveLayer {
             return Ok(());
         }
         let now = self.combined.state(cell);
-        if now != seen {
-            self.combined.set(cell, seen)?;
-            match seen {
-                CellState::Occupied => report.added += 1,
-                CellState::Free => report.cleared += 1,
-                CellState::Unknown | CellState::Stairs => {}
+        let points = (seen == CellState::Occupied).then_some(extent);
+        if now != seen || self.combined.extent(cell) != points {
+            if seen == CellState::Occupied {
+                self.combined.set_occupied_within(cell, extent)?;
+            } else {
+                self.combined.set(cell, seen)?;
+            }
+            if now != seen {
+                match seen {
+                    CellState::Occupied => report.added += 1,
+                    CellState::Free => report.cleared += 1,
+                    CellState::Unknown | CellState::Stairs => {}
+                }
             }
             grow(&mut report.changed, cell);
             grow(&mut report.observed, cell);
         }
-        if seen != self.static_map.state(cell) {
+        if seen != self.static_map.state(cell) || self.static_map.extent(cell) != points {
             let i = cell.y as usize * self.combined.width() as usize + cell.x as usize;
             self.last_seen[i] = stamp;
             if !self.queued.is_blocked(cell) {
@@ -451,7 +468,8 @@ impl LiveLayer {
             self.due.pop();
             let cell = Cell::new(i % width, i / width);
             let original = self.static_map.state(cell);
-            if self.combined.state(cell) == original {
+            let points = self.static_map.extent(cell);
+            if self.combined.state(cell) == original && self.combined.extent(cell) == points {
                 self.queued.set(cell, false)?;
                 continue;
             }
@@ -464,7 +482,10 @@ impl LiveLayer {
                 continue;
             }
             self.queued.set(cell, false)?;
-            self.combined.set(cell, original)?;
+            match points {
+                Some(extent) => self.combined.set_occupied_within(cell, extent)?,
+                None => self.combined.set(cell, original)?,
+            }
             report.decayed += 1;
             grow(&mut report.changed, cell);
             grow(&mut report.reverted, cell);
@@ -502,6 +523,7 @@ impl LiveLayer {
         let size = Vector2::repeat(f64::from(n));
         self.state.fill(UNSEEN);
         self.counts.fill(0);
+        self.extents.fill(CellExtent::CENTRE);
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.hit_stamp.fill(0);
@@ -527,6 +549,8 @@ impl LiveLayer {
                 if w.x >= 0.0 && w.y >= 0.0 && w.x < size.x && w.y < size.y {
                     let k = w.y as usize * n_us + w.x as usize;
                     self.counts[k] = self.counts[k].saturating_add(1);
+                    let within = Vector2::new(w.x - w.x.floor(), w.y - w.y.floor());
+                    self.extents[k] = self.extents[k].union(CellExtent::at(within));
                 }
             }
             // The part of the beam low enough to show the cells it crosses are free.

@@ -3,6 +3,7 @@
 use slam_core::{BitGrid, Cell, GridGeometry};
 
 use crate::error::GridMapError;
+use crate::extent::CellExtent;
 use crate::planning::CellRect;
 
 /// What is known of a cell.
@@ -32,12 +33,16 @@ pub enum UnknownCells {
 }
 
 /// A 2D occupancy grid. Cell (0, 0) is the lower-left corner at `geometry().origin`, row `y` grows
-/// along world +y, each cell is `geometry().resolution` metres wide.
+/// along world +y, each cell is `geometry().resolution` metres wide. An occupied cell may also
+/// hold where in it its obstacle points lie ([`OccupancyGrid::extent`]), for clearances measured
+/// from the points.
 #[derive(Debug, PartialEq, Eq)]
 pub struct OccupancyGrid {
     occupied: BitGrid,
     free: BitGrid,
     stairs: BitGrid,
+    /// Per cell, row-major: the box of the obstacle points in it (read only where occupied).
+    extents: Vec<CellExtent>,
 }
 
 impl Clone for OccupancyGrid {
@@ -46,6 +51,7 @@ impl Clone for OccupancyGrid {
             occupied: self.occupied.clone(),
             free: self.free.clone(),
             stairs: self.stairs.clone(),
+            extents: self.extents.clone(),
         }
     }
 
@@ -54,6 +60,7 @@ impl Clone for OccupancyGrid {
         self.occupied.clone_from(&source.occupied);
         self.free.clone_from(&source.free);
         self.stairs.clone_from(&source.stairs);
+        self.extents.clone_from(&source.extents);
     }
 }
 
@@ -78,6 +85,7 @@ impl OccupancyGrid {
             occupied,
             free,
             stairs,
+            extents: vec![CellExtent::CENTRE; width as usize * height as usize],
         })
     }
 
@@ -115,19 +123,52 @@ impl OccupancyGrid {
         }
     }
 
-    /// Set the state of `cell`.
+    /// Set the state of `cell` (an occupied cell set so reads as its centre: no points are
+    /// recorded in it; see [`Self::set_occupied_within`]).
     ///
     /// # Errors
     /// [`GridMapError::Grid`] when `cell` is off the grid.
     pub fn set(&mut self, cell: Cell, state: CellState) -> Result<(), GridMapError> {
+        self.set_cell(cell, state, CellExtent::CENTRE)
+    }
+
+    /// Set `cell` occupied with its obstacle points within `extent` (e.g. the union of
+    /// [`CellExtent::of_point`] over the points that fell in it).
+    ///
+    /// # Errors
+    /// [`GridMapError::Grid`] when `cell` is off the grid.
+    pub fn set_occupied_within(
+        &mut self,
+        cell: Cell,
+        extent: CellExtent,
+    ) -> Result<(), GridMapError> {
+        self.set_cell(cell, CellState::Occupied, extent)
+    }
+
+    fn set_cell(
+        &mut self,
+        cell: Cell,
+        state: CellState,
+        extent: CellExtent,
+    ) -> Result<(), GridMapError> {
         self.occupied.set(cell, state == CellState::Occupied)?;
         self.free.set(cell, state == CellState::Free)?;
         self.stairs.set(cell, state == CellState::Stairs)?;
+        let i = cell.y as usize * self.width() as usize + cell.x as usize;
+        self.extents[i] = extent;
         Ok(())
     }
 
-    /// The smallest rectangle holding every cell whose state differs from `earlier`'s (empty
-    /// when none does): the rectangle a [`crate::PlanningGrid`] built on `earlier` is
+    /// Where in `cell` its obstacle points lie: `Some` for an occupied cell ([`CellExtent::CENTRE`]
+    /// when none were recorded), `None` for any other cell and off the grid.
+    #[must_use]
+    pub fn extent(&self, cell: Cell) -> Option<CellExtent> {
+        (self.occupied.contains(cell) && self.occupied.is_blocked(cell))
+            .then(|| self.extents[cell.y as usize * self.width() as usize + cell.x as usize])
+    }
+
+    /// The smallest rectangle holding every cell whose state differs from `earlier`'s, or whose
+    /// obstacle points' [`extent`](Self::extent) does (empty when none does): the rectangle a [`crate::PlanningGrid`] built on `earlier` is
     /// [refreshed](crate::PlanningGrid::refresh) over to match this grid. Word by word, 64 cells
     /// at a time.
     ///
@@ -167,6 +208,21 @@ impl OccupancyGrid {
                         y1: y + 1,
                     };
                     changed = changed.union(&row);
+                }
+            }
+            // Cells occupied in both whose points moved within them.
+            let (now, then) = (self.occupied.row_words(y), earlier.occupied.row_words(y));
+            let base = y as usize * self.width() as usize;
+            for (i, (a, b)) in now.iter().zip(then).enumerate() {
+                let mut both = a & b;
+                while both != 0 {
+                    let x = i as u32 * 64 + both.trailing_zeros();
+                    both &= both - 1;
+                    if x < self.width()
+                        && self.extents[base + x as usize] != earlier.extents[base + x as usize]
+                    {
+                        changed = changed.union(&CellRect::cell(Cell::new(x, y)));
+                    }
                 }
             }
         }
@@ -211,6 +267,18 @@ impl OccupancyGrid {
         }
         // The padding past the width: as the other grids keep it.
         self.stairs.restore_padding();
+        // No obstacle points are kept in stairs cells.
+        let w = self.width() as usize;
+        for y in 0..self.height() {
+            for (x, e) in self.extents[y as usize * w..(y as usize + 1) * w]
+                .iter_mut()
+                .enumerate()
+            {
+                if stairs.is_blocked(Cell::new(x as u32, y)) {
+                    *e = CellExtent::CENTRE;
+                }
+            }
+        }
         self.occupied.restore_padding();
         self.free.restore_padding();
         Ok(())

@@ -6,6 +6,7 @@ use slam_core::{BitGrid, Cell};
 
 use crate::distance::{DistanceField, squared_distance_cells};
 use crate::error::{GridMapError, check, check_not_negative};
+use crate::extent::CellExtent;
 use crate::occupancy::{OccupancyGrid, UnknownCells};
 
 /// The clearance cost: entering a cell `d` metres from the nearest obstacle costs the step's
@@ -105,7 +106,9 @@ pub struct PlanningGridConfig {
     /// [`UnknownCells::Free`].
     pub unknown: UnknownCells,
     /// Hard inflation, 0.30 m: Spot's half width (0.25 m) plus 0.05 m. Cells whose centre lies
-    /// within it of an obstacle cell's centre are blocked.
+    /// within it of an obstacle are blocked: of the box of an occupied cell's points where the
+    /// grid records them ([`OccupancyGrid::extent`]), of the cell's centre otherwise (unknown
+    /// cells, cells set by hand).
     pub inflation: f64,
     /// How much less the cells the robot has walked ([`PlanningGrid::with_walked`]) are
     /// inflated, 0.05 m: the default's margin over Spot's half width. The robot fitted there,
@@ -113,6 +116,14 @@ pub struct PlanningGridConfig {
     /// cell), need not be added again: a door the robot walked through stays open when scans
     /// from its other side add a cell to a jamb. Obstacle cells block whatever the relief.
     pub walked_relief: f64,
+    /// How much nearer than its recorded points an obstacle may stand, 0.05 m: clearances
+    /// measured from an occupied cell's points ([`OccupancyGrid::extent`]) are this much less.
+    /// A scan samples a surface every few centimetres (a box's corner lies between the last
+    /// point on one face and the first past it), the points are a scan old, and the robot keeps
+    /// to its path within a few centimetres; measured from the cells' centres, half a cell of
+    /// slop hid all three. Cells with no points recorded read as their centres, without it.
+    /// With the default inflation a passage needs 0.70 m between its obstacles' points.
+    pub point_margin: f64,
     /// The clearance cost on the cells left free.
     pub cost: ClearanceCostConfig,
 }
@@ -123,6 +134,7 @@ impl Default for PlanningGridConfig {
             unknown: UnknownCells::Blocked,
             inflation: 0.30,
             walked_relief: 0.05,
+            point_margin: 0.05,
             cost: ClearanceCostConfig::default(),
         }
     }
@@ -133,7 +145,8 @@ impl PlanningGridConfig {
     ///
     /// # Errors
     /// [`GridMapError::InvalidConfig`] for an inflation that is not finite, not negative and at
-    /// most 1000 m, a walked relief that is not finite and non-negative, or an invalid cost.
+    /// most 1000 m, a walked relief or point margin that is not finite and non-negative, a
+    /// point margin above 1 m, or an invalid cost.
     pub fn validate(&self) -> Result<(), GridMapError> {
         check(
             self.inflation.is_finite() && (0.0..=1000.0).contains(&self.inflation),
@@ -141,17 +154,28 @@ impl PlanningGridConfig {
             self.inflation,
             "finite, from 0 to 1000 m",
         )?;
-        check_not_negative(&[("PlanningGridConfig::walked_relief", self.walked_relief)])?;
+        check_not_negative(&[
+            ("PlanningGridConfig::walked_relief", self.walked_relief),
+            ("PlanningGridConfig::point_margin", self.point_margin),
+        ])?;
+        check(
+            self.point_margin <= 1.0,
+            "PlanningGridConfig::point_margin",
+            self.point_margin,
+            "at most 1 m",
+        )?;
         self.cost.validate()
     }
 
     /// The farthest distance (metres) that matters: beyond it a cell is neither blocked nor
     /// penalised.
     fn reach(&self) -> f64 {
+        // An obstacle's points count the margin nearer.
+        let inflation = self.inflation + self.point_margin;
         if self.cost.weight > 0.0 {
-            self.inflation.max(self.cost.zero_beyond)
+            inflation.max(self.cost.zero_beyond)
         } else {
-            self.inflation
+            inflation
         }
     }
 }
@@ -191,6 +215,57 @@ fn obstacles(
     }
     sub.restore_padding();
     Ok(sub)
+}
+
+/// A cell's half diagonal in cells, rounded up: how far an obstacle point can lie from its
+/// cell's centre.
+const HALF_DIAGONAL: f64 = 0.707_2;
+
+/// Squared distance, in cells, from the centre of cell `(x, y)` of `occupancy` to the nearest
+/// obstacle within `radius` cells (columns and rows) of it: the box of the points in each
+/// occupied cell ([`OccupancyGrid::extent`]) less `margin` cells, the centre of each other
+/// obstacle of `sub` (the obstacles over `source`: unknown cells when they count). Infinite
+/// when there is none.
+fn squared_distance_to_points(
+    occupancy: &OccupancyGrid,
+    sub: &BitGrid,
+    source: CellRect,
+    (x, y): (u32, u32),
+    (radius, margin): (i64, f64),
+) -> f64 {
+    let mut best = f64::INFINITY;
+    let (sx, sy) = (i64::from(x - source.x0), i64::from(y - source.y0));
+    let (w, h) = (i64::from(sub.width()), i64::from(sub.height()));
+    for dy in -radius..=radius {
+        let oy = sy + dy;
+        if oy < 0 || oy >= h {
+            continue;
+        }
+        let near_y = (dy.abs() as f64 - 0.5).max(0.0);
+        for dx in -radius..=radius {
+            let ox = sx + dx;
+            let near_x = (dx.abs() as f64 - 0.5).max(0.0);
+            // The nearest a point of that cell can be, less the margin.
+            let nearest = ((near_x * near_x + near_y * near_y).sqrt() - margin).max(0.0);
+            if ox < 0 || ox >= w || nearest * nearest >= best {
+                continue;
+            }
+            if !sub.is_blocked(Cell::new(ox as u32, oy as u32)) {
+                continue;
+            }
+            let cell = Cell::new(source.x0 + ox as u32, source.y0 + oy as u32);
+            let d2 = match occupancy.extent(cell) {
+                Some(points) if !points.is_centre() => {
+                    let d =
+                        (points.squared_distance_from_centre((dx, dy)).sqrt() - margin).max(0.0);
+                    d * d
+                }
+                _ => CellExtent::CENTRE.squared_distance_from_centre((dx, dy)),
+            };
+            best = best.min(d2);
+        }
+    }
+    best
 }
 
 /// Every cell of `occupancy`.
@@ -277,7 +352,7 @@ impl CellRect {
 /// The planning layer over an occupancy grid: the blocked cells (obstacles, and unknown cells
 /// unless configured free, hard-inflated by [`PlanningGridConfig::inflation`]), each cell's
 /// clearance (metres to the nearest obstacle, capped at the reach: the larger of the inflation
-/// and the cost's `zero_beyond`) and its step-cost multiplier.
+/// plus the point margin and the cost's `zero_beyond`) and its step-cost multiplier.
 ///
 /// Build it once per map ([`PlanningGrid::new`], linear in cells), then after each change of the
 /// occupancy (a live layer's update) [`PlanningGrid::refresh`] the changed rectangle: the work
@@ -438,17 +513,33 @@ impl PlanningGrid {
         let limit = r_cells * r_cells + 1e-9;
         let walked_cells = (self.config.inflation - self.config.walked_relief).max(0.0) / res;
         let walked_limit = walked_cells * walked_cells + 1e-9;
+        // Cells whose distance to the obstacles' points could fall on either side of a limit
+        // (a point lies within half a cell's diagonal of its cell's centre, the margin nearer)
+        // are measured from the points; the others keep the distance between centres.
+        let margin = self.config.point_margin / res;
+        let (near, far) = (
+            walked_cells.min(r_cells) - HALF_DIAGONAL,
+            r_cells + margin + HALF_DIAGONAL,
+        );
+        let search = (far.ceil() as i64, margin);
         let sub_w = sub.width() as usize;
         for y in written.y0..written.y1 {
             for x in written.x0..written.x1 {
                 let k = (y - source.y0) as usize * sub_w + (x - source.x0) as usize;
                 let i = y as usize * w as usize + x as usize;
-                let d2 = d2[k];
+                let centres = d2[k];
+                let d = centres.sqrt();
+                let d2 = if centres > 0.0 && d > near && d <= far {
+                    squared_distance_to_points(occupancy, &sub, source, (x, y), search)
+                        .min((d + HALF_DIAGONAL) * (d + HALF_DIAGONAL))
+                } else {
+                    centres
+                };
                 let metres = (d2.sqrt() * res).min(reach);
                 self.clearance[i] = metres as f32;
                 self.costs[i] = self.config.cost.multiplier(metres);
-                // The same test as `inflate`, so that the blocked cells are `inflate`'s (but for
-                // the cells walked).
+                // The same test as `inflate`, so that the blocked cells are `inflate`'s where
+                // no points are recorded (but for the cells walked).
                 let walked = self
                     .walked
                     .as_ref()
@@ -483,9 +574,10 @@ impl PlanningGrid {
         &self.costs
     }
 
-    /// Metres from every cell centre to the nearest obstacle cell centre (row-major), capped at
-    /// the reach (the larger of the inflation and the cost's `zero_beyond`; the inflation alone
-    /// with the cost off).
+    /// Metres from every cell centre to the nearest obstacle (row-major): to its points less
+    /// the point margin where a cell lies within a cell's diagonal of the inflation, to the
+    /// obstacle cells' centres elsewhere; capped at the reach (the larger of the inflation plus
+    /// the point margin and the cost's `zero_beyond`; the former alone with the cost off).
     #[must_use]
     pub fn clearance(&self) -> &[f32] {
         &self.clearance

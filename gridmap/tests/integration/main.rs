@@ -7,6 +7,7 @@ mod common;
 mod floor_band;
 mod gridmap;
 mod live_layer;
+mod narrow_gap;
 mod planning_grid;
 mod rng;
 mod stairs;

@@ -141,6 +141,7 @@ proptest! {
             unknown: if unknown_blocks { UnknownCells::Blocked } else { UnknownCells::Free },
             inflation,
             walked_relief: relief,
+            point_margin: 0.05,
             cost: ClearanceCostConfig::default(),
         };
         let mut layer = PlanningGrid::new(&occupancy, config.clone())

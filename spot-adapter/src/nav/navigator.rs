@@ -492,8 +492,14 @@ impl<R: Registrator, P: NavPlanner> Navigator<R, P> {
         // under the lowest beam: nothing clears those cells from here) is not waited for: it
         // is forgotten and the way planned again. Anything still there is seen again.
         if let (Some(wait), Some(stamp)) = (&waiting, fused_at)
-            && let Some(blockers) =
-                unseen_blockers(&self.live, &wait.cells, self.config.planning.inflation)
+            && let Some(blockers) = unseen_blockers(
+                &self.live,
+                &wait.cells,
+                (
+                    self.config.planning.inflation,
+                    self.config.planning.point_margin,
+                ),
+            )
         {
             self.forget(&blockers, stamp)?;
             plan = self.search(position, target)?;

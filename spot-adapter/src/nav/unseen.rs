@@ -11,22 +11,29 @@
 use gridmap::{CellState, LiveLayer, LocalCell};
 use slam_core::Cell;
 
-/// The live obstacle cells (occupied in the live layer, not on the static map) whose centres lie
-/// within `inflation` metres of a cell of `blocked` (cells of the map's own path that the live
-/// layer blocks), when the live layer's last scan saw none of them occupied: memories of
+/// The live obstacle cells (occupied in the live layer, not on the static map) that block a cell
+/// of `blocked` (cells of the map's own path that the live layer blocks) as the planning grid
+/// measures it: their points within `inflation` plus `margin` metres (its point margin), their
+/// centres within `inflation` when no points are recorded; when the live layer's last scan saw none of them occupied: memories of
 /// something that moved on, or that the sensor cannot see from here. `None` when the last scan
 /// sees one of them (something stands there now: wait for it) or there are none.
 // Cell offsets within a few cells of a map cell: the casts are exact.
 pub(crate) fn unseen_blockers(
     live: &LiveLayer,
     blocked: &[Cell],
-    inflation: f64,
+    (inflation, margin): (f64, f64),
 ) -> Option<Vec<Cell>> {
     let combined = live.combined();
     let map = live.static_map();
     let geometry = combined.geometry();
-    let reach = (inflation / geometry.resolution).ceil() as i64;
-    let radius2 = (inflation / geometry.resolution).powi(2) + 1e-9;
+    // The planning grid measures from the points in each occupied cell, which lie up to half a
+    // cell's diagonal nearer than its centre: search that much farther, then measure as it does.
+    let (cells, margin) = (
+        inflation / geometry.resolution,
+        margin / geometry.resolution,
+    );
+    let reach = (cells + margin + std::f64::consts::FRAC_1_SQRT_2).ceil() as i64;
+    let radius = cells + margin + 1e-9;
     let scan = live.last_local_grid();
     let (gx, gy) = geometry.cell_coords(
         scan.map_t_grid.translation.vector + nalgebra::Vector2::repeat(0.5 * scan.resolution),
@@ -41,9 +48,6 @@ pub(crate) fn unseen_blockers(
     for b in blocked {
         for dy in -reach..=reach {
             for dx in -reach..=reach {
-                if ((dx * dx + dy * dy) as f64) > radius2 {
-                    continue;
-                }
                 let (x, y) = (i64::from(b.x) + dx, i64::from(b.y) + dy);
                 if x < 0
                     || y < 0
@@ -53,7 +57,11 @@ pub(crate) fn unseen_blockers(
                     continue;
                 }
                 let c = Cell::new(x as u32, y as u32);
-                if combined.state(c) != CellState::Occupied
+                let Some(points) = combined.extent(c) else {
+                    continue;
+                };
+                let d = points.squared_distance_from_centre((dx, dy)).sqrt();
+                if (if points.is_centre() { d + margin } else { d }) > radius
                     || map.state(c) == CellState::Occupied
                     || blockers.contains(&c)
                 {
@@ -89,11 +97,14 @@ mod tests {
         live.mark(Cell::new(50, 50), CellState::Occupied, 1.0)
             .unwrap();
         assert_eq!(
-            unseen_blockers(&live, &[Cell::new(50, 53)], 0.3),
+            unseen_blockers(&live, &[Cell::new(50, 53)], (0.3, 0.05)),
             Some(vec![Cell::new(50, 50)])
         );
         // Farther than the inflation from every blocked cell: nothing.
-        assert_eq!(unseen_blockers(&live, &[Cell::new(50, 54)], 0.3), None);
-        assert_eq!(unseen_blockers(&live, &[], 0.3), None);
+        assert_eq!(
+            unseen_blockers(&live, &[Cell::new(50, 54)], (0.3, 0.05)),
+            None
+        );
+        assert_eq!(unseen_blockers(&live, &[], (0.3, 0.05)), None);
     }
 }
