@@ -819,13 +819,7 @@ mod tests {
     /// cases are left out.)
     #[test]
     fn the_nearest_revealing_rule_is_nearest_first_without_the_scraps() {
-        let mut state = 0x853c_49e6_748f_ea9bu64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 33) as u32
-        };
+        let mut next = crate::nav::test_lcg::lcg(0x853c_49e6_748f_ea9bu64);
         let geometry = GridGeometry::try_new(Vector2::zeros(), 0.1).unwrap();
         let (mut chosen, mut shared_goals) = (0, 0);
         for _ in 0..60 {

@@ -318,13 +318,7 @@ mod tests {
     #[test]
     fn frontiers_match_the_brute_force_oracle_on_random_grids() {
         // A small LCG: the same grids every run.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 33) as u32
-        };
+        let mut next = crate::nav::test_lcg::lcg(0x2545_f491_4f6c_dd1du64);
         for _ in 0..200 {
             let (w, h) = (1 + next() % 12, 1 + next() % 12);
             let geometry = GridGeometry::try_new(Vector2::new(-1.0, 2.0), 0.2).unwrap();

@@ -82,6 +82,8 @@ mod stairs_climb;
 mod stairs_links;
 mod step;
 mod stuck;
+#[cfg(test)]
+mod test_lcg;
 mod travel_costs;
 mod unseen;
 

@@ -152,13 +152,7 @@ mod tests {
     /// cell), and no other cell is reachable.
     #[test]
     fn distances_equal_dijkstras_path_costs() {
-        let mut state = 7u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 33) as u32
-        };
+        let mut next = crate::nav::test_lcg::lcg(7u64);
         for _ in 0..20 {
             let (w, h) = (2 + next() % 10, 2 + next() % 10);
             let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
@@ -187,13 +181,7 @@ mod tests {
     /// Stopped at its targets, the search gives them the whole search's distances, to the bit.
     #[test]
     fn distances_between_targets_equal_the_whole_search() {
-        let mut state = 11u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 33) as u32
-        };
+        let mut next = crate::nav::test_lcg::lcg(11u64);
         for _ in 0..50 {
             let (w, h) = (2 + next() % 20, 2 + next() % 20);
             let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
