@@ -155,7 +155,8 @@ mod tests {
         let mut next = crate::nav::test_lcg::lcg(7u64);
         for _ in 0..20 {
             let (w, h) = (2 + next() % 10, 2 + next() % 10);
-            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
+            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next().is_multiple_of(4))
+                .unwrap();
             let costs = TravelCosts::from_start(&grid, Cell::new(0, 0));
             let mut dijkstra = pathfind::Dijkstra::new(&grid);
             for y in 0..h {
@@ -184,7 +185,8 @@ mod tests {
         let mut next = crate::nav::test_lcg::lcg(11u64);
         for _ in 0..50 {
             let (w, h) = (2 + next() % 20, 2 + next() % 20);
-            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next() % 4 == 0).unwrap();
+            let grid = BitGrid::from_fn(w, h, |x, y| (x, y) != (0, 0) && next().is_multiple_of(4))
+                .unwrap();
             let targets: Vec<Cell> = (0..=next() % 5)
                 .map(|_| Cell::new(next() % (w + 2), next() % h))
                 .collect();
