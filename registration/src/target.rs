@@ -256,29 +256,14 @@ impl PreparedTarget {
 
 impl PreparedTarget {
     /// Builds the index (when an in-place map changed since the last one) on a thread of its
-    /// own while `beside` runs on this one. The index is the one the first query would build;
-    /// an error stays for that query to report.
+    /// own while `beside` runs on this one ([`Self::index_ahead`], then claimed). The index is
+    /// the one the first query would build; an error stays for that query to report.
     pub(crate) fn index_beside(&mut self, beside: &mut (dyn FnMut() + Send)) {
-        // Built already (the map did not change since): no thread for nothing.
-        if self.index.get().is_some() {
-            beside();
-            return;
-        }
-        // Being built ahead: `beside` meanwhile, then the index claimed.
-        if self.pending.get_mut().is_some() {
-            beside();
-            let _ = self.index();
-            return;
-        }
-        let target = &mut *self;
-        // A thread of its own, not the pool's: the pool's idle worker did not take the other
-        // half of a `rayon::join` begun outside the pool before the first half was done.
-        std::thread::scope(|s| {
-            s.spawn(move || {
-                let _ = target.index();
-            });
-            beside();
-        });
+        // Nothing to start when built already (the map did not change since) or under way.
+        self.index_ahead();
+        beside();
+        // Claimed (or, without a thread, built here).
+        let _ = self.index();
     }
 
     /// Starts building the index of an in-place map that changed since its last one on a
