@@ -47,7 +47,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         if refine_sweep
             && self.config.sweep_motion
             && tracked.information.is_some()
-            && let Some(sweep) = self.sweep_motion(&tracked.prepared, &tracked.pose)
+            && let Some(sweep) =
+                self.sweep_motion(&tracked.prepared, &tracked.pose, tracked.inlier_ratio)
         {
             let sweep = self.recheck_sweep(&tracked.prepared, guesses, sweep);
             let a = sweep.alignment;
@@ -130,9 +131,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// sweep's start with its fit and information, and the correction to the velocity it was
     /// deskewed with.
     /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
-    /// pose, too small a gain over the scan's registration:
-    /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain)).
-    fn sweep_motion(&self, prepared: &Prepared<R::Source>, pose: &Pose3) -> Option<SweepAlignment> {
+    /// pose, too small a gain over the scan's registration, which matched `rigid_inliers` of it:
+    /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain),
+    /// [`GraphSlamConfig::sweep_min_inlier_gain`](super::GraphSlamConfig::sweep_min_inlier_gain)).
+    fn sweep_motion(
+        &self,
+        prepared: &Prepared<R::Source>,
+        pose: &Pose3,
+        rigid_inliers: f64,
+    ) -> Option<SweepAlignment> {
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
             .odometry
@@ -144,9 +151,11 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .ok()?;
         let a = &sweep.alignment;
         let gain = self.config.sweep_min_gain;
-        let better = self
-            .last_fit
-            .is_none_or(|rmse| a.rmse <= rmse * (1.0 - gain));
+        let more = self.config.sweep_min_inlier_gain;
+        let better = self.last_fit.is_none_or(|rmse| {
+            a.rmse <= rmse * (1.0 - gain)
+                || (a.inlier_ratio >= rigid_inliers + more && a.rmse <= rmse)
+        });
         (pose3_is_finite(&a.pose)
             && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
             && better)

@@ -46,7 +46,7 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 17] = [
+    let cases: [(GraphSlamConfig, &str); 21] = [
         (
             GraphSlamConfig {
                 gravity_tilt_sigma: f64::NAN,
@@ -88,6 +88,34 @@ fn bad_settings_are_refused_by_name() {
                 ..GraphSlamConfig::default()
             },
             "GraphSlamConfig::sweep_min_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_inlier_gain: f64::NAN,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_inlier_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_inlier_gain: 0.0,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_inlier_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_inlier_gain: -0.1,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_inlier_gain",
+        ),
+        (
+            GraphSlamConfig {
+                sweep_min_inlier_gain: 1.5,
+                ..GraphSlamConfig::default()
+            },
+            "GraphSlamConfig::sweep_min_inlier_gain",
         ),
         (
             GraphSlamConfig {
