@@ -11,6 +11,7 @@ use crate::alignment_inputs::checked_target_index;
 use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
 use crate::matcher::Matcher;
+use crate::pool_awake::with_pool_awake;
 use crate::target::{PreparedTarget, TargetIndex};
 
 /// One correspondence: source point moved by the current pose, its target point, and the target
@@ -189,11 +190,12 @@ pub(crate) fn align<S: IcpStep>(
         config.max_correspondence_distance,
         first_search_radius(config),
     );
-    // On a worker of the thread pool: each iteration's search then forks onto the other
-    // workers directly, not through the pool's queue from outside (a wake-up each time).
+    // On a worker of the thread pool, with another kept looking for work: each iteration's
+    // search then forks onto it directly, not through the pool's queue from outside and not
+    // by waking it from sleep (`with_pool_awake`).
     let mut left = None;
     let result =
-        rayon::scope(|_| align_indexed::<S>(config, source, index, matcher, initial, &mut left));
+        with_pool_awake(|| align_indexed::<S>(config, source, index, matcher, initial, &mut left));
     // The neighbours it found, for another alignment of the same points against the same
     // target (the next wide stage, a recheck, the sweep).
     if let Some(matcher) = left {

@@ -67,6 +67,7 @@ mod neighbour_cache;
 mod place_index;
 mod point_to_plane;
 mod point_to_point;
+mod pool_awake;
 mod scan_context;
 mod sweep;
 mod sym3;

@@ -23,6 +23,7 @@ use crate::alignment_report::alignment_report;
 use crate::config::IcpConfig;
 use crate::icp::{Pair, first_search_radius, inliers_and_rmse, thin_source};
 use crate::matcher::Matcher;
+use crate::pool_awake::with_pool_awake;
 use crate::target::{PreparedTarget, TargetIndex};
 
 /// The prior on the velocity correction, relative to the pairs' summed weight, for its linear
@@ -97,7 +98,7 @@ pub(crate) fn align_sweep(
         first_search_radius(config),
     );
     // On a worker of the thread pool, as `icp::align`.
-    let result = rayon::scope(|_| {
+    let result = with_pool_awake(|| {
         align_sweep_indexed(config, &points, &times, &mut matcher, index, initial)
     });
     target.keep_matcher(&points, 1, matcher);
