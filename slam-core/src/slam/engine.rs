@@ -600,15 +600,21 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         self.report.keyframes += 1;
         self.anchor = None;
-        // The local map slid first: its index is then built on the other core meanwhile.
-        self.visit_keyframe(index);
-        // Appearance (before this keyframe joins the recognizer); a scan the recognizer
+        // Appearance (before this keyframe joins the recognizer) on a worker of the thread
+        // pool, while the local map slides on this thread (its index is then built on the
+        // other core meanwhile); neither reads what the other writes. A scan the recognizer
         // refuses is counted, and the keyframe goes on without a place match.
-        let look_alikes = match self
-            .places
-            .as_mut()
-            .map(|p| p.candidates_then_add(index, &cloud))
-        {
+        let mut places = self.places.take();
+        let mut recognized = None;
+        rayon::in_place_scope(|s| {
+            if let Some(p) = places.as_mut() {
+                let (cloud, recognized) = (&cloud, &mut recognized);
+                s.spawn(move |_| *recognized = Some(p.candidates_then_add(index, cloud)));
+            }
+            self.visit_keyframe(index);
+        });
+        self.places = places;
+        let look_alikes = match recognized {
             Some(Ok(found)) => found,
             Some(Err(_)) => {
                 self.report.place_refusals += 1;
