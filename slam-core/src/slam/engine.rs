@@ -25,7 +25,7 @@ use crate::io::StampedPose;
 use crate::pose_graph::{GraphPose, PoseGraph};
 use crate::tracking::{Tracker, TurnPersistence};
 use crate::traits::optimizer::Optimizer;
-use crate::traits::place_recognizer::PlaceRecognizer;
+use crate::traits::place_recognizer::{PlaceMatch, PlaceRecognizer};
 use crate::traits::registrator::MapRegistrator;
 
 /// One LiDAR scan with the robot's odometry at the same instant (the `spot-adapter` sample).
@@ -516,6 +516,32 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         (from as u64, step, info)
     }
 
+    /// Keyframe `index` (scan `cloud`, thinned) joins the local map and the place recognizer;
+    /// the earlier keyframes it looks like. The recognizer runs on a worker of the thread pool
+    /// while the local map slides on this thread (its index is then built on the other core
+    /// meanwhile); neither reads what the other writes. A scan the recognizer refuses is
+    /// counted, and the keyframe goes on without a place match.
+    fn slide_and_recognize(&mut self, index: usize, cloud: &PointCloud) -> Vec<PlaceMatch> {
+        let mut places = self.places.take();
+        let mut recognized = None;
+        rayon::in_place_scope(|s| {
+            if let Some(p) = places.as_mut() {
+                let recognized = &mut recognized;
+                s.spawn(move |_| *recognized = Some(p.candidates_then_add(index, cloud)));
+            }
+            self.visit_keyframe(index);
+        });
+        self.places = places;
+        match recognized {
+            Some(Ok(found)) => found,
+            Some(Err(_)) => {
+                self.report.place_refusals += 1;
+                Vec::new()
+            }
+            None => Vec::new(),
+        }
+    }
+
     /// Adds `prepared` as a keyframe at `pose` (with its `registration`'s information for its
     /// odometry edge, and the share of the scan it matched), queues its loop candidate and runs a loop-closure step when
     /// inline.
@@ -600,28 +626,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         self.report.keyframes += 1;
         self.anchor = None;
-        // Appearance (before this keyframe joins the recognizer) on a worker of the thread
-        // pool, while the local map slides on this thread (its index is then built on the
-        // other core meanwhile); neither reads what the other writes. A scan the recognizer
-        // refuses is counted, and the keyframe goes on without a place match.
-        let mut places = self.places.take();
-        let mut recognized = None;
-        rayon::in_place_scope(|s| {
-            if let Some(p) = places.as_mut() {
-                let (cloud, recognized) = (&cloud, &mut recognized);
-                s.spawn(move |_| *recognized = Some(p.candidates_then_add(index, cloud)));
-            }
-            self.visit_keyframe(index);
-        });
-        self.places = places;
-        let look_alikes = match recognized {
-            Some(Ok(found)) => found,
-            Some(Err(_)) => {
-                self.report.place_refusals += 1;
-                Vec::new()
-            }
-            None => Vec::new(),
-        };
+        let look_alikes = self.slide_and_recognize(index, &cloud);
         if self.clouds.push(cloud).is_err() {
             // Kept in memory instead; counted, the walk goes on.
             self.report.keyframe_store_failures += 1;
