@@ -9,14 +9,16 @@
 #   GROUND_TRUTH  TUM (stamp tx ty tz qx qy qz qw) or KITTI poses (12 numbers, one line a scan)
 #                 of the body (= the LiDAR unless the extra args give --calibration)
 # KISS-ICP runs with its defaults; KISS_MAX_RANGE (m; its voxel then follows, max_range / 100),
-# KISS_VOXEL_SIZE (m) and KISS_THREADS (0 = all cores, its default) change them. Prints end-point
+# KISS_VOXEL_SIZE (m) and KISS_THREADS (0 = all cores, its default) change them. KISS_RUNS (default
+# 1) runs both that many times, one after the other, and ends with each run's means and the median
+# ratio: a shared machine's timings vary from run to run by more than most changes. Prints end-point
 # drift, ATE, RPE per 100 m, height drift, steps with more than 2 and 5 degrees of rotation error,
 # mean and p99 ms a scan (ours: the engine's, from summary.json, the whole LiDAR-only front end;
 # KISS-ICP: register_frame alone) and the ratio of the means. Installs kiss-icp into target/peers
 # and leaves both trajectories in target/peers/kiss-icp-out.
 set -euo pipefail
 if [ $# -lt 2 ]; then
-    sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
 fi
 scans=$(realpath "$1")
@@ -35,8 +37,11 @@ slam="${CARGO_TARGET_DIR:-target}/release/examples/slam"
 work=target/peers/kiss-icp-out
 rm -rf "$work"
 mkdir -p "$work"
-echo "== ours: slam $scans --no-odometry --ground-truth $truth $*"
-"$slam" "$scans" --no-odometry --ground-truth "$truth" --out "$work/ours" "$@"
+runs="${KISS_RUNS:-1}"
+if ! [[ "$runs" =~ ^[1-9][0-9]*$ ]]; then
+    echo "KISS_RUNS must be a positive whole number, not '$runs'" >&2
+    exit 2
+fi
 kiss_args=()
 [ -n "${KISS_MAX_RANGE:-}" ] && kiss_args+=(--max-range "$KISS_MAX_RANGE")
 [ -n "${KISS_VOXEL_SIZE:-}" ] && kiss_args+=(--voxel-size "$KISS_VOXEL_SIZE")
@@ -50,6 +55,30 @@ for a in "$@"; do
     previous="$a"
 done
 [ -n "$calibration" ] && kiss_args+=(--calibration "$calibration")
-echo "== KISS-ICP 1.3.0 and both against the ground truth"
-"$venv/bin/python" benches/peers/kiss_icp_peer.py "$scans" "$truth" "$work/ours" \
-    --write-tum "$work/kiss_icp.tum" "${kiss_args[@]}"
+summary=()
+for run in $(seq "$runs"); do
+    [ "$runs" -gt 1 ] && echo "== run $run of $runs"
+    rm -rf "$work/ours"
+    echo "== ours: slam $scans --no-odometry --ground-truth $truth $*"
+    "$slam" "$scans" --no-odometry --ground-truth "$truth" --out "$work/ours" "$@"
+    echo "== KISS-ICP 1.3.0 and both against the ground truth"
+    out=$("$venv/bin/python" benches/peers/kiss_icp_peer.py "$scans" "$truth" "$work/ours" \
+        --write-tum "$work/kiss_icp.tum" "${kiss_args[@]}")
+    echo "$out"
+    means=$(echo "$out" | sed -n 's|^mean / p99 ms a scan *\([0-9.]*\) / [0-9.]* (engine) *\([0-9.]*\) / .*|\1 \2|p')
+    if [ -z "$means" ]; then
+        echo "could not read both mean times a scan from the comparison above" >&2
+        exit 1
+    fi
+    summary+=("$means")
+done
+if [ "$runs" -gt 1 ]; then
+    echo "== $runs runs: ours / KISS-ICP mean ms a scan, and the ratio"
+    printf '%s\n' "${summary[@]}" | awk '{ printf "run %d    %.2f / %.2f ms    %.3f\n", NR, $1, $2, $1 / $2 }'
+    printf '%s\n' "${summary[@]}" | awk '{ print $1 / $2 }' | sort -g | awk '
+        { r[NR] = $1 }
+        END {
+            m = (NR % 2) ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2
+            printf "median ratio %.3f (of %d runs; lowest %.3f, highest %.3f)\n", m, NR, r[1], r[NR]
+        }'
+fi
