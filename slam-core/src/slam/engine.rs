@@ -104,9 +104,6 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     pub(super) turn_basis: Option<TurnBasis>,
     /// The gyro orientation of the last scan taken.
     pub(super) last_gyro: Option<GyroReading>,
-    /// The RMS error of the last scan's registration by the tracker (its sweep's own must beat
-    /// it, [`GraphSlamConfig::sweep_min_gain`]).
-    pub(super) last_fit: Option<f64>,
     /// Stamp and `odom_T_lidar` of the last accepted scan: the velocity for deskewing.
     pub(super) last_odometry: Option<StampedPose>,
     /// Place recognition over keyframe scans, when set: loops sought by appearance too.
@@ -178,7 +175,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             turns: TurnPersistence::default(),
             turn_basis: None,
             last_gyro: None,
-            last_fit: None,
             last_odometry: None,
             places: None,
             report: SlamReport::default(),

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix6, Vector6};
 
 use crate::tracking::replaces;
-use crate::traits::registrator::SweepAlignment;
+use crate::traits::registrator::{Alignment, SweepAlignment};
 
 use super::engine::{GraphSlam, ScanInput};
 use super::scan_preparation::Prepared;
@@ -37,18 +37,17 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         velocity: Option<Vector6<f64>>,
         refine_sweep: bool,
     ) -> TrackedScan<R::Source> {
-        let (pose, information, inlier_ratio) = self.register(&prepared, guesses);
+        let (pose, registered) = self.register(&prepared, guesses);
         let mut tracked = TrackedScan {
             prepared,
             pose,
-            information,
-            inlier_ratio,
+            information: registered.as_ref().map(|a| a.information),
+            inlier_ratio: registered.as_ref().map_or(0.0, |a| a.inlier_ratio),
         };
         if refine_sweep
             && self.config.sweep_motion
-            && tracked.information.is_some()
-            && let Some(sweep) =
-                self.sweep_motion(&tracked.prepared, &tracked.pose, tracked.inlier_ratio)
+            && let Some(rigid) = registered.as_ref()
+            && let Some(sweep) = self.sweep_motion(&tracked.prepared, &tracked.pose, rigid)
         {
             let sweep = self.recheck_sweep(&tracked.prepared, guesses, sweep);
             let a = sweep.alignment;
@@ -91,15 +90,15 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
     }
 
-    /// The pose of a scan, its registration's information and matched share: registered against the local
-    /// map from `guesses` (the prediction first) by the tracker; the prediction, counted as a
+    /// The pose of a scan and the registration taken: registered against the local map from
+    /// `guesses` (the prediction first) by the tracker; the prediction and `None`, counted as a
     /// fallback, when it cannot be (no map, or the registration is not taken). An alternative
     /// guess that wins counts as an odometry fault.
     fn register(
         &mut self,
         prepared: &Prepared<R::Source>,
         guesses: &[Pose3],
-    ) -> (Pose3, Option<Matrix6<f64>>, f64) {
+    ) -> (Pose3, Option<Alignment>) {
         let has_map = self.ensure_local_map();
         let target = self
             .local_map
@@ -121,9 +120,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // or rounding compounds scan after scan.
         let mut pose = outcome.pose;
         pose.rotation.renormalize();
-        self.last_fit = outcome.alignment.as_ref().map(|a| a.rmse);
-        let inlier_ratio = outcome.alignment.as_ref().map_or(0.0, |a| a.inlier_ratio);
-        (pose, outcome.alignment.map(|a| a.information), inlier_ratio)
+        (pose, outcome.alignment)
     }
 
     /// The scan registered again from `pose` (its registration) together with its sweep's own
@@ -131,14 +128,14 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
     /// sweep's start with its fit and information, and the correction to the velocity it was
     /// deskewed with.
     /// `None` when the backend cannot, or the result is not taken (too few inliers, a non-finite
-    /// pose, too small a gain over the scan's registration, which matched `rigid_inliers` of it:
+    /// pose, too small a gain over `rigid`, the scan's own registration:
     /// [`GraphSlamConfig::sweep_min_gain`](super::GraphSlamConfig::sweep_min_gain),
     /// [`GraphSlamConfig::sweep_min_inlier_gain`](super::GraphSlamConfig::sweep_min_inlier_gain)).
     fn sweep_motion(
         &self,
         prepared: &Prepared<R::Source>,
         pose: &Pose3,
-        rigid_inliers: f64,
+        rigid: &Alignment,
     ) -> Option<SweepAlignment> {
         let map = &self.local_map.as_ref()?.target;
         let sweep = self
@@ -152,10 +149,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let a = &sweep.alignment;
         let gain = self.config.sweep_min_gain;
         let more = self.config.sweep_min_inlier_gain;
-        let better = self.last_fit.is_none_or(|rmse| {
-            a.rmse <= rmse * (1.0 - gain)
-                || (a.inlier_ratio >= rigid_inliers + more && a.rmse <= rmse)
-        });
+        let better = a.rmse <= rigid.rmse * (1.0 - gain)
+            || (a.inlier_ratio >= rigid.inlier_ratio + more && a.rmse <= rigid.rmse);
         (pose3_is_finite(&a.pose)
             && a.inlier_ratio >= self.config.tracker.min_inlier_ratio
             && better)
