@@ -81,6 +81,9 @@ fn walk(seed: u64, source_points: Option<usize>) -> Result<(String, Walk), Strin
     Ok((row, summary))
 }
 
+/// At most this many seeds a range.
+const MAX_SEEDS: u64 = 10_000;
+
 /// The seeds of `SLAM_HANDHELD_SEEDS`: numbers and ranges (`1-36`) separated by commas.
 fn seeds(list: &str) -> Result<Vec<u64>, String> {
     let mut seeds = Vec::new();
@@ -95,6 +98,12 @@ fn seeds(list: &str) -> Result<Vec<u64>, String> {
                 let (a, b) = (number(a)?, number(b)?);
                 if a > b {
                     return Err(format!("seed range {part:?} runs backwards"));
+                }
+                // A walk takes seconds: a range longer than this is a typing slip, not a plan.
+                if b - a >= MAX_SEEDS {
+                    return Err(format!(
+                        "seed range {part:?} holds more than {MAX_SEEDS} seeds"
+                    ));
                 }
                 seeds.extend(a..=b);
             }

@@ -21,6 +21,11 @@ if [ $# -lt 2 ]; then
     sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
 fi
+runs="${KISS_RUNS:-1}"
+if ! [[ "$runs" =~ ^[1-9][0-9]*$ ]]; then
+    echo "KISS_RUNS must be a positive whole number, not '$runs'" >&2
+    exit 2
+fi
 scans=$(realpath "$1")
 truth=$(realpath "$2")
 shift 2
@@ -37,11 +42,6 @@ slam="${CARGO_TARGET_DIR:-target}/release/examples/slam"
 work=target/peers/kiss-icp-out
 rm -rf "$work"
 mkdir -p "$work"
-runs="${KISS_RUNS:-1}"
-if ! [[ "$runs" =~ ^[1-9][0-9]*$ ]]; then
-    echo "KISS_RUNS must be a positive whole number, not '$runs'" >&2
-    exit 2
-fi
 kiss_args=()
 [ -n "${KISS_MAX_RANGE:-}" ] && kiss_args+=(--max-range "$KISS_MAX_RANGE")
 [ -n "${KISS_VOXEL_SIZE:-}" ] && kiss_args+=(--voxel-size "$KISS_VOXEL_SIZE")

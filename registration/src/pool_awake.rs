@@ -7,6 +7,10 @@
 //! parallel chunks with a 60 us serial gap between them, on this project's 2-core machine: 214
 //! us an iteration, against 163 us with a worker kept looking). Only the scheduling changes:
 //! the same chunks, summed in the same order, so every result is the same to the bit.
+//!
+//! The price: that worker spins on its core for as long as the alignment runs, and while it
+//! waits it may take up any work pending in the same pool (another caller's), which the
+//! alignment then waits for before it returns.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

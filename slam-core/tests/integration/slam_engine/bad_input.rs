@@ -5,6 +5,9 @@ use nalgebra::Point3;
 use slam_core::tracking::{ReachConfig, TrackerConfig};
 use slam_core::{EdgeInformation, GraphSlamConfig, PointCloud, Pose3, ScanInput, ScanOutcome};
 
+/// Sets one scalar setting of a configuration.
+type Set = fn(&mut GraphSlamConfig, f64);
+
 #[test]
 fn bad_settings_are_refused_by_name() {
     let build = |config: GraphSlamConfig| brute_engine(config).err().map(|e| (e.setting, e.value));
@@ -46,112 +49,56 @@ fn bad_settings_are_refused_by_name() {
         build(nan_scale).map(|(setting, _)| setting),
         Some("GraphSlamConfig::odometry_information::scale")
     );
-    let cases: [(GraphSlamConfig, &str); 21] = [
+    // Scalar settings, each with the bad values it must refuse by name.
+    let scalars: [(&str, Set, &[f64]); 7] = [
         (
-            GraphSlamConfig {
-                gravity_tilt_sigma: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::gravity_tilt_sigma",
+            |c, v| c.gravity_tilt_sigma = v,
+            &[f64::NAN, 0.0, -1e-4],
         ),
         (
-            GraphSlamConfig {
-                gravity_tilt_sigma: 0.0,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::gravity_tilt_sigma",
-        ),
-        (
-            GraphSlamConfig {
-                gravity_tilt_sigma: -1e-4,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::gravity_tilt_sigma",
-        ),
-        (
-            GraphSlamConfig {
-                sweep_min_gain: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::sweep_min_gain",
+            |c, v| c.sweep_min_gain = v,
+            &[f64::NAN, -0.1, 1.0],
         ),
         (
-            GraphSlamConfig {
-                sweep_min_gain: -0.1,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::sweep_min_gain",
-        ),
-        (
-            GraphSlamConfig {
-                sweep_min_gain: 1.0,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::sweep_min_gain",
-        ),
-        (
-            GraphSlamConfig {
-                sweep_min_inlier_gain: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::sweep_min_inlier_gain",
+            |c, v| c.sweep_min_inlier_gain = v,
+            &[f64::NAN, 0.0, -0.1, 1.5],
         ),
         (
-            GraphSlamConfig {
-                sweep_min_inlier_gain: 0.0,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::sweep_min_inlier_gain",
-        ),
-        (
-            GraphSlamConfig {
-                sweep_min_inlier_gain: -0.1,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::sweep_min_inlier_gain",
-        ),
-        (
-            GraphSlamConfig {
-                sweep_min_inlier_gain: 1.5,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::sweep_min_inlier_gain",
-        ),
-        (
-            GraphSlamConfig {
-                loop_max_drift_rate: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::loop_max_drift_rate",
+            |c, v| c.loop_max_drift_rate = v,
+            &[f64::NAN, -0.01],
         ),
         (
-            GraphSlamConfig {
-                loop_max_drift_rate: -0.01,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::loop_max_drift_rate",
-        ),
-        (
-            GraphSlamConfig {
-                loop_max_height_drift_rate: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::loop_max_height_drift_rate",
+            |c, v| c.loop_max_height_drift_rate = v,
+            &[f64::NAN, -0.01],
         ),
         (
-            GraphSlamConfig {
-                loop_max_height_drift_rate: -0.01,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::loop_max_height_drift_rate",
-        ),
-        (
-            GraphSlamConfig {
-                keyframe_distance: f64::NAN,
-                ..GraphSlamConfig::default()
-            },
             "GraphSlamConfig::keyframe_distance",
+            |c, v| c.keyframe_distance = v,
+            &[f64::NAN],
         ),
+        (
+            "GraphSlamConfig::map_voxel_size",
+            |c, v| c.map_voxel_size = v as f32,
+            &[-0.05],
+        ),
+    ];
+    for (setting, set, bad) in scalars {
+        for &v in bad {
+            let mut config = GraphSlamConfig::default();
+            set(&mut config, v);
+            assert_eq!(
+                build(config).map(|(s, _)| s),
+                Some(setting),
+                "{setting} = {v}"
+            );
+        }
+    }
+    let cases: [(GraphSlamConfig, &str); 5] = [
         (
             GraphSlamConfig {
                 local_map_keyframes: 0,
@@ -195,13 +142,6 @@ fn bad_settings_are_refused_by_name() {
                 ..GraphSlamConfig::default()
             },
             "GraphSlamConfig::loop_information::scale",
-        ),
-        (
-            GraphSlamConfig {
-                map_voxel_size: -0.05,
-                ..GraphSlamConfig::default()
-            },
-            "GraphSlamConfig::map_voxel_size",
         ),
     ];
     for (config, setting) in cases {
