@@ -24,7 +24,7 @@ pub struct PreparedTarget {
     window: Option<Box<Window>>,
     /// The neighbours the last alignment against this target found, for the next alignment of
     /// the same source points (a sweep's motion found right after the scan's registration).
-    last_matcher: RefCell<Option<MatcherMemo>>,
+    last_matcher: RefCell<Vec<MatcherMemo>>,
     /// An in-place map's index being built on a thread of its own for the window as it is now
     /// ([`Self::index_ahead`]): claimed by the next query, or dropped unclaimed when the window
     /// changes first.
@@ -64,6 +64,10 @@ fn window_index(
     };
     (Ok(index), Some(built))
 }
+
+/// Neighbour caches kept for later alignments: a scan's few points (the wide stages', a
+/// recheck's first pass) and its many (the fine stage's, the sweep's) alternate.
+const KEPT_MATCHERS: usize = 2;
 
 /// An alignment's neighbour cache with what it is valid for.
 struct MatcherMemo {
@@ -136,7 +140,7 @@ impl PreparedTarget {
         Ok(Self {
             index: OnceCell::from(Ok(index)),
             window: None,
-            last_matcher: RefCell::new(None),
+            last_matcher: RefCell::new(Vec::new()),
             pending: RefCell::new(None),
         })
     }
@@ -151,7 +155,7 @@ impl PreparedTarget {
     ) -> Self {
         Self {
             index: OnceCell::new(),
-            last_matcher: RefCell::new(None),
+            last_matcher: RefCell::new(Vec::new()),
             pending: RefCell::new(None),
             window: Some(Box::new(Window {
                 voxels: VoxelWindow::new(voxel),
@@ -203,7 +207,7 @@ impl PreparedTarget {
         if let Some(w) = self.window.as_mut() {
             w.voxels.add(key, source, pose);
             self.index = OnceCell::new();
-            self.last_matcher = RefCell::new(None);
+            self.last_matcher = RefCell::new(Vec::new());
         }
     }
 
@@ -213,7 +217,7 @@ impl PreparedTarget {
         if let Some(w) = self.window.as_mut() {
             w.voxels.remove(key);
             self.index = OnceCell::new();
-            self.last_matcher = RefCell::new(None);
+            self.last_matcher = RefCell::new(Vec::new());
         }
     }
 
@@ -297,7 +301,11 @@ impl PreparedTarget {
         pair_points: usize,
         matcher: Matcher,
     ) {
-        *self.last_matcher.borrow_mut() = Some(MatcherMemo {
+        let mut kept = self.last_matcher.borrow_mut();
+        if kept.len() >= KEPT_MATCHERS {
+            kept.remove(0);
+        }
+        kept.push(MatcherMemo {
             points: points.to_vec(),
             pair_points,
             matcher,
@@ -318,11 +326,13 @@ impl PreparedTarget {
         max_distance: f64,
         first_radius: f64,
     ) -> Matcher {
-        let kept = self
-            .last_matcher
-            .borrow_mut()
-            .take()
-            .filter(|memo| memo.points == points && memo.pair_points == pair_points);
+        let kept = {
+            let mut memos = self.last_matcher.borrow_mut();
+            memos
+                .iter()
+                .position(|memo| memo.points == points && memo.pair_points == pair_points)
+                .map(|at| memos.remove(at))
+        };
         match kept {
             Some(memo) => memo.matcher.with_reach(max_distance, first_radius),
             None => Matcher::new(
