@@ -12,6 +12,9 @@ use crate::geometry::{Pose3, pose3_is_finite};
 use crate::traits::optimizer::Optimizer;
 use crate::traits::registrator::MapRegistrator;
 
+/// Points of a sweep's cheap first recheck: as many as a wide stage of the tracker pairs.
+const RECHECK_SWEEP_POINTS: usize = 600;
+
 /// A scan after tracking.
 pub(super) struct TrackedScan<S> {
     /// The scan, deskewed anew when its sweep's motion was found.
@@ -84,6 +87,22 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             return found;
         };
         let sweep = prepared.coarse.as_ref().unwrap_or(&prepared.cloud);
+        // First on a few of its points (as many as a wide stage pairs): within the basin of
+        // `found`, `found` stands; otherwise the whole sweep goes on from there.
+        let tracker = &self.config.tracker;
+        let start = if tracker.recheck_basin > 0.0 {
+            let every = sweep.len().div_ceil(RECHECK_SWEEP_POINTS).max(1);
+            let few = sweep.filtered(|i, _| i % every == 0);
+            match self.odometry.align_sweep(&few, &map.target, &start) {
+                Some(Ok(c)) if tracker.in_basin(&c.alignment.pose, &found.alignment.pose) => {
+                    return found;
+                }
+                Some(Ok(c)) if pose3_is_finite(&c.alignment.pose) => c.alignment.pose,
+                _ => start,
+            }
+        } else {
+            start
+        };
         match self.odometry.align_sweep(sweep, &map.target, &start) {
             Some(Ok(other)) if replaces(&other.alignment, &found.alignment) => other,
             _ => found,

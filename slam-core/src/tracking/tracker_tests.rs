@@ -345,11 +345,14 @@ fn every_bad_setting_is_refused_by_name() {
 
 /// A corridor where the wide stages carry any guess 0.2 m short of the truth along it (a basin
 /// that fits a little worse: `short_fit`), and the fine stage converges to the truth from
-/// within 0.1 m of it and stays put farther away.
+/// within 0.1 m of it and stays put farther away. A stage at the reach's minimum (a recheck's
+/// first pass) behaves as the fine stage, ending 3 mm from where the fine stage would.
 struct ShortBasin {
     truth: Pose3,
     /// Matched share and RMS error of the short pose.
     short_fit: (f64, f64),
+    /// Whole fine stages run.
+    fine_stages: std::cell::Cell<usize>,
 }
 
 impl ShortBasin {
@@ -376,6 +379,7 @@ impl Registrator for ShortBasin {
         Ok(())
     }
     fn align(&self, (): &(), (): &(), guess: &Pose3) -> Result<Alignment, RegistrationError> {
+        self.fine_stages.set(self.fine_stages.get() + 1);
         let off = (guess.translation.vector - self.truth.translation.vector).norm();
         Ok(if off <= 0.1 {
             fitted(self.truth, (0.9, 0.017))
@@ -387,10 +391,19 @@ impl Registrator for ShortBasin {
         &self,
         (): &(),
         (): &(),
-        _: &Pose3,
-        _: &Reach,
+        guess: &Pose3,
+        reach: &Reach,
     ) -> Result<Alignment, RegistrationError> {
-        Ok(fitted(self.short(), self.short_fit))
+        let off = (guess.translation.vector - self.truth.translation.vector).norm();
+        let min = TrackerConfig::default().reach.min;
+        Ok(if reach.distance <= min && off <= 0.1 {
+            fitted(
+                Pose3::translation(0.003, 0.0, 0.0) * self.truth,
+                (0.9, 0.017),
+            )
+        } else {
+            fitted(self.short(), self.short_fit)
+        })
     }
 }
 
@@ -402,13 +415,18 @@ fn a_registration_carried_short_along_a_corridor_is_rechecked_from_the_predicted
     );
     // The prediction 3 cm and 10 degrees off: the wide stages fix the heading but end short.
     let prediction = Pose3::translation(0.03, 0.0, 0.0) * turned(&truth, -10f64.to_radians());
-    let track = |config: TrackerConfig, short_fit: (f64, f64)| {
+    let track_from = |config: TrackerConfig, short_fit: (f64, f64), prediction: Pose3| {
         let mut tracker = Tracker::new(config).unwrap_or_else(|e| panic!("{e}"));
-        let corridor = ShortBasin { truth, short_fit };
+        let corridor = ShortBasin {
+            truth,
+            short_fit,
+            fine_stages: std::cell::Cell::new(0),
+        };
         let outcome = tracker.track(&corridor, &(), Some(&()), &[prediction], 10.0);
         assert!(outcome.tracked(), "{outcome:?}");
-        outcome.pose
+        (outcome.pose, corridor.fine_stages.get())
     };
+    let track = |config, short_fit| track_from(config, short_fit, prediction).0;
     let gap = |a: Pose3, b: Pose3| (a.translation.vector - b.translation.vector).norm();
     let short = Pose3::translation(-0.2, 0.0, 0.0) * truth;
     // Worse on both counts there: the recheck from the predicted position finds the truth.
@@ -424,13 +442,25 @@ fn a_registration_carried_short_along_a_corridor_is_rechecked_from_the_predicted
     // a larger error is no proof.
     assert!(gap(track(d, (0.85, 0.015)), short) < 1e-12);
     assert!(gap(track(d, (0.95, 0.02)), short) < 1e-12);
+    // A recheck whose first pass ends in the registration's own basin stops there: from a
+    // prediction 0.3 m off, both end short, and only the registration's fine stage runs (two
+    // when the recheck runs whole).
+    let far_off = Pose3::translation(0.3, 0.0, 0.0) * prediction;
+    let (pose, fine) = track_from(d, (0.85, 0.02), far_off);
+    assert!(gap(pose, short) < 1e-12 && fine == 1, "{fine}");
+    let whole = TrackerConfig {
+        recheck_basin: 0.0,
+        ..d
+    };
+    let (pose, fine) = track_from(whole, (0.85, 0.02), far_off);
+    assert!(gap(pose, short) < 1e-12 && fine == 2, "{fine}");
     // Ending within the distance of the prediction, nothing is rechecked.
     let far = TrackerConfig {
         recheck_distance: 0.5,
         ..d
     };
     assert!(gap(track(far, (0.85, 0.02)), short) < 1e-12);
-    // A distance that is negative or not finite is refused by name.
+    // A distance or basin that is negative or not finite is refused by name.
     for bad in [-0.1, f64::INFINITY, f64::NAN] {
         let config = TrackerConfig {
             recheck_distance: bad,
@@ -439,6 +469,14 @@ fn a_registration_carried_short_along_a_corridor_is_rechecked_from_the_predicted
         assert_eq!(
             Tracker::new(config).err().map(|e| e.setting),
             Some("TrackerConfig::recheck_distance")
+        );
+        let config = TrackerConfig {
+            recheck_basin: bad,
+            ..d
+        };
+        assert_eq!(
+            Tracker::new(config).err().map(|e| e.setting),
+            Some("TrackerConfig::recheck_basin")
         );
     }
 }

@@ -50,7 +50,7 @@ fn bad_settings_are_refused_by_name() {
         Some("GraphSlamConfig::odometry_information::scale")
     );
     // Scalar settings, each with the bad values it must refuse by name.
-    let scalars: [(&str, Set, &[f64]); 7] = [
+    let scalars: [(&str, Set, &[f64]); 8] = [
         (
             "GraphSlamConfig::gravity_tilt_sigma",
             |c, v| c.gravity_tilt_sigma = v,
@@ -85,6 +85,11 @@ fn bad_settings_are_refused_by_name() {
             "GraphSlamConfig::map_voxel_size",
             |c, v| c.map_voxel_size = v as f32,
             &[-0.05],
+        ),
+        (
+            "TrackerConfig::recheck_basin",
+            |c, v| c.tracker.recheck_basin = v,
+            &[f64::NAN, -0.01, f64::INFINITY],
         ),
     ];
     for (setting, set, bad) in scalars {
