@@ -184,64 +184,73 @@ fn a_shaking_hand_held_dense_lidar_is_tracked_in_six_degrees_of_freedom() {
 /// sensor turns 39° between two scans and the wide stages once slid the scan 1.9 m along the new
 /// corridor; on the way, scans carried about 0.2 m short (10.5 s). The fine stage and the sweep's
 /// motion run again from the predicted position (`TrackerConfig::recheck_distance`) hold it.
-/// Measured (no loop closes in these 75 s): ATE 4.9 cm and no step more than 0.9° off with the
-/// recheck (3.9 cm while every recheck ran whole, before `TrackerConfig::recheck_basin`);
-/// without it ATE 6.8 cm and two steps 3.6-3.8° off at 39 s. (Before the sweep's points were
-/// moved along a blended path, `slam_core::SweepPath`, the run without the recheck slid at the
-/// corner: ATE 0.30 m and a step 23° off. Which scan a run without the recheck loses moves with
-/// such changes; that it loses one does not.)
+/// Measured (no loop closes in these 75 s), with every recheck run whole
+/// (`TrackerConfig::recheck_basin` 0, where this walk's knife edge was measured): ATE 4.0 cm and
+/// no step more than 0.9° off with the recheck; without it ATE 6.8 cm and two steps 3.6° off at
+/// 39 s. As set up, a recheck whose cheap first pass ends in the registration's basin stops
+/// there: ATE 4.9 cm, no step more than 0.9° off, held to the same bounds. (Before the sweep's
+/// points were moved along a blended path, `slam_core::SweepPath`, the run without the recheck
+/// slid at the corner: ATE 0.30 m and a step 23° off. Which scan a run without the recheck loses
+/// moves with such changes; that it loses one does not.)
 #[test]
 fn a_scan_slid_along_a_corridor_at_a_sharp_corner_is_found_again_from_the_predicted_position() {
     let (samples, body_t_lidar) = hand_held_walk_of_seed(11, 150);
-    let with = lidar_only(slam_config(), &samples, &body_t_lidar);
-    eprintln!("recheck: {with:?}");
-    assert!(
-        with.worst_step_deg <= 2.0 && with.fallbacks == 0,
-        "{with:?}"
-    );
-    assert!(with.ate <= 0.08, "{with:?}");
-    let mut config = slam_config();
+    let held = |o: &Outcome| o.worst_step_deg <= 2.0 && o.fallbacks == 0 && o.ate <= 0.08;
+    let set_up = lidar_only(slam_config(), &samples, &body_t_lidar);
+    eprintln!("recheck as set up: {set_up:?}");
+    assert!(held(&set_up), "{set_up:?}");
+    let mut whole = slam_config();
+    whole.tracker.recheck_basin = 0.0;
+    let with = lidar_only(whole.clone(), &samples, &body_t_lidar);
+    eprintln!("recheck run whole: {with:?}");
+    assert!(held(&with), "{with:?}");
+    let mut config = whole;
     config.tracker.recheck_distance = 0.0;
     let without = lidar_only(config, &samples, &body_t_lidar);
     eprintln!("no recheck: {without:?}");
     assert!(
-        without.worst_step_deg > 2.0
-            && without.steps_over_2_deg > with.steps_over_2_deg
-            && without.ate > with.ate + 0.01,
+        without.worst_step_deg > 2.0 && without.ate > with.ate + 0.02,
         "{without:?}"
     );
 }
 
-/// Seed 35's hand-held walk through its first corners (80 scans, 40 s). Mid-turn, a scan is
-/// deskewed with the last step's turn rate where the hand had nearly stopped, and registers
-/// degrees off; its sweep's own motion then matches clearly more of it while cutting the RMS
-/// error by less than `GraphSlamConfig::sweep_min_gain`. Taken for matching clearly more
-/// (`GraphSlamConfig::sweep_min_inlier_gain`), the walk ends 2.6 cm ATE with one step 2.05°
-/// off; judged by the RMS error alone, 5.3 cm with four steps over 2° (3.8° at worst). (Before
-/// a recheck's cheap first pass, `TrackerConfig::recheck_basin`, the first 45 scans showed it
-/// alone: at 17.5 s a sweep matching 74 % against the rigid 61 % at 4.9 % less RMS error, and a
-/// step 9° off without the rule.)
+/// Seed 35's hand-held walk through its first corner (45 scans, 22 s). Mid-turn at 17.5 s the
+/// scan is deskewed with the last step's turn rate (96°/s) where the hand had nearly stopped, and
+/// registers 5.5° off; its sweep's own motion matches 74 % of it against 61 % but cuts the RMS
+/// error by 4.9 %, just short of `GraphSlamConfig::sweep_min_gain`. Taken for matching clearly
+/// more (`GraphSlamConfig::sweep_min_inlier_gain`), no step is more than 2° off; judged by the
+/// RMS error alone, a step is 9° off. Measured with every recheck run whole
+/// (`TrackerConfig::recheck_basin` 0); as set up, the rechecks' cheap first pass keeps that scan
+/// within 2° either way (1.1° at worst over these scans), held to the same bound.
 #[test]
 fn a_sweep_that_matches_clearly_more_of_a_turning_scan_is_taken() {
-    let (samples, body_t_lidar) = hand_held_walk_of_seed(35, 80);
-    let with = lidar_only(slam_config(), &samples, &body_t_lidar);
+    let (samples, body_t_lidar) = hand_held_walk_of_seed(35, 45);
+    let set_up = lidar_only(slam_config(), &samples, &body_t_lidar);
+    eprintln!("as set up: {set_up:?}");
+    assert!(
+        set_up.worst_step_deg <= 2.0 && set_up.fallbacks == 0,
+        "{set_up:?}"
+    );
+    let whole = GraphSlamConfig {
+        tracker: TrackerConfig {
+            recheck_basin: 0.0,
+            ..slam_config().tracker
+        },
+        ..slam_config()
+    };
+    let with = lidar_only(whole.clone(), &samples, &body_t_lidar);
     eprintln!("sweep taken for matching more: {with:?}");
     assert!(
-        with.worst_step_deg <= 2.5 && with.ate <= 0.04 && with.fallbacks == 0,
+        with.worst_step_deg <= 2.0 && with.fallbacks == 0,
         "{with:?}"
     );
     let rmse_only = GraphSlamConfig {
         sweep_min_inlier_gain: 1.0,
-        ..slam_config()
+        ..whole
     };
     let without = lidar_only(rmse_only, &samples, &body_t_lidar);
     eprintln!("RMS error alone: {without:?}");
-    assert!(
-        without.worst_step_deg > 3.0
-            && without.steps_over_2_deg > with.steps_over_2_deg + 1
-            && without.ate > 1.5 * with.ate,
-        "{without:?}"
-    );
+    assert!(without.worst_step_deg > 5.0, "{without:?}");
 }
 
 /// A hand's turns come in jolts: at 2 Hz the last step's turn says little about the next. The
