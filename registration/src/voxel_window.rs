@@ -3,7 +3,7 @@
 
 use nalgebra::{Point3, Vector3};
 use rustc_hash::FxHashMap;
-use slam_core::Pose3;
+use slam_core::{Pose3, pack_voxel_key};
 
 /// Integer voxel coordinates.
 pub(crate) type VoxelKey = [i64; 3];
@@ -78,17 +78,6 @@ pub(crate) struct VoxelWindow {
     parts: FxHashMap<u32, Part>,
 }
 
-/// A voxel key packed into 21 bits an axis, when every coordinate is within +-2^20.
-fn packed(k: &VoxelKey) -> Option<u64> {
-    const HALF: i64 = 1 << 20;
-    k.iter().try_fold(0u64, |acc, &v| {
-        // In range, `v + HALF` is 0 to 2^21 - 1.
-        (-HALF..HALF)
-            .contains(&v)
-            .then(|| (acc << 21) | (v + HALF) as u64)
-    })
-}
-
 impl VoxelWindow {
     /// An empty window with voxels of `voxel` metres (finite and positive, checked by the
     /// caller's configuration).
@@ -142,7 +131,7 @@ impl VoxelWindow {
                     (sums.len() - 1) as u32
                 }
             };
-            let slot = match packed(&k) {
+            let slot = match pack_voxel_key((k[0], k[1], k[2])) {
                 Some(p) => *self.cells.entry(p).or_insert_with(new_slot),
                 None => *self.far_cells.entry(k).or_insert_with(new_slot),
             };
@@ -166,7 +155,7 @@ impl VoxelWindow {
             cell.count -= 1;
             if cell.count == 0 {
                 let key = self.metas[slot as usize].key;
-                match packed(&key) {
+                match pack_voxel_key((key[0], key[1], key[2])) {
                     Some(p) => self.cells.remove(&p),
                     None => self.far_cells.remove(&key),
                 };

@@ -72,3 +72,4 @@ pub use traits::planner::{GridPath, Planner, validate_endpoints};
 pub use traits::registrator::{
     Alignment, MapRegistrator, Reach, Registrator, SweepAlignment, WholeMapRegistrator,
 };
+pub use voxel::pack_voxel_key;

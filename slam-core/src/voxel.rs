@@ -60,9 +60,21 @@ enum Fallback {
 /// Half the span of a packed axis: 21 bits, offset so that negative voxels fit.
 const PACK_HALF: i64 = 1 << 20;
 
-/// The voxel coordinates packed 21 bits an axis, when each is within `[-2^20, 2^20)`.
+/// Integer voxel coordinates packed 21 bits an axis into one `u64` (a hash key half the size
+/// of three `i64` and hashed with one multiply), when each is within `[-2^20, 2^20)`; `None`
+/// otherwise, for the caller to key that voxel another way. Distinct coordinates in range give
+/// distinct keys.
+///
+/// ```
+/// use slam_core::pack_voxel_key;
+///
+/// assert_ne!(pack_voxel_key((1, 0, 0)), pack_voxel_key((0, 1, 0)));
+/// assert!(pack_voxel_key((-(1 << 20), 0, (1 << 20) - 1)).is_some());
+/// assert_eq!(pack_voxel_key((1 << 20, 0, 0)), None);
+/// ```
 #[inline]
-fn pack((x, y, z): (i64, i64, i64)) -> Option<u64> {
+#[must_use]
+pub fn pack_voxel_key((x, y, z): (i64, i64, i64)) -> Option<u64> {
     let axis = |v: i64| {
         let u = v.checked_add(PACK_HALF)?;
         u64::try_from(u).ok().filter(|&u| u < (1 << 21))
@@ -97,7 +109,7 @@ fn packed_key(p: &Point3<f32>, inv: f64) -> Result<Option<u64>, Fallback> {
         return Ok(Some(axis(x) | (axis(y) << 21) | (axis(z) << 42)));
     }
     match voxel_key(p, inv) {
-        Ok(Some(k)) => pack(k).map(Some).ok_or(Fallback::Wide),
+        Ok(Some(k)) => pack_voxel_key(k).map(Some).ok_or(Fallback::Wide),
         Ok(None) => Ok(None),
         Err(()) => Err(Fallback::OutOfRange),
     }
