@@ -28,6 +28,9 @@ pub struct SlamSummary {
     pub scans: usize,
     /// Keyframes created.
     pub keyframes: usize,
+    /// Keyframes that kept their whole scan for the map (`SlamReport::whole_scans`: every one,
+    /// but for dense scans one a metre).
+    pub whole_scans: usize,
     /// Registered scans that rode on a keyframe already in the map instead of making one
     /// (`SlamReport::revisits`).
     pub revisits: usize,

@@ -66,15 +66,7 @@ impl SolverConfig {
 /// [`InvalidSetting`] for the first of `settings` (name, value) that is not finite and not
 /// negative.
 pub(crate) fn check_tolerances(settings: &[(&'static str, f64)]) -> Result<(), InvalidSetting> {
-    for &(setting, v) in settings {
-        InvalidSetting::check(
-            v.is_finite() && v >= 0.0,
-            setting,
-            v,
-            "finite and not negative",
-        )?;
-    }
-    Ok(())
+    InvalidSetting::check_non_negative(settings)
 }
 
 /// `sum rho(e^T Omega e)` with `poses` in place of the graph's; with `weights` (one per edge),

@@ -71,6 +71,8 @@ fn slam_settings(dict: Option<&Bound<'_, PyDict>>) -> PyResult<GraphSlamConfig> 
         &mut c.loop_max_height_drift_rate,
     )?;
     s.take("map_voxel_size", &mut c.map_voxel_size)?;
+    s.take("keyframe_scan_spacing", &mut c.keyframe_scan_spacing)?;
+    s.take("dense_scan_points", &mut c.dense_scan_points)?;
     s.take("min_scan_points", &mut c.min_scan_points)?;
     s.take("odometry_gravity", &mut c.odometry_gravity)?;
     s.take("deskew", &mut c.deskew)?;
@@ -250,6 +252,7 @@ impl Slam {
         let d = PyDict::new(py);
         d.set_item("scans", r.scans)?;
         d.set_item("keyframes", r.keyframes)?;
+        d.set_item("whole_scans", r.whole_scans)?;
         d.set_item("revisits", r.revisits)?;
         d.set_item("loops_attempted", r.loops_attempted)?;
         d.set_item("loops_closed", r.loops_closed)?;

@@ -51,11 +51,16 @@ pub type LoamSlam = GraphSlam<LoamRegistrator, PointToPointIcp, GraduatedNonConv
 
 /// The engine settings that go with [`point_to_plane_slam`] and [`loam_slam`]: the defaults,
 /// except that the point-to-point loop check accepts an RMS distance up to 0.2 m (voxel
-/// centroids of two different scans sit a few centimetres apart).
+/// centroids of two different scans sit a few centimetres apart), and that keyframes of scans
+/// of more than 60,000 points (an OS1-128's 131,072; not a VLP-16's 29,000) keep their whole
+/// scan for the map one a metre ([`GraphSlamConfig::keyframe_scan_spacing`]), not at every
+/// keyframe.
 #[must_use]
 pub fn slam_config() -> GraphSlamConfig {
     GraphSlamConfig {
         loop_max_mean_squared_error: 0.04,
+        keyframe_scan_spacing: 1.0,
+        dense_scan_points: SPARSE_SCAN_POINTS,
         ..GraphSlamConfig::default()
     }
 }

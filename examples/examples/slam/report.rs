@@ -97,9 +97,10 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
     let report = slam.report();
     let skipped: usize = skip_reasons(report).iter().map(|&(_, n)| n).sum();
     out!(
-        "scans       {} ({} keyframes, {} riding on a keyframe already there, {skipped} skipped)",
+        "scans       {} ({} keyframes, {} with their whole scan for the map, {} riding on a keyframe already there, {skipped} skipped)",
         report.scans,
         report.keyframes,
+        report.whole_scans,
         report.revisits
     )?;
     let loops = Loops::new(report);
@@ -153,6 +154,7 @@ pub(crate) fn report<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>>(
         tracker_map_voxel: slam.registrator().map_voxel(),
         scans: report.scans,
         keyframes: report.keyframes,
+        whole_scans: report.whole_scans,
         revisits: report.revisits,
         loops,
         tracking: health,

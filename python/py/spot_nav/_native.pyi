@@ -140,6 +140,8 @@ class Slam:
         loop_max_drift_rate: float = ...,
         loop_max_height_drift_rate: float = ...,
         map_voxel_size: float = ...,
+        keyframe_scan_spacing: float = ...,
+        dense_scan_points: int = ...,
         min_scan_points: int = ...,
         odometry_gravity: bool = ...,
         deskew: bool = ...,

@@ -63,4 +63,28 @@ impl InvalidSetting {
         let value = value.to_string().parse().unwrap_or(f64::from(value));
         Self::check(false, setting, value, expected)
     }
+
+    /// The error for the first of `settings` (name, value) that is not finite and not negative
+    /// (distances, angles, tolerances).
+    ///
+    /// ```
+    /// use slam_core::InvalidSetting;
+    /// assert!(InvalidSetting::check_non_negative(&[("A::a", 0.0), ("A::b", 2.0)]).is_ok());
+    /// let err = InvalidSetting::check_non_negative(&[("A::a", 1.0), ("A::b", f64::NAN)]);
+    /// assert_eq!(err.unwrap_err().setting, "A::b");
+    /// ```
+    ///
+    /// # Errors
+    /// [`InvalidSetting`] for the first setting out of range.
+    pub fn check_non_negative(settings: &[(&'static str, f64)]) -> Result<(), Self> {
+        for &(setting, v) in settings {
+            Self::check(
+                v.is_finite() && v >= 0.0,
+                setting,
+                v,
+                "finite and not negative",
+            )?;
+        }
+        Ok(())
+    }
 }

@@ -109,6 +109,9 @@ pub struct GraphSlam<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> 
     /// Place recognition over keyframe scans, when set: loops sought by appearance too.
     pub(super) places: Option<Box<dyn PlaceRecognizer + Send>>,
     pub(super) report: SlamReport,
+    /// The last keyframe that kept its whole scan
+    /// ([`GraphSlamConfig::keyframe_scan_spacing`]).
+    pub(super) last_whole_scan: Option<usize>,
     /// Whether the odometry backend was set up for the sensor
     /// ([`MapRegistrator::fit_to_scan`], with the first scan).
     pub(super) fitted_to_sensor: bool,
@@ -178,6 +181,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             last_odometry: None,
             places: None,
             report: SlamReport::default(),
+            last_whole_scan: None,
             fitted_to_sensor: false,
         })
     }
@@ -556,7 +560,8 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let Prepared {
             cloud,
             thinned,
-            coarse: thinned_source,
+            spaced,
+            coarse: cloud_source,
             source,
             sweep,
             ..
@@ -579,13 +584,18 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             .loop_coarse
             .source_voxel()
             .is_some_and(|v| Some(v) == self.odometry.source_voxel());
-        let loop_cloud = thinned_source.filter(|_| same_voxel);
+        let loop_cloud = cloud_source.as_ref().filter(|_| same_voxel);
         let Ok(coarse) = self
             .loop_coarse
-            .prepare_source(loop_cloud.as_ref().unwrap_or(&cloud))
+            .prepare_source(loop_cloud.unwrap_or(&cloud))
         else {
             return self.skip(SkipReason::PreparationFailed, started);
         };
+        // A dense scan within the spacing of the last whole one keeps the points its
+        // registration used instead of its whole scan (place recognition still reads it).
+        let kept = cloud_source
+            .filter(|_| spaced && !self.whole_scan_due(&pose))
+            .map(PointCloud::without_ring_and_time);
         let index = self.keyframes.len();
         let id = index as u64;
         // The odometry edge comes from the reference: the last keyframe, or on a revisit the old
@@ -622,8 +632,12 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         }
         self.report.keyframes += 1;
         self.anchor = None;
+        if kept.is_none() {
+            self.last_whole_scan = Some(index);
+            self.report.whole_scans += 1;
+        }
         let look_alikes = self.slide_and_recognize(index, &cloud);
-        if self.clouds.push(cloud).is_err() {
+        if self.clouds.push(kept.unwrap_or(cloud)).is_err() {
             // Kept in memory instead; counted, the walk goes on.
             self.report.keyframe_store_failures += 1;
         }

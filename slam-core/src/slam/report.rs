@@ -185,6 +185,11 @@ pub struct SlamReport {
     pub scans: usize,
     /// Keyframes created.
     pub keyframes: usize,
+    /// Keyframes that kept their whole scan at the map's voxel: all of them but those of dense
+    /// scans within [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig) of the
+    /// last one that did.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub whole_scans: usize,
     /// Skipped scans: out-of-order stamps.
     pub skipped_out_of_order: usize,
     /// Skipped scans: non-finite odometry.

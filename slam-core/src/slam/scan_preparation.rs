@@ -21,6 +21,11 @@ pub(super) struct Prepared<S> {
     pub(super) cloud: PointCloud,
     /// The scan thinned to the map's voxel before deskewing, when the backend takes it so.
     pub(super) thinned: Option<PointCloud>,
+    /// A dense scan thinned for the odometry (`thinned` and `coarse` given) whose keyframe keeps
+    /// its whole scan only when it lies
+    /// [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig) from the last that
+    /// did; otherwise `coarse`.
+    pub(super) spaced: bool,
     /// `cloud` thinned again to the odometry's source voxel when `thinned` is given: what the
     /// source is prepared from and the sweep's motion is found on (voxelised once, not twice).
     pub(super) coarse: Option<PointCloud>,
@@ -79,6 +84,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             return Err(SkipReason::TooFewPoints);
         }
         let coarse = self.coarse(&cloud, thinned.is_some());
+        let spaced = coarse.is_some() && self.spaces_whole_scans(scan);
         let source = self
             .odometry
             .prepare_source(coarse.as_ref().unwrap_or(&cloud))
@@ -88,9 +94,25 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             extent: scan_extent(&cloud),
             cloud,
             thinned,
+            spaced,
             coarse,
             sweep,
             source,
+        })
+    }
+
+    /// Whether `scan` is dense enough for its keyframes to keep their whole scan only every
+    /// [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig).
+    fn spaces_whole_scans(&self, scan: &ScanInput<'_>) -> bool {
+        self.config.keyframe_scan_spacing > 0.0 && scan.cloud.len() > self.config.dense_scan_points
+    }
+
+    /// Whether a keyframe at `pose` is far enough from the last one that kept its whole scan
+    /// to keep its own ([`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig)).
+    pub(super) fn whole_scan_due(&self, pose: &Pose3) -> bool {
+        self.last_whole_scan.is_none_or(|k| {
+            (self.keyframe_pose(k).translation.vector - pose.translation.vector).norm()
+                >= self.config.keyframe_scan_spacing
         })
     }
 

@@ -18,6 +18,7 @@ mod evaluation;
 mod exploration;
 mod floors;
 mod floors_walk;
+mod keyframe_scans;
 mod lidar_models;
 mod lidar_only;
 mod motion_profiles;

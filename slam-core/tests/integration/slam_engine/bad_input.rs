@@ -50,7 +50,7 @@ fn bad_settings_are_refused_by_name() {
         Some("GraphSlamConfig::odometry_information::scale")
     );
     // Scalar settings, each with the bad values it must refuse by name.
-    let scalars: [(&str, Set, &[f64]); 8] = [
+    let scalars: [(&str, Set, &[f64]); 9] = [
         (
             "GraphSlamConfig::gravity_tilt_sigma",
             |c, v| c.gravity_tilt_sigma = v,
@@ -85,6 +85,11 @@ fn bad_settings_are_refused_by_name() {
             "GraphSlamConfig::map_voxel_size",
             |c, v| c.map_voxel_size = v as f32,
             &[-0.05],
+        ),
+        (
+            "GraphSlamConfig::keyframe_scan_spacing",
+            |c, v| c.keyframe_scan_spacing = v,
+            &[f64::NAN, -1.0, f64::INFINITY],
         ),
         (
             "TrackerConfig::recheck_basin",
