@@ -149,7 +149,7 @@ pub struct GraphSlamConfig {
     /// graph are the same to the bit either way; only what is kept for the map differs. At
     /// 2 Hz a hand-held sensor moves half a metre a scan and every scan is a keyframe: an
     /// OS1-128's keyframes kept 44,000 points each, 0.7 MB a scan (on a 218-scan walk at 1 m:
-    /// 155 MB resident at the end against 212 MB). 0 (the default) keeps every keyframe's
+    /// 156 MB resident at the end against 214 MB). 0 (the default) keeps every keyframe's
     /// whole scan.
     pub keyframe_scan_spacing: f64,
     /// Scans of more than this many points (as the sensor gave them, 0: every scan) are dense,

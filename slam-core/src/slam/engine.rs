@@ -560,7 +560,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         let Prepared {
             cloud,
             thinned,
-            spaced,
             coarse: cloud_source,
             source,
             sweep,
@@ -594,7 +593,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
         // A dense scan within the spacing of the last whole one keeps the points its
         // registration used instead of its whole scan (place recognition still reads it).
         let kept = cloud_source
-            .filter(|_| spaced && !self.whole_scan_due(&pose))
+            .filter(|_| self.spaces_whole_scans(scan) && !self.whole_scan_due(&pose))
             .map(PointCloud::without_ring_and_time);
         let index = self.keyframes.len();
         let id = index as u64;

@@ -21,13 +21,10 @@ pub(super) struct Prepared<S> {
     pub(super) cloud: PointCloud,
     /// The scan thinned to the map's voxel before deskewing, when the backend takes it so.
     pub(super) thinned: Option<PointCloud>,
-    /// A dense scan thinned for the odometry (`thinned` and `coarse` given) whose keyframe keeps
-    /// its whole scan only when it lies
-    /// [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig) from the last that
-    /// did; otherwise `coarse`.
-    pub(super) spaced: bool,
     /// `cloud` thinned again to the odometry's source voxel when `thinned` is given: what the
-    /// source is prepared from and the sweep's motion is found on (voxelised once, not twice).
+    /// source is prepared from and the sweep's motion is found on (voxelised once, not twice),
+    /// and what a dense scan's keyframe keeps within
+    /// [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig) of the last whole one.
     pub(super) coarse: Option<PointCloud>,
     /// How it was deskewed, when it was.
     pub(super) sweep: Option<Sweep>,
@@ -84,7 +81,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             return Err(SkipReason::TooFewPoints);
         }
         let coarse = self.coarse(&cloud, thinned.is_some());
-        let spaced = coarse.is_some() && self.spaces_whole_scans(scan);
         let source = self
             .odometry
             .prepare_source(coarse.as_ref().unwrap_or(&cloud))
@@ -94,7 +90,6 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
             extent: scan_extent(&cloud),
             cloud,
             thinned,
-            spaced,
             coarse,
             sweep,
             source,
@@ -103,7 +98,7 @@ impl<R: MapRegistrator, C: MapRegistrator, O: Optimizer<Pose3>> GraphSlam<R, C, 
 
     /// Whether `scan` is dense enough for its keyframes to keep their whole scan only every
     /// [`GraphSlamConfig::keyframe_scan_spacing`](super::GraphSlamConfig).
-    fn spaces_whole_scans(&self, scan: &ScanInput<'_>) -> bool {
+    pub(super) fn spaces_whole_scans(&self, scan: &ScanInput<'_>) -> bool {
         self.config.keyframe_scan_spacing > 0.0 && scan.cloud.len() > self.config.dense_scan_points
     }
 
