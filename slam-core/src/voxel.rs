@@ -3,6 +3,7 @@
 use std::cell::RefCell;
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 use crate::cloud::PointCloud;
@@ -18,6 +19,9 @@ struct Accumulator {
     /// The ring of the voxel's first point (rings are labels, not averaged).
     ring: u16,
 }
+
+/// Points keyed a chunk when keys are computed on all cores.
+const KEY_CHUNK: usize = 4096;
 
 /// Voxels from the origin within which every voxel key fits (2^62, half the keys' range).
 const KEYABLE_VOXELS: f64 = 4.611_686_018_427_388e18;
@@ -115,10 +119,13 @@ fn packed_key(p: &Point3<f32>, inv: f64) -> Result<Option<u64>, Fallback> {
     }
 }
 
-/// The thinning's working memory: the voxels' index and their sums.
+/// The thinning's working memory: the voxels' index, their sums and each one's first point.
 struct Scratch<K> {
     index: FxHashMap<K, u32>,
     acc: Vec<Accumulator>,
+    /// The index of each voxel's first point, ascending: the order in which parts of a cloud
+    /// thinned apart are merged back.
+    first: Vec<u32>,
 }
 
 impl<K> Default for Scratch<K> {
@@ -126,6 +133,7 @@ impl<K> Default for Scratch<K> {
         Self {
             index: FxHashMap::default(),
             acc: Vec::new(),
+            first: Vec::new(),
         }
     }
 }
@@ -141,12 +149,52 @@ thread_local! {
     /// found no hole in the heap below what a walk keeps (its keyframes) and moved its top up,
     /// so that resident memory grew with the walk without being used.
     static PACKED_SCRATCH: RefCell<Scratch<u64>> = RefCell::new(Scratch::default());
+
+    /// The calling thread's scratch for a thinning split across the thread pool: the points'
+    /// packed keys and one [`Scratch`] a part, lent to the pool's workers and kept from cloud
+    /// to cloud as [`PACKED_SCRATCH`] is.
+    static SPLIT_SCRATCH: RefCell<SplitScratch> = RefCell::new(SplitScratch::default());
+}
+
+/// Working memory of a thinning split across the thread pool.
+#[derive(Default)]
+struct SplitScratch {
+    keys: Vec<u64>,
+    parts: Vec<Scratch<u64>>,
+}
+
+/// Clouds of at least this many points are thinned by the thread pool's workers together, each
+/// summing the voxels of one part of the key space (a dense scan: 131,072 points at 5 cm). The
+/// result is the same to the bit either way; smaller clouds are not worth the hand-over.
+const SPLIT_POINTS: usize = 32_768;
+
+/// At most this many parts.
+const MAX_PARTS: usize = 8;
+
+/// A stand-in key for a point without a voxel (not finite): packed keys use 63 bits.
+const NO_KEY: u64 = u64::MAX;
+
+/// Which of `parts` the packed `key` belongs to: a mix of all its bits, independent of the
+/// hash map's own hash, so that a part's voxels still spread over its table.
+#[inline]
+fn part_of(key: u64, parts: usize) -> usize {
+    let mixed = (key ^ (key >> 31)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    // The top 32 bits times the count, shifted down: a part index below `parts`.
+    (((mixed >> 32) * parts as u64) >> 32) as usize
 }
 
 impl<K: std::hash::Hash + Eq + Copy> Scratch<K> {
     /// Whether this scratch holds room for more than [`KEPT_SCRATCH_VOXELS`] voxels.
     fn oversized(&self) -> bool {
         self.index.capacity().max(self.acc.capacity()) > KEPT_SCRATCH_VOXELS
+    }
+}
+
+impl SplitScratch {
+    /// Whether this scratch holds room for more than a kept [`Scratch`] may, in keys or in any
+    /// part.
+    fn oversized(&self) -> bool {
+        self.keys.capacity() > 4 * KEPT_SCRATCH_VOXELS || self.parts.iter().any(Scratch::oversized)
     }
 }
 
@@ -159,26 +207,51 @@ impl PointCloud {
         scratch: &mut Scratch<K>,
         key: impl Fn(&Point3<f32>) -> Result<Option<K>, Fallback>,
     ) -> Result<(), (Fallback, usize)> {
-        let Scratch { index, acc } = scratch;
+        let mut refusal = None;
+        let keyed = self
+            .points()
+            .iter()
+            .enumerate()
+            .map_while(|(i, p)| match key(p) {
+                Ok(k) => Some(k.map(|k| (i, k))),
+                Err(f) => {
+                    refusal = Some((f, i));
+                    None
+                }
+            })
+            .flatten();
+        self.accumulate_keyed(scratch, (self.len() / 4).min(1 << 15), keyed);
+        refusal.map_or(Ok(()), Err)
+    }
+
+    /// Per-voxel sums of the points `keyed` gives (index, voxel key; indices ascending) into
+    /// `scratch`, with room for `room` voxels first.
+    fn accumulate_keyed<K: std::hash::Hash + Eq + Copy>(
+        &self,
+        scratch: &mut Scratch<K>,
+        room: usize,
+        keyed: impl Iterator<Item = (usize, K)>,
+    ) {
+        let Scratch { index, acc, first } = scratch;
         index.clear();
         acc.clear();
-        // Room for a voxel every four points, up to 32,768: a dense scan thins to about a
-        // third of its points at 5 cm, and a table sized for every point spreads the voxels
-        // over more memory than the core's cache holds (an OS1-128 sweep of 131,072 points at
-        // 5 cm: 3.4 ms against 5.2 ms with room for all). Growing past it rehashes once or twice.
-        let room = (self.len() / 4).min(1 << 15);
+        first.clear();
+        // Room for a voxel every four points, up to 32,768 (the callers' `room`): a dense scan
+        // thins to about a third of its points at 5 cm, and a table sized for every point
+        // spreads the voxels over more memory than the core's cache holds (an OS1-128 sweep of
+        // 131,072 points at 5 cm: 3.4 ms against 5.2 ms with room for all). Growing past it
+        // rehashes once or twice.
         index.reserve(room);
         acc.reserve(room);
+        first.reserve(room);
         let ring = self.ring();
         let intensity = self.intensity();
         let time = self.time();
+        let points = self.points();
         // Consecutive points of a scan (one firing's beams near the sensor, neighbours along a
         // ring) often share a voxel: the previous point's voxel is checked before the hash map.
         let mut last: Option<(K, u32)> = None;
-        for (i, p) in self.points().iter().enumerate() {
-            let Some(key) = key(p).map_err(|f| (f, i))? else {
-                continue;
-            };
+        for (i, key) in keyed {
             let slot = match last {
                 Some((k, slot)) if k == key => slot,
                 _ => *index.entry(key).or_insert_with(|| {
@@ -190,10 +263,12 @@ impl PointCloud {
                         ring: ring.map_or(0, |r| r[i]),
                     });
                     // Clouds hold fewer than 2^32 points.
+                    first.push(i as u32);
                     (acc.len() - 1) as u32
                 }),
             };
             last = Some((key, slot));
+            let p = &points[i];
             let a = &mut acc[slot as usize];
             a.sum += Vector3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z));
             a.count += 1;
@@ -204,14 +279,80 @@ impl PointCloud {
                 a.time += f64::from(v[i]);
             }
         }
-        Ok(())
+    }
+
+    /// [`Self::accumulate`] with packed keys, split across the thread pool: every point's key
+    /// first (in chunks on all cores), then each part of the key space summed on a worker of
+    /// its own, then the parts' centroids merged in the order of their voxels' first points.
+    /// The sums of a voxel run over its points in the same order as on one thread, so the
+    /// cloud is the same to the bit. `None` when a point needs more than a packed key (the
+    /// caller thins on one thread, which finds the refusal).
+    fn thin_split(
+        &self,
+        inv: f64,
+        split: &mut SplitScratch,
+    ) -> Option<Result<PointCloud, CloudError>> {
+        let parts = rayon::current_num_threads().clamp(1, MAX_PARTS);
+        let SplitScratch {
+            keys,
+            parts: scratch,
+        } = split;
+        keys.clear();
+        keys.resize(self.len(), NO_KEY);
+        let packable = keys
+            .par_chunks_mut(KEY_CHUNK)
+            .zip(self.points().par_chunks(KEY_CHUNK))
+            .all(|(keys, points)| {
+                keys.iter_mut()
+                    .zip(points)
+                    .all(|(k, p)| match packed_key(p, inv) {
+                        Ok(Some(key)) => {
+                            *k = key;
+                            true
+                        }
+                        Ok(None) => true,
+                        Err(_) => false,
+                    })
+            });
+        if !packable {
+            return None;
+        }
+        scratch.resize_with(parts, Scratch::default);
+        let keys = &*keys;
+        let room = (self.len() / 4 / parts).min(1 << 15);
+        scratch.par_iter_mut().enumerate().for_each(|(part, s)| {
+            let mine = keys
+                .iter()
+                .enumerate()
+                .filter(|&(_, &k)| k != NO_KEY && part_of(k, parts) == part)
+                .map(|(i, &k)| (i, k));
+            self.accumulate_keyed(s, room, mine);
+        });
+        // Merge the parts by first point: the order one thread would have made.
+        let total = scratch.iter().map(|s| s.acc.len()).sum();
+        let mut heads = vec![0usize; parts];
+        let mut merged = Vec::with_capacity(total);
+        for _ in 0..total {
+            let (part, _) = scratch
+                .iter()
+                .zip(&heads)
+                .enumerate()
+                .filter_map(|(p, (s, &h))| s.first.get(h).map(|&f| (p, f)))
+                .min_by_key(|&(_, f)| f)?;
+            merged.push(&scratch[part].acc[heads[part]]);
+            heads[part] += 1;
+        }
+        Some(self.centroids(merged.iter().copied()))
     }
 
     /// The cloud of the voxels' centroids in `acc`, with the channels this cloud has averaged
     /// (the ring: the voxel's first point's).
-    fn centroids(&self, acc: &[Accumulator]) -> Result<PointCloud, CloudError> {
+    fn centroids<'a>(
+        &self,
+        acc: impl Iterator<Item = &'a Accumulator> + Clone,
+    ) -> Result<PointCloud, CloudError> {
         let points = acc
-            .iter()
+            .clone()
             .map(|a| {
                 let c = a.sum / f64::from(a.count);
                 Point3::new(c.x as f32, c.y as f32, c.z as f32)
@@ -219,21 +360,17 @@ impl PointCloud {
             .collect();
         let mut out = PointCloud::from_points(points);
         if self.ring().is_some() {
-            out = out.with_ring(acc.iter().map(|a| a.ring).collect())?;
+            out = out.with_ring(acc.clone().map(|a| a.ring).collect())?;
         }
         if self.intensity().is_some() {
             out = out.with_intensity(
-                acc.iter()
+                acc.clone()
                     .map(|a| (a.intensity / f64::from(a.count)) as f32)
                     .collect(),
             )?;
         }
         if self.time().is_some() {
-            out = out.with_time(
-                acc.iter()
-                    .map(|a| (a.time / f64::from(a.count)) as f32)
-                    .collect(),
-            )?;
+            out = out.with_time(acc.map(|a| (a.time / f64::from(a.count)) as f32).collect())?;
         }
         Ok(out)
     }
@@ -314,12 +451,27 @@ impl PointCloud {
         // general keys.
         let packed = |scratch: &mut Scratch<u64>| {
             let summed = self.accumulate(scratch, |p| packed_key(p, inv));
-            let out = summed.map(|()| self.centroids(&scratch.acc));
+            let out = summed.map(|()| self.centroids(scratch.acc.iter()));
             if scratch.oversized() {
                 *scratch = Scratch::default();
             }
             out
         };
+        if self.len() >= SPLIT_POINTS && rayon::current_num_threads() > 1 {
+            let split = SPLIT_SCRATCH.with(|kept| match kept.try_borrow_mut() {
+                Ok(mut split) => {
+                    let out = self.thin_split(inv, &mut split);
+                    if split.oversized() {
+                        *split = SplitScratch::default();
+                    }
+                    out
+                }
+                Err(_) => self.thin_split(inv, &mut SplitScratch::default()),
+            });
+            if let Some(out) = split {
+                return out;
+            }
+        }
         let thinned = PACKED_SCRATCH.with(|kept| match kept.try_borrow_mut() {
             Ok(mut scratch) => packed(&mut scratch),
             Err(_) => packed(&mut Scratch::default()),
@@ -333,7 +485,7 @@ impl PointCloud {
                     voxel_key(p, inv).map_err(|()| Fallback::OutOfRange)
                 })
                 .map_err(|(_, i)| out_of_range(i))?;
-                self.centroids(&scratch.acc)
+                self.centroids(scratch.acc.iter())
             }
         }
     }
@@ -399,6 +551,101 @@ mod tests {
             let cloud = PointCloud::from_points(pts);
             let down = cloud.voxel_downsample(voxel).unwrap();
             prop_assert_eq!(sorted_points(&down), oracle_centroids(&cloud, voxel));
+        }
+    }
+
+    /// A dense scan-like cloud (rings of points with times, intensities, a few non-finite):
+    /// a spiral whose neighbours share voxels as a sweep's do.
+    fn dense_cloud(n: usize) -> PointCloud {
+        let points = (0..n)
+            .map(|i| {
+                let a = i as f32 * 0.013;
+                let r = 2.0 + (i % 97) as f32 * 0.11;
+                if i % 5_000 == 17 {
+                    Point3::new(f32::NAN, 0.0, 0.0)
+                } else {
+                    Point3::new(r * a.cos(), r * a.sin(), (i % 128) as f32 * 0.02 - 1.0)
+                }
+            })
+            .collect();
+        PointCloud::from_points(points)
+            .with_ring((0..n).map(|i| (i % 128) as u16).collect())
+            .unwrap()
+            .with_intensity((0..n).map(|i| (i % 251) as f32).collect())
+            .unwrap()
+            .with_time((0..n).map(|i| i as f32 * 1e-6).collect())
+            .unwrap()
+    }
+
+    /// The cloud thinned on a pool of `threads` workers.
+    fn thinned_on(
+        threads: usize,
+        cloud: &PointCloud,
+        voxel: f32,
+    ) -> Result<PointCloud, CloudError> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| cloud.voxel_downsample(voxel))
+    }
+
+    #[test]
+    fn a_dense_cloud_thinned_by_several_workers_is_the_one_thread_cloud_to_the_bit() {
+        let cloud = dense_cloud(3 * SPLIT_POINTS);
+        for voxel in [0.05, 0.25, 1.0] {
+            let alone = thinned_on(1, &cloud, voxel).unwrap();
+            for threads in [2, 3, 8] {
+                let split = thinned_on(threads, &cloud, voxel).unwrap();
+                assert_eq!(split, alone, "{threads} workers at {voxel} m");
+            }
+            // The oracle's voxels and centroids too, and each voxel where its first point is.
+            assert_eq!(
+                sorted_points(&alone),
+                oracle_centroids(&cloud.filtered(|_, p| p.x.is_finite()), voxel)
+            );
+            let inv = 1.0 / f64::from(voxel);
+            let firsts: Vec<usize> = {
+                let mut seen = std::collections::HashSet::new();
+                cloud
+                    .points()
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, p)| {
+                        voxel_key(p, inv)
+                            .unwrap()
+                            .filter(|k| seen.insert(*k))
+                            .map(|_| i)
+                    })
+                    .collect()
+            };
+            let rings = cloud.ring().unwrap();
+            let want: Vec<u16> = firsts.iter().map(|&i| rings[i]).collect();
+            assert_eq!(
+                alone.ring().unwrap(),
+                &want[..],
+                "voxels in the order of their first points"
+            );
+        }
+    }
+
+    #[test]
+    fn a_dense_cloud_beyond_packed_keys_is_thinned_or_refused_as_on_one_thread() {
+        // 1e6 m at 5 cm is 2e7 voxels out: past the packed keys, within the general ones.
+        let mut far = dense_cloud(2 * SPLIT_POINTS);
+        far.points_mut()[40_000] = Point3::new(1e6, 0.0, 0.0);
+        assert_eq!(
+            thinned_on(2, &far, 0.05).unwrap(),
+            thinned_on(1, &far, 0.05).unwrap()
+        );
+        // Beyond any key: the same error with the same point either way.
+        let mut out = dense_cloud(2 * SPLIT_POINTS);
+        out.points_mut()[50_000] = Point3::new(0.0, 3.0e38, 0.0);
+        for threads in [1, 2] {
+            assert!(matches!(
+                thinned_on(threads, &out, 1e-3),
+                Err(CloudError::VoxelOutOfRange { index: 50_000, .. })
+            ));
         }
     }
 
