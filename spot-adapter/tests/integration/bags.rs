@@ -95,13 +95,25 @@ fn lap() -> impl Iterator<Item = Sample> {
         .take(SCANS)
 }
 
-/// The folder of bags written from the lap (once per test run; `bags/` holds the bags, see
-/// `tests/bags/write_bags.py`).
+/// The folder of bags written from the lap (`bags/` holds the bags, see
+/// `tests/bags/write_bags.py`): written once for this build of the tests and this script, and
+/// reused by every test and test process after (a runner such as cargo-nextest runs each test in
+/// a process of its own; they take turns by a lock on a file beside the folder, so that none
+/// reads bags another is still writing).
 pub(crate) fn bags() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let python = python();
-        let dir = target_dir().join("tmp/bags-fixture");
+        let tmp = target_dir().join("tmp");
+        std::fs::create_dir_all(&tmp).unwrap();
+        let lock = std::fs::File::create(tmp.join("bags-fixture.lock")).unwrap();
+        lock.lock().unwrap();
+        let dir = tmp.join("bags-fixture");
+        let stamp = dir.join("written-for");
+        let written_for = fixture_key();
+        if std::fs::read_to_string(&stamp).is_ok_and(|s| s == written_for) {
+            return dir;
+        }
         let _ = std::fs::remove_dir_all(&dir);
         let recording = dir.join("recording");
         let sim = SimulatedSpot::corridor_loop(&sim_config()).unwrap();
@@ -118,9 +130,26 @@ pub(crate) fn bags() -> &'static Path {
                 .arg(dir.join("bags")),
             "writing the bags with rosbags",
         );
+        // Last: a folder without its stamp (an interrupted run) is written again.
+        std::fs::write(&stamp, written_for).unwrap();
         dir
     })
     .as_path()
+}
+
+/// What the bags were written by: this test binary (its path and modification time: a rebuilt
+/// simulator or test rebuilds it) and the script with its pinned packages.
+fn fixture_key() -> String {
+    use std::hash::{DefaultHasher, Hash, Hasher};
+    let exe = std::env::current_exe().unwrap();
+    let built = std::fs::metadata(&exe).and_then(|m| m.modified()).unwrap();
+    let mut script = DefaultHasher::new();
+    for file in ["tests/bags/write_bags.py", "tests/bags/requirements.txt"] {
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(file))
+            .unwrap()
+            .hash(&mut script);
+    }
+    format!("{} {built:?} {:016x}", exe.display(), script.finish())
 }
 
 fn mcap(dir: &Path) -> PathBuf {
