@@ -11,8 +11,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Translation3, UnitQuaternion};
 use slam_core::Pose3;
 use spot_adapter::sim::{
-    Building, BuildingConfig, LidarConfig, MotionProfile, Route, SimRng, SimulatedSpot,
-    SimulationConfig, SpinningLidar,
+    Building, BuildingConfig, LidarConfig, Route, SimRng, SimulatedSpot, SimulationConfig,
+    SpinningLidar,
 };
 
 fn sim(c: &mut Criterion) {
@@ -74,10 +74,7 @@ fn sim(c: &mut Criterion) {
             criterion::BatchSize::LargeInput,
         );
     });
-    let mut handheld = SimulationConfig::with_seed(1);
-    handheld.lidar = LidarConfig::os1_128();
-    handheld.motion = MotionProfile::handheld();
-    handheld.motion_distortion = true;
+    let handheld = SimulationConfig::handheld_os1_128(1);
     group.bench_function("handheld_os1_128_sample", |b| {
         b.iter_batched(
             || SimulatedSpot::corridor_loop(&handheld),

@@ -24,7 +24,7 @@ use spot_adapter::eval::TrajectoryEvaluation;
 use spot_adapter::pipelines::{
     point_to_plane_slam_with, point_to_plane_tracker, scan_context_places, slam_config,
 };
-use spot_adapter::sim::{LidarConfig, MotionProfile, SimulatedSpot, SimulationConfig};
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// What a walk's summary line counts.
 struct Walk {
@@ -36,10 +36,7 @@ struct Walk {
 /// One seed's walk (with `source_points` source points a registration when given), its row, or
 /// why it could not be run.
 fn walk(seed: u64, source_points: Option<usize>) -> Result<(String, Walk), String> {
-    let mut config = SimulationConfig::with_seed(seed);
-    config.lidar = LidarConfig::os1_128();
-    config.motion = MotionProfile::handheld();
-    config.motion_distortion = true;
+    let config = SimulationConfig::handheld_os1_128(seed);
     let sim = SimulatedSpot::floors_tour(&config).map_err(|e| format!("simulation: {e}"))?;
     let body_t_lidar = sim.body_t_lidar();
     let truth = sim.ground_truth();

@@ -97,6 +97,28 @@ impl SimulationConfig {
             ..Self::default()
         }
     }
+
+    /// The hand-held walk with `seed`: an OS1-128 ([`LidarConfig::os1_128`]) carried by a
+    /// walking person ([`MotionProfile::handheld`]: 2 Hz scans, turns of up to 50° between
+    /// them), each 0.1 s sweep skewed by the motion during it (`motion_distortion`). The walk
+    /// `simulate --sensor os1-128 --motion handheld --skewed` makes.
+    ///
+    /// ```
+    /// use spot_adapter::sim::{MotionProfile, SimulationConfig};
+    ///
+    /// let config = SimulationConfig::handheld_os1_128(3);
+    /// assert_eq!((config.seed, config.lidar.rings), (3, 128));
+    /// assert!(matches!(config.motion, MotionProfile::Handheld(_)) && config.motion_distortion);
+    /// ```
+    #[must_use]
+    pub fn handheld_os1_128(seed: u64) -> Self {
+        Self {
+            lidar: LidarConfig::os1_128(),
+            motion: MotionProfile::handheld(),
+            motion_distortion: true,
+            ..Self::with_seed(seed)
+        }
+    }
 }
 
 /// A simulated run: an iterator of [`Sample`]s with ground truth attached.

@@ -15,8 +15,8 @@ use spot_adapter::record::{
 use spot_adapter::robot::Sample;
 use spot_adapter::sim::SimError;
 use spot_adapter::sim::{
-    CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat, LidarConfig,
-    MotionProfile, SimulatedSpot, SimulationConfig,
+    CLOUD_FOLDER_GROUND_TRUTH, CLOUD_FOLDER_ODOMETRY, CloudFolderWriter, CloudFormat,
+    SimulatedSpot, SimulationConfig,
 };
 
 /// A fresh folder under the system's temporary folder.
@@ -56,10 +56,7 @@ fn trajectory_is(dir: &std::path::Path, name: &str, expected: &[(f64, slam_core:
 
 #[test]
 fn a_handheld_run_written_as_plain_ply_files_reads_back_point_for_point() {
-    let mut config = SimulationConfig::with_seed(5);
-    config.lidar = LidarConfig::os1_128();
-    config.motion = MotionProfile::handheld();
-    config.motion_distortion = true;
+    let config = SimulationConfig::handheld_os1_128(5);
     let dir = fresh("ply-folder");
     let samples = write(&config, 3, CloudFormat::Ply, &dir);
     let mut names: Vec<String> = fs::read_dir(&dir)

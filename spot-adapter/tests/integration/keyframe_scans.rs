@@ -13,7 +13,7 @@ use slam_core::io::StampedPose;
 use slam_core::{GraphSlamConfig, PointCloud};
 use spot_adapter::pipelines::{point_to_plane_slam, slam_config};
 use spot_adapter::robot::Sample;
-use spot_adapter::sim::{LidarConfig, MotionProfile, SimulatedSpot, SimulationConfig};
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// What a walk gave: the map at 5 cm, each keyframe's position and how many points it kept,
 /// how many kept their whole scan by the engine's count, and every scan's pose.
@@ -78,10 +78,7 @@ fn beside(of: &HashSet<[i32; 3]>, near: &HashSet<[i32; 3]>) -> f64 {
 #[test]
 fn a_dense_walks_keyframes_keep_their_whole_scan_one_a_metre_and_the_map_stays_whole() {
     // The first 40 scans of the hand-held OS1-128 walk (20 s, about 20 m, one corner).
-    let mut sim_config = SimulationConfig::with_seed(1);
-    sim_config.lidar = LidarConfig::os1_128();
-    sim_config.motion = MotionProfile::handheld();
-    sim_config.motion_distortion = true;
+    let sim_config = SimulationConfig::handheld_os1_128(1);
     let sim = SimulatedSpot::corridor_loop(&sim_config).unwrap();
     let samples: Vec<Sample> = sim.take(40).collect();
     assert!(samples[0].cloud.len() > 100_000);

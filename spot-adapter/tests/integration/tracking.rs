@@ -19,7 +19,7 @@ use spot_adapter::pipelines::{
     point_to_plane_slam, point_to_plane_slam_with, point_to_plane_tracker, slam_config,
 };
 use spot_adapter::robot::Sample;
-use spot_adapter::sim::{LidarConfig, MotionProfile, SimulatedSpot, SimulationConfig};
+use spot_adapter::sim::{SimulatedSpot, SimulationConfig};
 
 /// The engine's settings with the tracker this crate had before the adaptive reach: pairs
 /// within the fine stage's fixed reach only, no retries, no second fine stage from the predicted
@@ -151,10 +151,7 @@ fn hand_held_walk(scans: usize) -> (Vec<Sample>, Pose3) {
 
 /// The first `scans` of the hand-held OS1-128 walk of `seed` and the LiDAR's pose on the body.
 fn hand_held_walk_of_seed(seed: u64, scans: usize) -> (Vec<Sample>, Pose3) {
-    let mut config = SimulationConfig::with_seed(seed);
-    config.lidar = LidarConfig::os1_128();
-    config.motion = MotionProfile::handheld();
-    config.motion_distortion = true;
+    let config = SimulationConfig::handheld_os1_128(seed);
     let sim = SimulatedSpot::corridor_loop(&config).unwrap();
     let body_t_lidar = sim.body_t_lidar();
     (sim.take(scans).collect(), body_t_lidar)
