@@ -297,7 +297,8 @@ impl PointCloud {
             keys,
             parts: scratch,
         } = split;
-        keys.clear();
+        // Every key is written below whenever the keys are used (a point without a voxel gets
+        // `NO_KEY`), so the last cloud's keys are left to be overwritten, not cleared first.
         keys.resize(self.len(), NO_KEY);
         let packable = keys
             .par_chunks_mut(KEY_CHUNK)
@@ -310,7 +311,10 @@ impl PointCloud {
                             *k = key;
                             true
                         }
-                        Ok(None) => true,
+                        Ok(None) => {
+                            *k = NO_KEY;
+                            true
+                        }
                         Err(_) => false,
                     })
             });
@@ -626,6 +630,33 @@ mod tests {
                 &want[..],
                 "voxels in the order of their first points"
             );
+        }
+    }
+
+    /// The split's key buffer is kept from cloud to cloud on a thread: a cloud with points
+    /// that have no voxel, thinned after a larger one whose points all had one, is thinned as
+    /// on one thread (no key of the earlier cloud is taken for those points).
+    #[test]
+    fn a_cloud_thinned_after_a_larger_one_keeps_none_of_its_keys() {
+        let finite = dense_cloud(4 * SPLIT_POINTS).filtered(|_, p| p.x.is_finite());
+        let mut gappy = dense_cloud(3 * SPLIT_POINTS);
+        for (i, p) in gappy.points_mut().iter_mut().enumerate() {
+            if i % 7 == 3 {
+                *p = Point3::new(f32::NAN, 0.0, 0.0);
+            }
+        }
+        for voxel in [0.05, 0.25] {
+            let alone = thinned_on(1, &gappy, voxel).unwrap();
+            let after = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap()
+                .install(|| {
+                    finite.voxel_downsample(voxel).unwrap();
+                    gappy.voxel_downsample(voxel)
+                })
+                .unwrap();
+            assert_eq!(after, alone, "at {voxel} m");
         }
     }
 
